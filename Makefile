@@ -1,0 +1,34 @@
+# The two commands of the README: `make run` starts the workstation,
+# `make test` runs every test. Both set up what they need first.
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: run test bench soak setup system screenshots clean
+
+setup: system $(STAMP)
+
+system:
+	@bash tools/system-packages.sh
+
+$(STAMP): pyproject.toml
+	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[test]'
+	@touch $(STAMP)
+
+run: setup
+	@bash tools/run-gui.sh
+
+test: setup
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q tests
+
+bench: setup
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench
+
+screenshots: setup
+	QT_QPA_PLATFORM=offscreen $(BIN)/python tools/screenshots.py
+
+clean:
+	rm -rf $(VENV) build *.egg-info .pytest_cache

@@ -1,0 +1,157 @@
+"""Derived parameters with propagated uncertainties (physics.md sections 1 and 3).
+
+    fs  = 1 / (2 pi sqrt(CMES LCES))      Mms = CMES Bl^2     Rms = Bl^2 / RES
+    Cms = LCES / Bl^2    Kms = 1 / Cms    Qes = 2 pi fs CMES RE    Qms = 2 pi fs CMES RES
+    Qts = Qes Qms / (Qes + Qms)           Vas = rho c^2 Sd^2 Cms
+    eta0 = rho Bl^2 Sd^2 / (2 pi c RE Mms^2)          (reference efficiency, piston in half space)
+    SPL(1 W, 1 m) = 10 log10(rho c eta0 / (2 pi p0^2))   SPL(2.83 V, 1 m) = SPL(1 W) + 10 log10(2.83^2 / RE)
+
+Uncertainties are propagated to first order through the full covariance of
+the fitted parameters (the `uncertainties` package), so correlations count:
+fs is far better known than CMES or LCES alone.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Mapping
+
+import numpy as np
+import uncertainties
+from uncertainties import umath
+
+from analysis.fit import FitResult
+
+RHO = 1.18        # kg/m^3, air at 20 C
+C_SOUND = 343.0   # m/s
+P_REF = 20e-6     # Pa
+V_283 = 2.83      # V, the customary sensitivity drive (1 W into 8 ohm)
+
+NO_DISPLACEMENT = ("not identifiable without displacement: Bl only appears in Hx; measure with the laser "
+                   "or use an added-mass method")
+NO_SD = "needs Sd: give the effective radiating area (--sd, or the driver's diaphragm diameter)"
+
+
+@dataclass(frozen=True, slots=True)
+class ParameterValue:
+    name: str
+    value: float | None
+    std: float | None
+    unit: str                  # SI
+    display_unit: str
+    display_scale: float       # display = SI * scale
+    reason: str | None = None  # why value is None
+    fitted: bool = False
+
+    def as_json(self) -> dict:
+        if self.value is None:
+            return {"value": None, "reason": self.reason, "unit": self.unit}
+        out = {"value": self.value, "std": self.std, "unit": self.unit}
+        return out
+
+
+@dataclass(frozen=True, slots=True)
+class _Derived:
+    name: str
+    unit: str
+    display_unit: str
+    display_scale: float
+    needs_bl: bool
+    needs_sd: bool
+    formula: Callable
+
+
+def _fs(p):
+    return 1.0 / (2 * np.pi * umath.sqrt(p["CMES"] * p["LCES"]))
+
+
+def _qes(p):
+    return 2 * np.pi * _fs(p) * p["CMES"] * p["RE"]
+
+
+def _qms(p):
+    return 2 * np.pi * _fs(p) * p["CMES"] * p["RES"]
+
+
+def _eta0(p, sd):
+    mms = p["CMES"] * p["Bl"] ** 2
+    return RHO * p["Bl"] ** 2 * sd**2 / (2 * np.pi * C_SOUND * p["RE"] * mms**2)
+
+
+def _spl_1w(p, sd):
+    return 10 * umath.log10(RHO * C_SOUND * _eta0(p, sd) / (2 * np.pi * P_REF**2))
+
+
+DERIVED: tuple[_Derived, ...] = (
+    _Derived("fs", "Hz", "Hz", 1.0, False, False, lambda p, sd: _fs(p)),
+    _Derived("Mms", "kg", "g", 1e3, True, False, lambda p, sd: p["CMES"] * p["Bl"] ** 2),
+    _Derived("Rms", "kg/s", "kg/s", 1.0, True, False, lambda p, sd: p["Bl"] ** 2 / p["RES"]),
+    _Derived("Cms", "m/N", "mm/N", 1e3, True, False, lambda p, sd: p["LCES"] / p["Bl"] ** 2),
+    _Derived("Kms", "N/m", "N/mm", 1e-3, True, False, lambda p, sd: p["Bl"] ** 2 / p["LCES"]),
+    _Derived("Qes", "1", "-", 1.0, False, False, lambda p, sd: _qes(p)),
+    _Derived("Qms", "1", "-", 1.0, False, False, lambda p, sd: _qms(p)),
+    _Derived("Qts", "1", "-", 1.0, False, False, lambda p, sd: _qes(p) * _qms(p) / (_qes(p) + _qms(p))),
+    _Derived("Vas", "m^3", "l", 1e3, True, True,
+             lambda p, sd: RHO * C_SOUND**2 * sd**2 * p["LCES"] / p["Bl"] ** 2),
+    _Derived("eta0", "1", "%", 100.0, True, True, _eta0),
+    _Derived("SPL_1W_1m", "dB", "dB SPL", 1.0, True, True, _spl_1w),
+    _Derived("SPL_2.83V_1m", "dB", "dB SPL", 1.0, True, True,
+             lambda p, sd: _spl_1w(p, sd) + 10 * umath.log10(V_283**2 / p["RE"])),
+)
+
+
+def _correlated(fit: FitResult) -> dict[str, object]:
+    """Fitted values as correlated ufloats (fixed ones as plain floats)."""
+    values: dict[str, object] = dict(fit.values)
+    if fit.covar is not None and fit.varying:
+        nominal = [fit.values[n] for n in fit.varying]
+        try:
+            for name, u in zip(fit.varying, uncertainties.correlated_values(nominal, fit.covar)):
+                values[name] = u
+        except (np.linalg.LinAlgError, ValueError):
+            pass   # a covariance that is not positive semi-definite: values without uncertainty
+    return values
+
+
+def _split(x) -> tuple[float, float | None]:
+    if hasattr(x, "nominal_value"):
+        std = float(x.std_dev)
+        return float(x.nominal_value), std if np.isfinite(std) else None
+    return float(x), None
+
+
+def parameter_table(fit: FitResult, sd_m2: float | None) -> dict[str, ParameterValue]:
+    """Fitted and derived parameters, in the order of physics.md, with reasons for the missing."""
+    table: dict[str, ParameterValue] = {}
+    for spec in fit.model.param_specs:
+        table[spec.name] = ParameterValue(spec.name, fit.values[spec.name], fit.stderr.get(spec.name),
+                                          spec.unit, spec.display_unit, spec.display_scale, fitted=True)
+    has_bl = fit.model.with_displacement
+    if not has_bl:
+        table["Bl"] = ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, NO_DISPLACEMENT)
+    p = _correlated(fit)
+    for d in DERIVED:
+        if d.needs_bl and not has_bl:
+            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
+                                           NO_DISPLACEMENT)
+            continue
+        if d.needs_sd and not sd_m2:
+            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale, NO_SD)
+            continue
+        try:
+            value, std = _split(d.formula(p, sd_m2))
+        except (ValueError, ZeroDivisionError) as exc:
+            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
+                                           f"cannot be computed from the fitted values ({exc})")
+            continue
+        table[d.name] = ParameterValue(d.name, value, std, d.unit, d.display_unit, d.display_scale)
+    return table
+
+
+def derived_from_values(values: Mapping[str, float], sd_m2: float | None = None) -> dict[str, float]:
+    """Derived parameters of plain values (no uncertainties), e.g. for a driver definition."""
+    out = {}
+    for d in DERIVED:
+        if (d.needs_bl and "Bl" not in values) or (d.needs_sd and not sd_m2):
+            continue
+        out[d.name] = float(d.formula(dict(values), sd_m2))
+    return out

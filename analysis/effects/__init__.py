@@ -1,0 +1,41 @@
+"""The effects catalogue: every effect the model lab can add, by id."""
+from __future__ import annotations
+
+from analysis.effects.base import Effect, ParamSpec, Site
+from analysis.effects import creep, inductance
+
+_ALL: tuple[Effect, ...] = (
+    inductance.lr2,
+    creep.creep_log,
+)
+
+CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}
+DEFAULT_EFFECTS = ("lr2", "creep-log")
+
+
+def categories() -> dict[str, list[Effect]]:
+    grouped: dict[str, list[Effect]] = {}
+    for effect in CATALOGUE.values():
+        grouped.setdefault(effect.category, []).append(effect)
+    return grouped
+
+
+def get_effect(effect_id: str) -> Effect:
+    try:
+        return CATALOGUE[effect_id]
+    except KeyError:
+        known = ", ".join(sorted(CATALOGUE))
+        raise KeyError(f"unknown effect {effect_id!r}; known effects: {known}") from None
+
+
+def parse_effects(text: str | None) -> tuple[Effect, ...]:
+    """'lr2,creep-log' -> the effects; '' or 'none' or 'textbook' -> none."""
+    if text is None:
+        return tuple(get_effect(i) for i in DEFAULT_EFFECTS)
+    ids = [t.strip() for t in text.split(",") if t.strip()]
+    if ids in (["none"], ["textbook"]):
+        return ()
+    return tuple(get_effect(i) for i in ids)
+
+
+__all__ = ["CATALOGUE", "DEFAULT_EFFECTS", "Effect", "ParamSpec", "Site", "categories", "get_effect", "parse_effects"]

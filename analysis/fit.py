@@ -1,0 +1,260 @@
+"""Joint weighted least-squares fit of Z and Hx on their complex values.
+
+Every line is weighted by its own standard uncertainty, so the residual of
+each line is in units of its noise: when the model is right and the noise
+estimate honest, the reduced chi^2 of each channel is about 1.
+
+With known per-line uncertainties, -2 ln L = chi^2 + const, so
+
+    AIC = chi^2 + 2k        BIC = chi^2 + k ln n
+
+(n real data points, k varying parameters): differences of these between
+models fitted to the same data are what the model lab ranks by.
+
+Standard errors come from the Jacobian at the optimum (lmfit/MINPACK),
+scaled by sqrt(max(1, reduced chi^2)) (the Birge ratio) so that a model
+that does not fit never claims the precision of one that does.
+"""
+from __future__ import annotations
+
+import keyword
+import threading
+from dataclasses import dataclass, field
+from typing import Callable, Mapping
+
+import lmfit
+import numpy as np
+
+from analysis.effects.base import Site
+from analysis.model import Model
+from analysis.spectra import Spectra, TransferFunction
+from analysis.startvalues import linear_gain, start_context
+
+# A line's uncertainty never counts as less than this fraction of its value:
+# noise-free (simulated) data would otherwise get infinite weights.
+RELATIVE_STD_FLOOR = 1e-9
+CHANNELS = ("impedance", "displacement")
+
+
+class FitError(RuntimeError):
+    """The fit could not run (too few lines, cancelled, no convergence)."""
+
+
+class FitCancelled(FitError):
+    pass
+
+
+@dataclass(frozen=True)
+class FitData:
+    """What the fit sees: Z and optionally Hx at their lines, with per-line uncertainties."""
+
+    impedance: TransferFunction
+    displacement: TransferFunction | None = None
+
+    @classmethod
+    def from_spectra(cls, spectra: Spectra) -> "FitData":
+        return cls(_usable(spectra.impedance), _usable(spectra.displacement) if spectra.displacement else None)
+
+    def channel(self, name: str) -> TransferFunction | None:
+        return self.impedance if name == "impedance" else self.displacement
+
+
+def _usable(tf: TransferFunction) -> TransferFunction:
+    keep = np.isfinite(tf.value) & np.isfinite(tf.std) & (tf.freqs > 0)
+    return tf.restricted(keep)
+
+
+@dataclass(frozen=True)
+class ChannelFit:
+    name: str
+    freqs: np.ndarray
+    measured: np.ndarray
+    model: np.ndarray
+    std: np.ndarray
+    chi2: float
+    n_points: int             # real numbers: 2 per complex line
+    chi2_red: float
+
+    @property
+    def normalized_residual(self) -> np.ndarray:
+        """(model - measured) per line in units of each component's standard deviation (complex)."""
+        return (self.model - self.measured) / (self.std / np.sqrt(2.0))
+
+
+@dataclass(frozen=True)
+class FitResult:
+    model: Model
+    values: dict[str, float]
+    stderr: dict[str, float | None]
+    varying: tuple[str, ...]
+    covar: np.ndarray | None          # of the varying parameters, in `varying` order, Birge-scaled
+    channels: dict[str, ChannelFit]
+    chi2: float
+    n_data: int
+    success: bool
+    message: str
+    nfev: int
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def n_varying(self) -> int:
+        return len(self.varying)
+
+    @property
+    def chi2_red(self) -> float:
+        return self.chi2 / max(self.n_data - self.n_varying, 1)
+
+    @property
+    def aic(self) -> float:
+        return self.chi2 + 2 * self.n_varying
+
+    @property
+    def bic(self) -> float:
+        return self.chi2 + self.n_varying * np.log(self.n_data)
+
+    def chi2_red_by_channel(self) -> dict[str, float]:
+        return {name: ch.chi2_red for name, ch in self.channels.items()}
+
+    def correlation(self) -> np.ndarray | None:
+        if self.covar is None:
+            return None
+        d = np.sqrt(np.diag(self.covar))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.covar / np.outer(d, d)
+
+
+def _sigma(tf: TransferFunction) -> np.ndarray:
+    return np.maximum(tf.std, RELATIVE_STD_FLOOR * np.abs(tf.value)) / np.sqrt(2.0)
+
+
+def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x: bool,
+                     sigmas: dict[str, np.ndarray]) -> np.ndarray:
+    z = data.impedance
+    rz = (model.impedance(2j * np.pi * z.freqs, p) - z.value) / sigmas["impedance"]
+    parts = [rz.real, rz.imag]
+    if use_x:
+        x = data.displacement
+        rx = (model.displacement(2j * np.pi * x.freqs, p) - x.value) / sigmas["displacement"]
+        parts += [rx.real, rx.imag]
+    return np.concatenate(parts)
+
+
+def _lm_name(name: str) -> str:
+    """lmfit names must be identifiers: 'lambda' is a Python keyword."""
+    return name + "_" if keyword.iskeyword(name) else name
+
+
+def _our_name(lm_name: str) -> str:
+    base = lm_name[:-1]
+    return base if lm_name.endswith("_") and keyword.iskeyword(base) else lm_name
+
+
+def _params(model: Model, values: Mapping[str, float], fixed: set[str]) -> lmfit.Parameters:
+    params = lmfit.Parameters()
+    for spec in model.param_specs:
+        value = float(np.clip(values[spec.name], spec.min, spec.max))
+        params.add(_lm_name(spec.name), value=value, min=spec.min, max=spec.max,
+                   vary=spec.name not in fixed)
+    return params
+
+
+def _values(params: lmfit.Parameters) -> dict[str, float]:
+    return {_our_name(name): p.value for name, p in params.items()}
+
+
+def _minimize(model, params, data, use_x, sigmas, cancel) -> lmfit.minimizer.MinimizerResult:
+    def residual(prm):
+        r = _residual_vector(model, _values(prm), data, use_x, sigmas)
+        # A parameter set where the model is undefined is simply very bad:
+        # a fixed size keeps MINPACK's bookkeeping intact.
+        return np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
+
+    def iteration(prm, it, resid, *args, **kws):
+        return bool(cancel is not None and cancel.is_set())   # True aborts lmfit
+
+    minimizer = lmfit.Minimizer(residual, params, iter_cb=iteration, scale_covar=False, nan_policy="propagate")
+    result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12, max_nfev=20000)
+    if cancel is not None and cancel.is_set():
+        raise FitCancelled("fit cancelled")
+    return result
+
+
+def start_values(model: Model, data: FitData) -> dict[str, float]:
+    ctx = start_context(data.impedance)
+    values = ctx.base_values()
+    if model.with_displacement:
+        values["Bl"] = 1.0
+    for effect in model.effects:
+        values.update(effect.guess(ctx))
+    return values
+
+
+def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = None,
+              cancel: threading.Event | None = None) -> FitResult:
+    """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values."""
+    use_x = model.with_displacement
+    if use_x and data.displacement is None:
+        raise FitError("the model needs Hx but the data have no displacement channel")
+    sigmas = {"impedance": _sigma(data.impedance)}
+    if use_x:
+        sigmas["displacement"] = _sigma(data.displacement)
+
+    values = start_values(model, data)
+    warm = dict(start or {})
+    values.update({k: v for k, v in warm.items() if k in values})
+    nfev = 0
+    displacement_only = {s.name for e in model.effects if e.site is Site.DISPLACEMENT for s in e.params}
+    compliance = {s.name for e in model.effects if e.site is Site.COMPLIANCE for s in e.params}
+    cold = {name for name in values if name not in warm}
+
+    # Stage 1: Z alone. Creep barely shows in Z: hold it until Hx joins in.
+    fixed = {"Bl"} | displacement_only | (compliance & cold if use_x else set())
+    if cold - fixed:
+        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel)
+        values = _values(r.params)
+        nfev += r.nfev
+        if compliance & cold and not use_x:
+            r = _minimize(model, _params(model, values, set()), data, False, sigmas, cancel)
+            values = _values(r.params)
+            nfev += r.nfev
+    # Stage 2: Bl is a pure gain on Hx: solve for it linearly.
+    if use_x and "Bl" in cold:
+        x = data.displacement
+        g = model.displacement(2j * np.pi * x.freqs, {**values, "Bl": 1.0})
+        inv_bl = linear_gain(g, x.value, sigmas["displacement"])
+        values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
+    # Stage 3: everything together.
+    result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel)
+    return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
+
+
+def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
+    values = _values(result.params)
+    channels: dict[str, ChannelFit] = {}
+    n_total = 0
+    for name in CHANNELS[: 2 if use_x else 1]:
+        tf = data.channel(name)
+        s = 2j * np.pi * tf.freqs
+        model_values = model.impedance(s, values) if name == "impedance" else model.displacement(s, values)
+        r = (model_values - tf.value) / sigmas[name]
+        chi2 = float(np.sum(r.real**2 + r.imag**2))
+        channels[name] = ChannelFit(name, tf.freqs, tf.value, model_values, sigmas[name] * np.sqrt(2.0),
+                                    chi2, 2 * len(tf.freqs), 0.0)
+        n_total += 2 * len(tf.freqs)
+    varying = tuple(_our_name(n) for n in result.var_names)
+    k = len(varying)
+    chi2 = sum(ch.chi2 for ch in channels.values())
+    # Parameters are shared out to channels by their share of the data.
+    for name, ch in channels.items():
+        dof = max(ch.n_points - k * ch.n_points / n_total, 1.0)
+        channels[name] = ChannelFit(ch.name, ch.freqs, ch.measured, ch.model, ch.std, ch.chi2, ch.n_points,
+                                    ch.chi2 / dof)
+    chi2_red = chi2 / max(n_total - k, 1)
+    birge = max(1.0, chi2_red)
+    covar = None if result.covar is None else np.asarray(result.covar) * birge
+    stderr: dict[str, float | None] = {n: None for n in values}
+    if covar is not None:
+        for i, name in enumerate(varying):
+            stderr[name] = float(np.sqrt(covar[i, i])) if covar[i, i] >= 0 else None
+    return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total,
+                     bool(result.success), str(result.message), int(nfev))

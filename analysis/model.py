@@ -1,0 +1,124 @@
+"""The lumped loudspeaker model of physics.md, composed with effects.
+
+    Ze(s) = RE + s*LE + sum(blocked effects)
+    Y(s)  = s*CMES + 1/RES + 1/(s*LCES*c(s)) + sum(mechanical effects)   c(s): product of compliance factors
+    ZR(s) = 1 / Y(s)
+    Z(s)  = (Ze + ZR) * prod(current-channel factors)
+    Hx(s) = ZR / (ZR + Ze) / (Bl*s) * prod(displacement-channel factors)
+
+The motional branch is written as an admittance so that mechanical effects
+(which add to Zm, and Y = Zm / Bl^2) simply add. Bl only scales Hx.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterable, Mapping
+
+import numpy as np
+
+from analysis.effects.base import Effect, ParamSpec, Site
+
+# The textbook model without extra effects: the lumped elements of physics.md.
+BASE_PARAMS: tuple[ParamSpec, ...] = (
+    ParamSpec("RE", "ohm", "ohm", 1.0, 1e-3, 1e3, 6.0, "voice-coil DC resistance"),
+    ParamSpec("LE", "H", "mH", 1e3, 0.0, 1.0, 1e-4, "voice-coil inductance"),
+    ParamSpec("CMES", "F", "uF", 1e6, 1e-9, 10.0, 4e-4, "moving mass seen from the terminals (Mms / Bl^2)"),
+    ParamSpec("LCES", "H", "mH", 1e3, 1e-7, 100.0, 1e-2, "compliance seen from the terminals (Cms * Bl^2)"),
+    ParamSpec("RES", "ohm", "ohm", 1.0, 1e-3, 1e6, 20.0, "mechanical losses seen from the terminals (Bl^2 / Rms)"),
+)
+BL_PARAM = ParamSpec("Bl", "T*m", "T*m", 1.0, 1e-3, 1e3, 5.0, "force factor")
+ELECTRICAL_BASE = tuple(p.name for p in BASE_PARAMS)
+
+
+class ModelError(ValueError):
+    """A model that cannot be composed (unknown effect, two effects of one category, a name collision)."""
+
+
+@dataclass(frozen=True)
+class Model:
+    """The base lumped model plus effects, at most one per category."""
+
+    effects: tuple[Effect, ...] = ()
+    with_displacement: bool = True
+
+    def __post_init__(self) -> None:
+        seen_categories: dict[str, str] = {}
+        seen_names = {p.name for p in self.base_params}
+        for effect in self.effects:
+            if effect.category in seen_categories:
+                raise ModelError(
+                    f"effects {seen_categories[effect.category]!r} and {effect.id!r} are both of category "
+                    f"{effect.category!r}: keep one (swap instead of adding)")
+            seen_categories[effect.category] = effect.id
+            for name in effect.param_names:
+                if name in seen_names:
+                    raise ModelError(f"effect {effect.id!r} adds parameter {name!r}, which the model already has")
+                seen_names.add(name)
+
+    @property
+    def base_params(self) -> tuple[ParamSpec, ...]:
+        return BASE_PARAMS + ((BL_PARAM,) if self.with_displacement else ())
+
+    @property
+    def param_specs(self) -> tuple[ParamSpec, ...]:
+        specs = list(self.base_params)
+        for effect in self.effects:
+            if effect.site is Site.DISPLACEMENT and not self.with_displacement:
+                continue
+            specs.extend(effect.params)
+        return tuple(specs)
+
+    @property
+    def effect_ids(self) -> tuple[str, ...]:
+        return tuple(e.id for e in self.effects)
+
+    def spec(self, name: str) -> ParamSpec:
+        for p in self.param_specs:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def with_effects(self, effects: Iterable[Effect]) -> "Model":
+        return Model(tuple(effects), self.with_displacement)
+
+    def _site(self, site: Site) -> list[Effect]:
+        return [e for e in self.effects if e.site is site]
+
+    def blocked_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        Ze = p["RE"] + s * p["LE"]
+        for effect in self._site(Site.BLOCKED):
+            Ze = Ze + effect.response(s, p)
+        return Ze
+
+    def motional_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        compliance = np.ones_like(s)
+        for effect in self._site(Site.COMPLIANCE):
+            compliance = compliance * effect.response(s, p)
+        Y = s * p["CMES"] + 1.0 / p["RES"] + 1.0 / (s * p["LCES"] * compliance)
+        for effect in self._site(Site.MECHANICAL):
+            Y = Y + effect.response(s, p)
+        return 1.0 / Y
+
+    def impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        """Z = U / I as the current channel measures it."""
+        Z = self.blocked_impedance(s, p) + self.motional_impedance(s, p)
+        for effect in self._site(Site.CURRENT):
+            Z = Z * effect.response(s, p)
+        return Z
+
+    def displacement(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        """Hx = X / U as the displacement channel measures it."""
+        Ze = self.blocked_impedance(s, p)
+        ZR = self.motional_impedance(s, p)
+        Hx = ZR / (ZR + Ze) / (p["Bl"] * s)
+        for effect in self._site(Site.DISPLACEMENT):
+            Hx = Hx * effect.response(s, p)
+        return Hx
+
+    def describe(self) -> str:
+        return ",".join(self.effect_ids) if self.effects else "textbook"
+
+
+def resonance_frequency(p: Mapping[str, float]) -> float:
+    """fs = 1 / (2*pi*sqrt(CMES*LCES)) = 1 / (2*pi*sqrt(Mms*Cms))."""
+    return 1.0 / (2.0 * np.pi * np.sqrt(p["CMES"] * p["LCES"]))

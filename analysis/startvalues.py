@@ -1,0 +1,103 @@
+"""Start values for the fit, read off the measured impedance and Hx.
+
+The fit must converge without hand tuning on drivers from a 2-inch
+full-range to an 18-inch woofer, so nothing here assumes a driver size:
+
+- RE: the lowest real part of Z (the motional branch and eddy-current
+  losses only add to it);
+- fs and RES: the motional peak of Re(Z) - RE, ignoring a rise that merely
+  continues to the top line (that is the voice coil's inductance);
+- Qms from the half-value bandwidth of that peak (a parallel resonance);
+- LE from Im(Z) / w at the top lines, where the motional branch is spent;
+- Bl by linear least squares: Hx = G / Bl with G known once Z is fitted.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.spectra import TransferFunction
+
+
+class StartValueError(ValueError):
+    """The data show no resonance to start from."""
+
+
+@dataclass(frozen=True, slots=True)
+class StartContext:
+    RE: float
+    fs: float
+    RES: float
+    Qms: float
+    LE_high: float      # Im(Z) / w at the top lines
+    f_min: float
+    f_max: float
+
+    @property
+    def CMES(self) -> float:
+        return self.Qms / (2 * np.pi * self.fs * self.RES)
+
+    @property
+    def LCES(self) -> float:
+        return 1.0 / ((2 * np.pi * self.fs) ** 2 * self.CMES)
+
+    def base_values(self) -> dict[str, float]:
+        return {"RE": self.RE, "LE": self.LE_high, "CMES": self.CMES, "LCES": self.LCES, "RES": self.RES}
+
+
+def _motional_peak(f: np.ndarray, excess: np.ndarray) -> int:
+    """Index of the motional resonance peak in Re(Z) - RE."""
+    # Local maxima, not at the top edge (a rise to the top is inductive).
+    interior = np.flatnonzero((excess[1:-1] >= excess[:-2]) & (excess[1:-1] >= excess[2:])) + 1
+    if interior.size == 0:
+        raise StartValueError("no resonance peak in the real part of the impedance: is the driver connected "
+                              "and does the frequency range include its resonance?")
+    # Prefer the largest peak; a breakup peak is usually much smaller than the main one.
+    return int(interior[np.argmax(excess[interior])])
+
+
+def _half_value_bandwidth(f: np.ndarray, excess: np.ndarray, k: int) -> float:
+    half = excess[k] / 2
+    lo = k
+    while lo > 0 and excess[lo] > half:
+        lo -= 1
+    hi = k
+    while hi < len(f) - 1 and excess[hi] > half:
+        hi += 1
+    f_lo = np.interp(half, [excess[lo], excess[lo + 1]], [f[lo], f[lo + 1]]) if lo < k else f[0]
+    f_hi = np.interp(half, [excess[hi], excess[hi - 1]], [f[hi], f[hi - 1]]) if hi > k else f[-1]
+    if excess[lo] > half:   # the peak's low side runs past the lowest line: mirror the high side
+        f_lo = f[k] ** 2 / f_hi
+    if excess[hi] > half:
+        f_hi = f[k] ** 2 / f_lo
+    return max(f_hi - f_lo, 1e-6 * f[k])
+
+
+def start_context(z: TransferFunction) -> StartContext:
+    finite = np.isfinite(z.value)
+    f = z.freqs[finite]
+    Z = z.value[finite]
+    if f.size < 5:
+        raise StartValueError(f"only {f.size} impedance lines: at least 5 are needed to fit the model")
+    RE = float(np.min(Z.real))
+    if RE <= 0:
+        RE = float(np.min(np.abs(Z)))
+    excess = Z.real - RE
+    k = _motional_peak(f, excess)
+    fs = float(f[k])
+    RES = float(max(excess[k], 1e-3 * RE))
+    Qms = float(np.clip(fs / _half_value_bandwidth(f, excess, k), 0.3, 100.0))
+    top = slice(max(len(f) - 5, k + 1), None)
+    LE = float(np.median(Z.imag[top] / (2 * np.pi * f[top]))) if len(f[top]) else 0.0
+    return StartContext(RE=RE, fs=fs, RES=RES, Qms=Qms, LE_high=max(LE, 1e-7),
+                        f_min=float(f[0]), f_max=float(f[-1]))
+
+
+def linear_gain(model_values: np.ndarray, measured: np.ndarray, std: np.ndarray) -> float:
+    """The real g minimising sum |g*model - measured|^2 / std^2."""
+    w = 1.0 / np.maximum(std, 1e-300) ** 2
+    ok = np.isfinite(model_values) & np.isfinite(measured) & np.isfinite(w)
+    num = np.sum(w[ok] * (np.conj(model_values[ok]) * measured[ok]).real)
+    den = np.sum(w[ok] * np.abs(model_values[ok]) ** 2)
+    return float(num / den)

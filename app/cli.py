@@ -1,0 +1,83 @@
+"""The `linpar` command line. Qt is imported only by `linpar gui`."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Sequence
+
+EXIT_OK, EXIT_ERROR = 0, 2
+
+
+class CliError(Exception):
+    """A user error: printed as one line, exit code 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, no usage dump: scripts read stderr
+        raise CliError(f"{message} (see 'linpar {self.prog.split()[-1]} --help')"
+                       if " " in self.prog else f"{message} (see 'linpar --help')")
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="linpar", description="Loudspeaker linear parameters from voltage, current and "
+                                                "laser displacement.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    analyze = sub.add_parser("analyze", help="fit the parameters of a recording")
+    analyze.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
+    analyze.add_argument("--sd", type=_positive_float, metavar="M2", help="effective radiating area in m^2")
+    analyze.add_argument("--model", metavar="EFFECTS",
+                         help="effect ids separated by commas (default lr2,creep-log; 'none' for the textbook model)")
+    analyze.add_argument("--json", action="store_true", help="print one JSON object")
+
+    diagnose = sub.add_parser("diagnose", help="find which physical effect the model lacks")
+    diagnose.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
+    diagnose.add_argument("--from", dest="start", metavar="EFFECTS", default="none",
+                          help="the starting model's effect ids (default: the textbook model)")
+    diagnose.add_argument("--sd", type=_positive_float, metavar="M2")
+    diagnose.add_argument("--json", action="store_true")
+
+    effects = sub.add_parser("effects", help="list the effects catalogue")
+    effects.add_argument("--json", action="store_true")
+
+    gui = sub.add_parser("gui", help="start the workstation window")
+    gui.add_argument("path", nargs="?", help="a recording to open")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        return _run(args)
+    except CliError as exc:
+        print(f"linpar: error: {exc}", file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        print("linpar: interrupted", file=sys.stderr)
+        return 130
+
+
+def _run(args: argparse.Namespace) -> int:
+    if args.command == "gui":
+        from app.main import run_gui
+        return run_gui(args.path)
+    from app import cli_commands
+    try:
+        return cli_commands.dispatch(args)
+    except cli_commands.USER_ERRORS as exc:
+        raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,96 @@
+"""What each `linpar` subcommand does (no Qt here)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from analysis.derived import ParameterValue
+from analysis.drivers import DriverFileError
+from analysis.effects import CATALOGUE, categories, parse_effects
+from analysis.fit import FitError
+from analysis.model import ModelError
+from analysis.pipeline import AnalysisResult, analyze_path, result_json
+from analysis.recording import RecordingError
+from analysis.spectra import SpectrumError
+from analysis.startvalues import StartValueError
+
+USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelError, DriverFileError,
+               KeyError, OSError)
+
+
+def dispatch(args: argparse.Namespace) -> int:
+    if args.command == "analyze":
+        return cmd_analyze(args)
+    if args.command == "diagnose":
+        from app.cli_diagnose import cmd_diagnose
+        return cmd_diagnose(args)
+    if args.command == "effects":
+        return cmd_effects(args)
+    raise KeyError(f"unknown command {args.command!r}")
+
+
+def _effects(text: str | None):
+    try:
+        return parse_effects(text)
+    except KeyError as exc:
+        raise ModelError(f"--model: {exc.args[0]}") from None
+
+
+def cmd_analyze(args: argparse.Namespace) -> int:
+    result = analyze_path(args.path, args.sd, _effects(args.model))
+    if args.json:
+        print(json.dumps(result_json(result), allow_nan=False, default=_json_number))
+    else:
+        print(format_result(result))
+    return 0
+
+
+def _json_number(value):
+    return None
+
+
+def format_value(p: ParameterValue) -> tuple[str, str]:
+    if p.value is None:
+        return "n/a", ""
+    v = p.value * p.display_scale
+    s = None if p.std is None else p.std * abs(p.display_scale)
+    digits = 4
+    if s and s > 0:
+        import math
+        digits = max(2, min(8, int(-math.floor(math.log10(s))) + 1))
+        return f"{v:.{digits}f}" if abs(v) < 1e6 else f"{v:.6g}", f"{s:.2g}"
+    return f"{v:.6g}", "-"
+
+
+def format_result(result: AnalysisResult) -> str:
+    lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"]
+    notes = []
+    for p in result.parameters.values():
+        value, std = format_value(p)
+        lines.append(f"{p.name:<14}{value:>14}  {std:>10}  {p.display_unit}")
+        if p.value is None:
+            notes.append(f"  {p.name}: {p.reason}")
+    fit = result.fit
+    chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
+    lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   BIC {fit.bic:.1f}"
+              f"   ({fit.n_data} data, {fit.n_varying} parameters)"]
+    if not fit.success:
+        lines.append(f"warning: the fit did not converge: {fit.message}")
+    if notes:
+        lines += ["", "not reported:"] + sorted(set(notes))
+    lines.append(f"validity: {result.validity.get('overall', 'unknown')}")
+    return "\n".join(lines)
+
+
+def cmd_effects(args: argparse.Namespace) -> int:
+    if args.json:
+        print(json.dumps([e.describe() for e in CATALOGUE.values()], indent=1))
+        return 0
+    for category, effects in categories().items():
+        print(f"[{category}]")
+        for e in effects:
+            params = ", ".join(f"{p.name} [{p.display_unit}]" for p in e.params)
+            print(f"  {e.id:<22} {e.title} ({params})")
+            print(f"  {'':<22} cures: {e.signature}")
+    return 0

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the Debian packages linpar needs (PortAudio for the sound card,
+# jackd2 for the virtual rig, the libraries Qt loads), when they are missing.
+# As root it installs them with apt-get; otherwise it says what to install.
+set -u
+needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 libfontconfig1 libdbus-1-3 libxcb-cursor0 libglib2.0-0)
+missing=()
+for pkg in "${needed[@]}"; do
+  dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+if [ "$(id -u)" -ne 0 ]; then
+  echo "linpar needs these Debian packages: ${missing[*]}" >&2
+  echo "Install them with: sudo apt-get install ${missing[*]}" >&2
+  echo "(continuing: the in-process simulator works without PortAudio and JACK)" >&2
+  exit 0
+fi
+echo "Installing Debian packages: ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+# jackd2 asks whether to enable realtime priority: answer no, non-interactively.
+echo "jackd2 jackd/tweak_rt_limits boolean false" | debconf-set-selections 2>/dev/null || true
+apt-get update -qq >/dev/null 2>&1 || apt-get update
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null || {
+  echo "apt-get could not install: ${missing[*]}" >&2
+  exit 1
+}
