@@ -16,6 +16,9 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+# Imported before the effects: effects that need fs import it from here while
+# this module is still loading (analysis.lumped is the cycle-free home).
+from analysis.lumped import resonance_frequency  # noqa: F401  (re-exported)
 from analysis.effects.base import Effect, ParamSpec, Site
 
 # The textbook model without extra effects: the lumped elements of physics.md.
@@ -118,7 +121,3 @@ class Model:
     def describe(self) -> str:
         return ",".join(self.effect_ids) if self.effects else "textbook"
 
-
-def resonance_frequency(p: Mapping[str, float]) -> float:
-    """fs = 1 / (2*pi*sqrt(CMES*LCES)) = 1 / (2*pi*sqrt(Mms*Cms))."""
-    return 1.0 / (2.0 * np.pi * np.sqrt(p["CMES"] * p["LCES"]))

@@ -30,7 +30,7 @@ ANALYSED_SIGNALS = ("voltage", "current", "displacement")
 DETECT_SNR_DB = 20.0
 DETECT_RANGE_DB = 60.0
 # Degrees of freedom each line's noise estimate should rest on (see _transfer).
-MIN_NOISE_DOF = 14
+MIN_NOISE_DOF = 40
 
 
 class SpectrumError(ValueError):

@@ -1,0 +1,528 @@
+"""Recordings: the raw signals of one multitone measurement, and their files.
+
+A recording is NAME.wav (the samples) and NAME.json (the sidecar: what each
+channel is and how to scale it); the format is /work/shared/spec/recording-format.md.
+A Recording in memory always satisfies every rule of the format: the checks run
+when it is built, whether from files (read_recording), from signals
+(make_recording) or directly, so code that holds one need not check again.
+
+Messages name the file (or "<in memory>"), the sidecar key or the channel, what
+was found and what was expected, on one line: they are shown to the user as is.
+"""
+from __future__ import annotations
+
+import json
+import math
+import numbers
+import os
+import re
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Mapping
+
+import numpy as np
+
+from analysis.recording_wav import WavFormatError, decode_wav, encode_float32_wav
+
+FORMAT = "linpar-recording/1"
+# The signals the analysis knows, with the only unit each may be in.
+UNITS = MappingProxyType({"voltage": "V", "current": "A", "displacement": "m"})
+REQUIRED_SIGNALS = ("voltage", "current")
+# Two periods are the fewest from which the noise on a line can be estimated.
+MIN_PERIODS = 2
+IN_MEMORY = "<in memory>"
+_CHANNEL_KEYS = ("signal", "unit", "scale")
+_EXCITATION_KEYS = ("period_samples", "settle_periods", "excited_bins")
+_TOP_KEYS = ("format", "channels", "excitation", "driver")
+
+
+class RecordingError(ValueError):
+    """A recording that breaks the format. str(err) is ONE line naming the file, the key or channel, and what was expected."""
+
+    def __init__(self, message: str):
+        super().__init__(" ".join(str(message).splitlines()))
+
+
+@dataclass(frozen=True, slots=True)
+class Channel:
+    signal: str      # "voltage" | "current" | "displacement" | any other name (kept, not analysed)
+    unit: str
+    scale: float     # physical = sample * scale
+    # Other keys of the sidecar's channel entry, written back unchanged; not compared.
+    extra: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+
+# eq=False: comparing recordings field by field would compare numpy arrays,
+# which has no single truth value; a Recording is compared by identity.
+@dataclass(frozen=True, eq=False)
+class Recording:
+    sample_rate: int
+    channels: tuple[Channel, ...]
+    data: np.ndarray            # (n_channels, n_samples) float64, C-contiguous, physical units, read-only
+    period_samples: int
+    settle_periods: int = 0
+    excited_bins: tuple[int, ...] | None = None    # sorted
+    driver: Mapping[str, Any] = field(default_factory=dict)
+    extra: Mapping[str, Any] = field(default_factory=dict)     # other top-level sidecar keys
+    source: Path | None = None  # the .wav it was read from
+    # Other keys of the sidecar's "excitation" object, written back unchanged.
+    excitation_extra: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name, value in _checked_fields(self).items():
+            object.__setattr__(self, name, value)
+
+    def signal(self, name: str) -> np.ndarray | None:
+        """The row of that signal in physical units, or None if the recording has none."""
+        for row, channel in enumerate(self.channels):
+            if channel.signal == name:
+                return self.data[row]
+        return None
+
+    @property
+    def n_samples(self) -> int:
+        return self.data.shape[1]
+
+    @property
+    def n_periods(self) -> int:
+        """Whole periods after the settle periods; a trailing partial period does not count."""
+        analysed = self.n_samples - self.settle_periods * self.period_samples
+        return max(analysed // self.period_samples, 0)
+
+    def periods(self, name: str) -> np.ndarray:
+        """(n_periods, period_samples) read-only view of the analysed part of one signal."""
+        row = self.signal(name)
+        if row is None:
+            raise KeyError(f"no {name!r} channel in this recording "
+                           f"(it has {', '.join(c.signal for c in self.channels)})")
+        start = self.settle_periods * self.period_samples
+        stop = start + self.n_periods * self.period_samples
+        return row[start:stop].reshape(self.n_periods, self.period_samples)
+
+    @property
+    def duration_s(self) -> float:
+        return self.n_samples / self.sample_rate
+
+
+def read_recording(path: str | Path) -> Recording:
+    """Read NAME.wav + NAME.json; `path` is the stem, NAME.wav or NAME.json.
+
+    Every rule of the format is checked; a file that breaks one raises
+    RecordingError and nothing is returned.
+    """
+    wav_path, json_path = recording_paths(path)
+    for missing, other, what in ((json_path, wav_path, "sidecar"), (wav_path, json_path, "signals")):
+        if not missing.is_file():
+            raise RecordingError(f"{missing}: missing, expected the {what} of the recording next to {other.name}")
+    sidecar = _parse_sidecar(_load_json(json_path), str(json_path))
+    channels = _checked_channels(sidecar["channels"], str(json_path))
+    try:
+        wav = decode_wav(_read_bytes(wav_path))
+    except WavFormatError as err:
+        raise RecordingError(f"{wav_path}: {err}") from None
+    _check_channel_count(wav.samples.shape[0], len(channels), str(wav_path), str(json_path))
+    scales = np.array([c.scale for c in channels])[:, None]
+    with np.errstate(over="ignore", invalid="ignore"):   # a scale that overflows is refused below
+        data = wav.samples * scales
+    data.flags.writeable = False
+    return Recording(sample_rate=wav.sample_rate, channels=channels, data=data, source=wav_path, **sidecar["rest"])
+
+
+def write_recording(path: str | Path, recording: Recording) -> tuple[Path, Path]:
+    """Write NAME.wav (32-bit float, samples = data / scale) and NAME.json; return their paths.
+
+    Each file is written atomically. Nothing is written unless both can be:
+    the samples and the sidecar are encoded in memory first. The .wav is
+    replaced before the .json, so a new sidecar never points at a missing file.
+    RecordingError if the data do not fit the format; OSError if the folder
+    cannot be written.
+    """
+    wav_path, json_path = recording_paths(path)
+    scales = np.array([c.scale for c in recording.channels])[:, None]
+    with np.errstate(over="ignore"):
+        samples = (recording.data / scales).astype(np.float32)
+    _check_finite(samples, recording.channels, f"{wav_path} (as 32-bit float, data / scale)")
+    try:
+        wav_bytes = encode_float32_wav(recording.sample_rate, samples)
+    except WavFormatError as err:
+        raise RecordingError(f"{wav_path}: {err}") from None
+    json_bytes = _format_sidecar(_sidecar_of(recording)).encode("utf-8")
+    _write_atomic(wav_path, wav_bytes)
+    _write_atomic(json_path, json_bytes)
+    return wav_path, json_path
+
+
+def make_recording(sample_rate: int, signals: Mapping[str, np.ndarray], period_samples: int,
+                   settle_periods: int = 0, excited_bins=None, driver=None, extra=None) -> Recording:
+    """A Recording of physical signals (V, A, m) computed or measured in this program.
+
+    Every channel gets scale 1.0: float32 keeps 24 significant bits at any
+    magnitude, so no scale would make the written file more precise. Signals
+    that the analysis does not know get the unit "" (unknown). The data stay
+    float64 in memory; a written and re-read copy is rounded to float32.
+    """
+    if not isinstance(signals, Mapping):
+        raise RecordingError(f"{IN_MEMORY}: signals: found {_show(signals)}, expected a mapping of name -> samples")
+    rows = []
+    for name, values in signals.items():
+        try:
+            # A complex array would be cast silently, dropping its imaginary part.
+            row = None if np.iscomplexobj(values) else np.asarray(values, dtype=np.float64)
+        except (TypeError, ValueError):
+            row = None
+        if row is None or row.ndim != 1:
+            raise RecordingError(f"{IN_MEMORY}: signal {name!r}: found {_show(values)}, "
+                                 f"expected a 1-D array of real numbers")
+        if rows and len(row) != len(rows[0]):
+            raise RecordingError(f"{IN_MEMORY}: signal {name!r}: {len(row)} samples, expected {len(rows[0])} "
+                                 f"like {next(iter(signals))!r}")
+        rows.append(row)
+    data = np.stack(rows) if rows else np.empty((0, 0))
+    data.flags.writeable = False    # ours alone: the Recording may keep it without a copy
+    channels = tuple(Channel(name, UNITS.get(name, ""), 1.0) for name in signals)
+    return Recording(sample_rate=sample_rate, channels=channels, data=data, period_samples=period_samples,
+                     settle_periods=settle_periods, excited_bins=excited_bins,
+                     driver={} if driver is None else driver, extra={} if extra is None else extra)
+
+
+def recording_paths(path: str | Path) -> tuple[Path, Path]:
+    """(NAME.wav, NAME.json) for a stem, NAME.wav or NAME.json."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".wav":
+        return path, path.with_suffix(".json")
+    if suffix == ".json":
+        return path.with_suffix(".wav"), path
+    # A stem may hold dots ("sweep.2024-05-01"): add the suffix, never replace.
+    return path.with_name(path.name + ".wav"), path.with_name(path.name + ".json")
+
+
+# --- the rules, shared by every way of building a Recording -----------------
+
+def _checked_fields(rec: Recording) -> dict[str, Any]:
+    """The fields of `rec`, normalised, or RecordingError for the first broken rule."""
+    source = None if rec.source is None else Path(rec.source)
+    wav_label, json_label = ((IN_MEMORY, IN_MEMORY) if source is None
+                             else tuple(str(p) for p in recording_paths(source)))
+    channels = _checked_channels(rec.channels, json_label)
+    data = _checked_data(rec.data, channels, wav_label, json_label)
+    sample_rate = _integer(rec.sample_rate, 1, wav_label, "sample rate", "a positive integer (Hz)")
+    period = _integer(rec.period_samples, 1, json_label, "excitation.period_samples", "a positive integer")
+    settle = _integer(rec.settle_periods, 0, json_label, "excitation.settle_periods", "a non-negative integer")
+    _check_length(data.shape[1], period, settle, json_label, wav_label)
+    return {
+        "sample_rate": sample_rate, "channels": channels, "data": data, "period_samples": period,
+        "settle_periods": settle, "source": source,
+        "excited_bins": _checked_bins(rec.excited_bins, period, json_label),
+        "driver": _checked_driver(rec.driver, json_label),
+        "extra": _checked_mapping(rec.extra, _TOP_KEYS, json_label, ""),
+        "excitation_extra": _checked_mapping(rec.excitation_extra, _EXCITATION_KEYS, json_label, "excitation."),
+    }
+
+
+def _checked_channels(channels, label: str) -> tuple[Channel, ...]:
+    if not isinstance(channels, (list, tuple)) or not channels:
+        raise RecordingError(f"{label}: channels: found {_show(channels)}, "
+                             f"expected a non-empty list of {{signal, unit, scale}}")
+    checked: list[Channel] = []
+    first_seen: dict[str, int] = {}
+    for i, channel in enumerate(channels):
+        key = f"channels[{i}]"
+        if not isinstance(channel, Channel):
+            raise RecordingError(f"{label}: {key}: found {_show(channel)}, expected a Channel")
+        signal, unit, scale = channel.signal, channel.unit, channel.scale
+        if not isinstance(signal, str) or not signal:
+            raise RecordingError(f"{label}: {key}.signal: found {_show(signal)}, expected a non-empty string")
+        if signal in first_seen:
+            raise RecordingError(f"{label}: {key}.signal: {signal!r} again (first in channels[{first_seen[signal]}]), "
+                                 f"expected each signal once")
+        first_seen[signal] = i
+        expected_unit = UNITS.get(signal)
+        if not isinstance(unit, str) or (expected_unit is not None and unit != expected_unit):
+            raise RecordingError(f"{label}: {key}.unit: found {_show(unit)} for signal {signal!r}, "
+                                 f"expected {_unit_wanted(signal)}")
+        if not _is_finite_real(scale) or scale == 0:
+            raise RecordingError(f"{label}: {key}.scale: found {_show(scale)} for signal {signal!r}, "
+                                 f"expected a finite nonzero number")
+        extra = _checked_mapping(channel.extra, _CHANNEL_KEYS, label, f"{key}.")
+        checked.append(Channel(signal, unit, float(scale), extra))
+    for required in REQUIRED_SIGNALS:
+        if required not in first_seen:
+            raise RecordingError(f"{label}: channels: no {required!r} channel (found {', '.join(map(repr, first_seen))}), "
+                                 f"expected a 'voltage' and a 'current' channel")
+    return tuple(checked)
+
+
+def _checked_data(data, channels: tuple[Channel, ...], wav_label: str, json_label: str) -> np.ndarray:
+    if np.iscomplexobj(data):
+        raise RecordingError(f"{wav_label}: data: found complex samples, expected real numbers")
+    if not (isinstance(data, np.ndarray) and data.dtype == np.float64 and data.flags.c_contiguous
+            and not data.flags.writeable):
+        try:
+            data = np.array(data, dtype=np.float64, order="C")
+        except (TypeError, ValueError):
+            raise RecordingError(f"{wav_label}: data: found {_show(data)}, expected an array of numbers") from None
+        data.flags.writeable = False
+    if data.ndim != 2:
+        raise RecordingError(f"{wav_label}: data: found shape {data.shape}, expected (n_channels, n_samples)")
+    _check_channel_count(data.shape[0], len(channels), wav_label, json_label)
+    _check_finite(data, channels, wav_label)
+    return data
+
+
+def _check_channel_count(found: int, expected: int, wav_label: str, json_label: str) -> None:
+    if found != expected:
+        per = "channel" if json_label == IN_MEMORY else f"entry of 'channels' in {Path(json_label).name}"
+        raise RecordingError(f"{wav_label}: {found} channels, expected {expected}, one per {per}")
+
+
+def _check_finite(data: np.ndarray, channels: tuple[Channel, ...], label: str) -> None:
+    bad = ~np.isfinite(data)
+    if bad.any():
+        row = int(np.flatnonzero(bad.any(axis=1))[0])
+        index = int(np.argmax(bad[row]))
+        what = "NaN" if np.isnan(data[row, index]) else "infinite"
+        raise RecordingError(f"{label}: channel {channels[row].signal!r} (channel {row + 1}): sample {index} is {what}, "
+                             f"expected finite samples")
+
+
+def _check_length(n_samples: int, period: int, settle: int, json_label: str, wav_label: str) -> None:
+    if period > n_samples:
+        raise RecordingError(f"{json_label}: excitation.period_samples: {period} samples is longer than the recording "
+                             f"({n_samples} samples in {wav_label}), expected at most {n_samples // MIN_PERIODS}")
+    left = max(n_samples // period - settle, 0)
+    if left < MIN_PERIODS:
+        raise RecordingError(f"{json_label}: excitation: {n_samples} samples hold {n_samples // period} whole periods "
+                             f"of {period} samples, {settle} to settle, which leaves {left}; expected at least "
+                             f"{MIN_PERIODS} whole periods after the settle periods")
+
+
+def _checked_bins(bins, period: int, label: str) -> tuple[int, ...] | None:
+    if bins is None:
+        return None
+    top = period // 2
+    expected = f"a non-empty list of distinct integers in 1..{top} (period_samples // 2)"
+    try:
+        if isinstance(bins, (str, bytes, Mapping)):
+            raise TypeError
+        bins = list(bins)
+    except TypeError:
+        raise RecordingError(f"{label}: excitation.excited_bins: found {_show(bins)}, expected {expected}") from None
+    if not bins:
+        raise RecordingError(f"{label}: excitation.excited_bins: found an empty list, expected {expected}")
+    seen: set[int] = set()
+    for i, b in enumerate(bins):
+        if not _is_integer(b) or not 1 <= b <= top or b in seen:
+            problem = f"{b!r} again" if _is_integer(b) and b in seen else f"found {_show(b)}"
+            raise RecordingError(f"{label}: excitation.excited_bins[{i}]: {problem}, expected {expected}")
+        seen.add(int(b))
+    return tuple(sorted(seen))
+
+
+def _checked_driver(driver, label: str) -> Mapping[str, Any]:
+    driver = _checked_mapping(driver, (), label, "driver.", whole_key="driver")
+    if "name" in driver and not isinstance(driver["name"], str):
+        raise RecordingError(f"{label}: driver.name: found {_show(driver['name'])}, expected a string")
+    if "sd_m2" in driver:
+        sd = driver["sd_m2"]
+        if not _is_finite_real(sd) or sd <= 0:
+            raise RecordingError(f"{label}: driver.sd_m2: found {_show(sd)}, expected a positive area in m^2")
+    return driver
+
+
+def _checked_mapping(mapping, reserved, label: str, prefix: str, whole_key: str | None = None) -> Mapping[str, Any]:
+    """A read-only copy of a mapping that must stay writable as JSON beside the keys in `reserved`."""
+    where = whole_key or (prefix + "extra" if prefix else "extra")
+    if not isinstance(mapping, Mapping):
+        raise RecordingError(f"{label}: {where}: found {_show(mapping)}, expected an object (a mapping)")
+    for key, value in mapping.items():
+        if not isinstance(key, str) or key in reserved:
+            other_than = f" other than {', '.join(reserved)}" if reserved else ""
+            raise RecordingError(f"{label}: {where}: key {_show(key)}, expected a string{other_than}")
+        try:
+            json.dumps(value, allow_nan=False, default=_json_default)
+        except (TypeError, ValueError, RecursionError):
+            raise RecordingError(f"{label}: {prefix}{key}: found {_show(value)}, "
+                                 f"expected a JSON value (no NaN or infinity)") from None
+    return MappingProxyType(dict(mapping))
+
+
+# --- the sidecar --------------------------------------------------------------
+
+def _load_json(path: Path) -> Any:
+    try:
+        text = _read_bytes(path).decode("utf-8-sig")   # tolerate the BOM that some editors add
+    except UnicodeDecodeError as err:
+        raise RecordingError(f"{path}: not UTF-8 (byte {err.start}), expected a UTF-8 JSON object") from None
+    try:
+        return json.loads(text, parse_constant=_refuse_constant)
+    except _NotJson as err:
+        line = _line_of(text, str(err))
+        raise RecordingError(f"{path}: invalid JSON at line {line}: {err} is not a JSON number, "
+                             f"expected a JSON object with finite numbers") from None
+    except json.JSONDecodeError as err:
+        raise RecordingError(f"{path}: invalid JSON at line {err.lineno}, column {err.colno}: {err.msg}, "
+                             f"expected a JSON object") from None
+    except RecursionError:
+        raise RecordingError(f"{path}: JSON nested too deeply, expected a JSON object") from None
+
+
+class _NotJson(ValueError):
+    pass
+
+
+def _refuse_constant(name: str):
+    # NaN and Infinity are Python's extension, not JSON: other readers refuse them.
+    raise _NotJson(name)
+
+
+def _line_of(text: str, token: str) -> int:
+    """Line of the first bare `token` (not inside a string, as far as a regex can tell)."""
+    match = re.search(rf'(?<![\w"]){re.escape(token)}(?![\w"])', text)
+    return text.count("\n", 0, match.start()) + 1 if match else 1
+
+
+def _parse_sidecar(doc: Any, label: str) -> dict[str, Any]:
+    """Channels and the other Recording fields of a sidecar, by key; values are checked later."""
+    if not isinstance(doc, dict):
+        raise RecordingError(f"{label}: found a JSON {_json_type(doc)} at the top, expected a JSON object")
+    if doc.get("format") != FORMAT:
+        found = f"found {_show(doc['format'])}" if "format" in doc else "missing"
+        raise RecordingError(f"{label}: format: {found}, expected exactly {FORMAT!r}")
+    entries = _required(doc, "channels", list, label, "channels", "a non-empty list of {signal, unit, scale}")
+    channels = []
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict):
+            raise RecordingError(f"{label}: channels[{i}]: found a JSON {_json_type(entry)}, "
+                                 f"expected an object with signal, unit and scale")
+        signal = entry.get("signal")
+        for key in _CHANNEL_KEYS:
+            if key not in entry:
+                wanted = {"signal": "a signal name (voltage, current, displacement or another)",
+                          "unit": _unit_wanted(signal),
+                          "scale": "a finite nonzero number (physical value = sample x scale)"}[key]
+                raise RecordingError(f"{label}: channels[{i}].{key}: missing, expected {wanted}")
+        extra = {k: v for k, v in entry.items() if k not in _CHANNEL_KEYS}
+        channels.append(Channel(entry["signal"], entry["unit"], entry["scale"], extra))
+    excitation = _required(doc, "excitation", dict, label, "excitation", "an object with period_samples")
+    if "period_samples" not in excitation:
+        raise RecordingError(f"{label}: excitation.period_samples: missing, "
+                             f"expected the length of one period in samples (a positive integer)")
+    return {"channels": channels, "rest": {
+        "period_samples": excitation["period_samples"],
+        "settle_periods": excitation.get("settle_periods", 0),
+        "excited_bins": excitation.get("excited_bins"),
+        "excitation_extra": {k: v for k, v in excitation.items() if k not in _EXCITATION_KEYS},
+        "driver": doc.get("driver", {}),
+        "extra": {k: v for k, v in doc.items() if k not in _TOP_KEYS},
+    }}
+
+
+def _required(doc: dict, key: str, kind: type, label: str, where: str, expected: str):
+    if key not in doc:
+        raise RecordingError(f"{label}: {where}: missing, expected {expected}")
+    if not isinstance(doc[key], kind):
+        raise RecordingError(f"{label}: {where}: found a JSON {_json_type(doc[key])}, expected {expected}")
+    return doc[key]
+
+
+def _sidecar_of(rec: Recording) -> dict[str, Any]:
+    excitation: dict[str, Any] = {"period_samples": rec.period_samples, "settle_periods": rec.settle_periods}
+    if rec.excited_bins is not None:
+        excitation["excited_bins"] = list(rec.excited_bins)
+    doc: dict[str, Any] = {
+        "format": FORMAT,
+        "channels": [{"signal": c.signal, "unit": c.unit, "scale": c.scale, **c.extra} for c in rec.channels],
+        "excitation": {**excitation, **rec.excitation_extra},
+    }
+    if rec.driver:
+        doc["driver"] = dict(rec.driver)
+    doc.update(rec.extra)
+    return doc
+
+
+def _format_sidecar(doc: dict[str, Any]) -> str:
+    """The layout of the spec's example: one line per top-level key and per channel."""
+    def compact(value: Any) -> str:
+        return json.dumps(value, ensure_ascii=False, allow_nan=False, default=_json_default)
+    lines = []
+    for key, value in doc.items():
+        if key == "channels":
+            entries = ",\n".join(f"    {compact(c)}" for c in value)
+            lines.append(f'  "channels": [\n{entries}\n  ]')
+        else:
+            lines.append(f"  {compact(key)}: {compact(value)}")
+    return "{\n" + ",\n".join(lines) + "\n}\n"
+
+
+def _json_default(value: Any) -> Any:
+    """What json.dumps cannot write by itself but a program may put in `extra`."""
+    if isinstance(value, Mapping):
+        return dict(value)
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+# --- files and small helpers -------------------------------------------------
+
+def _read_bytes(path: Path) -> bytes:
+    try:
+        return path.read_bytes()
+    except OSError as err:
+        raise RecordingError(f"{path}: cannot be read ({err.strerror or err}), expected a readable file") from None
+
+
+def _write_atomic(path: Path, payload: bytes) -> None:
+    """Write to a temporary file in the same folder, then rename over `path`."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(payload)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _integer(value, minimum: int, label: str, key: str, expected: str) -> int:
+    if not _is_integer(value) or value < minimum:
+        raise RecordingError(f"{label}: {key}: found {_show(value)}, expected {expected}")
+    return int(value)
+
+
+def _is_integer(value) -> bool:
+    return isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_finite_real(value) -> bool:
+    if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:       # a JSON integer beyond the float range
+        return False
+
+
+def _unit_wanted(signal) -> str:
+    if isinstance(signal, str) and signal in UNITS:
+        return f"{UNITS[signal]!r} for {signal}"
+    return "a unit string ('V', 'A' and 'm' for voltage, current and displacement)"
+
+
+def _json_type(value) -> str:
+    for kind, name in ((dict, "object"), (list, "array"), (str, "string"), (bool, "boolean"),
+                       (int, "number"), (float, "number")):
+        if isinstance(value, kind):
+            return name
+    return "null" if value is None else type(value).__name__
+
+
+def _show(value, width: int = 60) -> str:
+    """A short one-line repr for messages."""
+    text = repr(value)
+    return text if len(text) <= width else text[:width - 3] + "..."
