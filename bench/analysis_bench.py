@@ -1,0 +1,47 @@
+"""Analysis core and model lab: speed and memory on the standard recording."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import tracemalloc
+from pathlib import Path
+
+from bench.common import Row, at_most, median_time, standard_recording
+
+
+def run(workdir: Path) -> list[Row]:
+    from analysis.diagnosis import diagnose
+    from analysis.fit import FitData
+    from analysis.model import Model
+    from analysis.parallel import fit_executor
+    from analysis.pipeline import analyze_path
+    from analysis.recording import read_recording
+    from analysis.spectra import estimate_spectra
+
+    path = standard_recording(workdir)
+    rows = []
+    t_analysis = median_time(lambda: analyze_path(path), repeats=7)
+    rows.append(at_most("analysis in process (read, spectra, fit, derived)", t_analysis, "s", 0.3))
+
+    cmd = [sys.executable, "-m", "app.cli", "analyze", str(path), "--json"]
+    t_process = median_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeats=5)
+    rows.append(at_most("whole 'linpar analyze' process", t_process, "s", 1.5))
+
+    rec = read_recording(path)
+    samples = rec.data.size
+    del rec
+    tracemalloc.start()
+    analyze_path(path)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    ratio = peak / (samples * 8)
+    rows.append(at_most("peak memory / samples in float64", ratio, "x", 4.0))
+
+    data = FitData.from_spectra(estimate_spectra(read_recording(path)))
+    textbook = Model((), with_displacement=True)
+    with fit_executor() as pool:
+        t_diag = median_time(lambda: diagnose(data, textbook, executor=pool), repeats=3)
+    rows.append(at_most("diagnosis, whole catalogue, from the textbook model", t_diag, "s", 3.0))
+    t_serial = median_time(lambda: diagnose(data, textbook), repeats=1, warmup=0)
+    rows.append(Row("  the same diagnosis on one core", t_serial, "s", "", None))
+    return rows

@@ -1,0 +1,55 @@
+"""Shared bits of the benchmarks: timing, rows, the standard recording."""
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+RESULTS_DIR = Path(__file__).resolve().parent / "results"
+
+
+@dataclass(frozen=True)
+class Row:
+    name: str
+    value: float
+    unit: str
+    target: str          # e.g. "<= 0.3"
+    ok: bool | None      # None: no target
+
+    def as_json(self) -> dict:
+        return {"name": self.name, "value": self.value, "unit": self.unit, "target": self.target, "ok": self.ok}
+
+
+def median_time(fn: Callable[[], object], repeats: int = 5, warmup: int = 1) -> float:
+    for _ in range(warmup):
+        fn()
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def at_most(name: str, value: float, unit: str, limit: float) -> Row:
+    return Row(name, value, unit, f"<= {limit:g}", value <= limit)
+
+
+def standard_recording(directory: Path) -> Path:
+    """3 channels, 48 kHz, 16 periods of 65,536 samples plus one settle period (the issue's benchmark)."""
+    from analysis.drivers import load_driver
+    from analysis.multitone import design_multitone
+    from analysis.recording import write_recording
+    from analysis.synthesis import ChannelNoise, synthesize_recording
+
+    path = directory / "standard"
+    if (directory / "standard.wav").exists():
+        return path
+    driver = load_driver("paper")
+    mt = design_multitone(48000, 65536, 5.0, 10000.0, rms=1.0)
+    rec = synthesize_recording(driver.model(), driver.parameters, mt.waveform, mt.excited_bins, 48000, 16, 1,
+                               ChannelNoise(1e-4, 1e-4, 1e-8), seed=1, driver={"name": "paper", "sd_m2": 0.0133})
+    write_recording(path, rec)
+    return path
