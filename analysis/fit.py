@@ -60,7 +60,9 @@ class FitData:
 
 
 def _usable(tf: TransferFunction) -> TransferFunction:
-    keep = np.isfinite(tf.value) & np.isfinite(tf.std) & (tf.freqs > 0)
+    keep = np.isfinite(tf.value) & (tf.freqs > 0)
+    if tf.noise_known:
+        keep &= np.isfinite(tf.std)
     return tf.restricted(keep)
 
 
@@ -72,12 +74,19 @@ class ChannelFit:
     model: np.ndarray
     std: np.ndarray
     chi2: float
-    n_points: int             # real numbers: 2 per complex line
+    n_points: int             # real numbers: 2 per complex line, 1 per magnitude-only line
     chi2_red: float
+    has_phase: bool = True
 
     @property
     def normalized_residual(self) -> np.ndarray:
-        """(model - measured) per line in units of each component's standard deviation (complex)."""
+        """(model - measured) per line in units of each component's standard deviation.
+
+        Complex (real and imaginary parts) when the phase was measured; real
+        (on the magnitude) for magnitude-only data.
+        """
+        if not self.has_phase:
+            return (np.abs(self.model) - self.measured) / (self.std / np.sqrt(2.0))
         return (self.model - self.measured) / (self.std / np.sqrt(2.0))
 
 
@@ -94,6 +103,7 @@ class FitResult:
     success: bool
     message: str
     nfev: int
+    noise_known: bool = True      # False: weights are relative, uncertainties come from the scatter
     extras: dict = field(default_factory=dict)
 
     @property
@@ -123,19 +133,33 @@ class FitResult:
             return self.covar / np.outer(d, d)
 
 
+# Curves imported without a noise estimate are weighted relatively: every
+# line as if it carried this relative uncertainty. Their parameter
+# uncertainties are then scaled by the scatter of the residual.
+ASSUMED_RELATIVE_STD = 0.01
+
+
 def _sigma(tf: TransferFunction) -> np.ndarray:
+    """Standard deviation of each real component (real, imaginary or magnitude) of a line."""
+    if not tf.noise_known:
+        return ASSUMED_RELATIVE_STD * np.abs(tf.value) / np.sqrt(2.0)
     return np.maximum(tf.std, RELATIVE_STD_FLOOR * np.abs(tf.value)) / np.sqrt(2.0)
+
+
+def _channel_residual(model_values: np.ndarray, tf: TransferFunction, sigma: np.ndarray) -> list[np.ndarray]:
+    if not tf.has_phase:
+        return [(np.abs(model_values) - tf.value.real) / sigma]
+    r = (model_values - tf.value) / sigma
+    return [r.real, r.imag]
 
 
 def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x: bool,
                      sigmas: dict[str, np.ndarray]) -> np.ndarray:
     z = data.impedance
-    rz = (model.impedance(2j * np.pi * z.freqs, p) - z.value) / sigmas["impedance"]
-    parts = [rz.real, rz.imag]
+    parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"])
     if use_x:
         x = data.displacement
-        rx = (model.displacement(2j * np.pi * x.freqs, p) - x.value) / sigmas["displacement"]
-        parts += [rx.real, rx.imag]
+        parts += _channel_residual(model.displacement(2j * np.pi * x.freqs, p), x, sigmas["displacement"])
     return np.concatenate(parts)
 
 
@@ -221,7 +245,7 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
     if use_x and "Bl" in cold:
         x = data.displacement
         g = model.displacement(2j * np.pi * x.freqs, {**values, "Bl": 1.0})
-        inv_bl = linear_gain(g, x.value, sigmas["displacement"])
+        inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
         values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
     # Stage 3: everything together.
     result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel)
@@ -236,11 +260,12 @@ def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
         tf = data.channel(name)
         s = 2j * np.pi * tf.freqs
         model_values = model.impedance(s, values) if name == "impedance" else model.displacement(s, values)
-        r = (model_values - tf.value) / sigmas[name]
-        chi2 = float(np.sum(r.real**2 + r.imag**2))
+        parts = _channel_residual(model_values, tf, sigmas[name])
+        chi2 = float(sum(np.sum(part**2) for part in parts))
+        n_points = len(parts) * len(tf.freqs)
         channels[name] = ChannelFit(name, tf.freqs, tf.value, model_values, sigmas[name] * np.sqrt(2.0),
-                                    chi2, 2 * len(tf.freqs), 0.0)
-        n_total += 2 * len(tf.freqs)
+                                    chi2, n_points, 0.0, tf.has_phase)
+        n_total += n_points
     varying = tuple(_our_name(n) for n in result.var_names)
     k = len(varying)
     chi2 = sum(ch.chi2 for ch in channels.values())
@@ -248,13 +273,16 @@ def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
     for name, ch in channels.items():
         dof = max(ch.n_points - k * ch.n_points / n_total, 1.0)
         channels[name] = ChannelFit(ch.name, ch.freqs, ch.measured, ch.model, ch.std, ch.chi2, ch.n_points,
-                                    ch.chi2 / dof)
+                                    ch.chi2 / dof, ch.has_phase)
     chi2_red = chi2 / max(n_total - k, 1)
-    birge = max(1.0, chi2_red)
+    noise_known = all(data.channel(name).noise_known for name in channels)
+    # Known noise: the Birge ratio, never below 1. Unknown noise: the residual's
+    # own scatter sets the scale (as lmfit's scale_covar does).
+    birge = max(1.0, chi2_red) if noise_known else chi2_red
     covar = None if result.covar is None else np.asarray(result.covar) * birge
     stderr: dict[str, float | None] = {n: None for n in values}
     if covar is not None:
         for i, name in enumerate(varying):
             stderr[name] = float(np.sqrt(covar[i, i])) if covar[i, i] >= 0 else None
     return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total,
-                     bool(result.success), str(result.message), int(nfev))
+                     bool(result.success), str(result.message), int(nfev), noise_known)

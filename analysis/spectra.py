@@ -64,12 +64,14 @@ class TransferFunction:
     unit: str
     freqs: np.ndarray       # Hz
     bins: np.ndarray        # FFT bins of one period
-    value: np.ndarray       # complex
-    std: np.ndarray         # sqrt(E|dH|^2), the complex standard uncertainty
+    value: np.ndarray       # complex (real and >= 0 when has_phase is False: a magnitude)
+    std: np.ndarray         # sqrt(E|dH|^2), the complex standard uncertainty; NaN when unknown
+    has_phase: bool = True  # imported curves may carry the magnitude only
+    noise_known: bool = True  # imported curves carry no per-line uncertainty
 
     def restricted(self, keep: np.ndarray) -> "TransferFunction":
         return TransferFunction(self.name, self.unit, self.freqs[keep], self.bins[keep],
-                                self.value[keep], self.std[keep])
+                                self.value[keep], self.std[keep], self.has_phase, self.noise_known)
 
 
 @dataclass(frozen=True, slots=True)

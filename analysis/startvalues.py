@@ -80,16 +80,23 @@ def start_context(z: TransferFunction) -> StartContext:
     Z = z.value[finite]
     if f.size < 5:
         raise StartValueError(f"only {f.size} impedance lines: at least 5 are needed to fit the model")
-    RE = float(np.min(Z.real))
+    if z.has_phase:
+        real, imag = Z.real, Z.imag
+    else:
+        # Magnitude only: around the resonance the phase of Z is small, so |Z|
+        # stands in for Re(Z); at the top |Z|^2 = RE^2 + (w*LE)^2 gives LE.
+        real = np.abs(Z)
+        imag = np.sqrt(np.maximum(real**2 - np.min(real) ** 2, 0.0))
+    RE = float(np.min(real))
     if RE <= 0:
         RE = float(np.min(np.abs(Z)))
-    excess = Z.real - RE
+    excess = real - RE
     k = _motional_peak(f, excess)
     fs = float(f[k])
     RES = float(max(excess[k], 1e-3 * RE))
     Qms = float(np.clip(fs / _half_value_bandwidth(f, excess, k), 0.3, 100.0))
     top = slice(max(len(f) - 5, k + 1), None)
-    LE = float(np.median(Z.imag[top] / (2 * np.pi * f[top]))) if len(f[top]) else 0.0
+    LE = float(np.median(imag[top] / (2 * np.pi * f[top]))) if len(f[top]) else 0.0
     return StartContext(RE=RE, fs=fs, RES=RES, Qms=Qms, LE_high=max(LE, 1e-7),
                         f_min=float(f[0]), f_max=float(f[-1]))
 
