@@ -68,21 +68,17 @@ from typing import Callable
 import numpy as np
 import scipy.fft
 
+from analysis.crest_factor import reduce_crest_factor
+
 MIN_PERIOD_SAMPLES = 16
 # The excitable bins are k with k % 6 in _EXCITABLE_RESIDUES (see module doc).
 _GRID_MODULUS = 6
 _EXCITABLE_RESIDUES = (1, 5)
-# Exponents of the L^p continuation, powers of two so y**p is a few squarings.
-_P_SCHEDULE = (4, 8, 16, 32, 64, 128)
 # Phase dither (rad, standard deviation) added to Schroeder's phases: it is the
 # only use of `seed`; different seeds give different waveforms with about the
 # same crest factor (independent realisations for a level series).
 _SEED_DITHER_RAD = 0.1
 _DEFAULT_RMS = 1.0
-# Points per cycle of the highest line on the grid where the peak is minimised.
-_POINTS_PER_TOP_CYCLE = 6
-# First L-BFGS step of each stage, before any curvature is known (rad).
-_FIRST_STEP_RAD = 0.05
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -208,7 +204,7 @@ def design_multitone(
     shape = _line_shape(amplitude_shape, bins * sample_rate / period_samples)
     rng = np.random.default_rng(seed)
     start = schroeder_phases(bins, shape) + rng.normal(0.0, _SEED_DITHER_RAD, bins.size)
-    phases = _reduce_crest_factor(bins, shape, start, crest_iterations)
+    phases = reduce_crest_factor(bins, shape, start, crest_iterations)
     phases = np.mod(phases, 2 * np.pi)
 
     unit = synthesize(period_samples, bins, shape, phases)
@@ -307,95 +303,6 @@ def _bins_for_count(allowed: np.ndarray, k_min: float, k_max: float, n_lines: in
             high = middle
     at_low = lines(low)
     return at_low if at_low.size == n_lines else lines(high)
-
-
-def _reduce_crest_factor(bins: np.ndarray, amplitudes: np.ndarray, phases: np.ndarray,
-                         iterations: int) -> np.ndarray:
-    """Phases with a lower peak: L^p-norm descent, best waveform kept.
-
-    The gradient of log ||x||_p with respect to the phases costs one FFT:
-    d x[n] / d phase_i = -A_i sin(w_i n + phase_i), so the gradient is
-    -A_i Im(exp(j phase_i) conj(G[k_i])) with G the FFT of x**(p-1)/sum(x**p).
-    """
-    if iterations == 0 or bins.size == 1:
-        return phases
-    # Any grid of more than 2*k_max points holds the same periodic signal.
-    grid = scipy.fft.next_fast_len(_POINTS_PER_TOP_CYCLE * (int(bins[-1]) + 1), real=True)
-    spectrum = np.zeros(grid // 2 + 1, dtype=np.complex128)
-    line_scale = amplitudes * (grid / 2)
-    best = {"peak": np.inf, "phases": phases}
-
-    def log_norm_and_gradient(ph: np.ndarray, p: int) -> tuple[float, np.ndarray]:
-        rotation = np.exp(1j * ph)
-        spectrum[bins] = line_scale * rotation
-        x = scipy.fft.irfft(spectrum, grid)
-        peak = np.max(np.abs(x))
-        if peak < best["peak"]:  # rms is fixed by the amplitudes: lowest peak = lowest crest
-            best["peak"], best["phases"] = peak, ph.copy()
-        y = x / peak  # NB: normalised so y**p neither overflows nor underflows to all-zero
-        y_p = y * y
-        for _ in range(int(math.log2(p)) - 1):
-            y_p *= y_p
-        total = y_p.sum()
-        y_p_minus_1 = np.divide(y_p, y, out=np.zeros_like(y), where=y != 0)
-        g = scipy.fft.rfft(y_p_minus_1 / (peak * total))[bins]
-        return math.log(peak) + math.log(total) / p, -amplitudes * np.imag(rotation * np.conj(g))
-
-    per_stage = max(1, math.ceil(iterations / len(_P_SCHEDULE)))
-    current = phases
-    for p in _P_SCHEDULE:
-        current = _minimise_lbfgs(lambda ph, p=p: log_norm_and_gradient(ph, p), current, per_stage)
-    return best["phases"]
-
-
-def _minimise_lbfgs(fun_and_grad: Callable[[np.ndarray], tuple[float, np.ndarray]],
-                    x: np.ndarray, iterations: int, memory: int = 8) -> np.ndarray:
-    """A few iterations of L-BFGS with a backtracking (Armijo) line search.
-
-    NB: hand-written instead of scipy's L-BFGS-B, whose many tiny BLAS calls
-    made it 1.5-3x slower and erratic under multi-threaded OpenBLAS on a busy
-    2-core machine; here the cost is the FFTs, about one evaluation per step.
-    """
-    f, g = fun_and_grad(x)
-    steps: list[tuple[np.ndarray, np.ndarray]] = []  # (s, y) pairs, oldest first
-    for _ in range(iterations):
-        direction = -_inverse_hessian_times(steps, g)
-        slope = g @ direction
-        if slope >= 0:  # stale curvature pairs: restart along the gradient
-            steps.clear()
-            direction = -_inverse_hessian_times(steps, g)
-            slope = g @ direction
-        step = 1.0
-        for _ in range(20):
-            x_new = x + step * direction
-            f_new, g_new = fun_and_grad(x_new)
-            if f_new <= f + 1e-4 * step * slope:
-                break
-            step *= 0.5
-        else:
-            return x  # no descent found: at a (numerically) flat point
-        s, y = x_new - x, g_new - g
-        if s @ y > 1e-12 * (s @ s):  # keep only pairs with positive curvature
-            steps = [*steps[-(memory - 1):], (s, y)]
-        x, f, g = x_new, f_new, g_new
-    return x
-
-
-def _inverse_hessian_times(steps: list[tuple[np.ndarray, np.ndarray]], g: np.ndarray) -> np.ndarray:
-    """L-BFGS two-loop recursion; without history, a step that turns no phase by more than 0.05 rad."""
-    if not steps:
-        return g * (_FIRST_STEP_RAD / max(float(np.max(np.abs(g))), 1e-300))
-    q = g.copy()
-    alphas = []
-    for s, y in reversed(steps):
-        alpha = (s @ q) / (y @ s)
-        alphas.append(alpha)
-        q -= alpha * y
-    s, y = steps[-1]
-    q *= (s @ y) / (y @ y)
-    for (s, y), alpha in zip(steps, reversed(alphas)):
-        q += s * (alpha - (y @ q) / (y @ s))
-    return q
 
 
 def _line_shape(amplitude_shape: Callable[[np.ndarray], np.ndarray] | None,
