@@ -6,8 +6,10 @@ magnitude part and a phase part, both in units of the line's noise:
     measured / model - 1 = a + j b      a: relative magnitude error, b: phase error (rad)
     mag = a / sigma_rel,  phase = b / sigma_rel,  sigma_rel = std / |model| / sqrt(2)
 
-The band where the (slightly smoothed) squared residual stays above 3 sigma
-and holds the largest share of the misfit is the one reported.
+The band reported is where the (slightly smoothed) squared residual stays
+above 3 sigma and within 10 dB of its peak, holding the largest share of
+the misfit: a missing effect leaves its mark everywhere (the other
+parameters bend to absorb it) but most where it acts.
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ import numpy as np
 from analysis.fit import ChannelFit, FitResult
 
 THRESHOLD_SIGMA = 3.0
+PEAK_FRACTION = 0.1
 CHANNEL_WORDS = {"impedance": "impedance Z", "displacement": "displacement Hx"}
 
 
@@ -60,9 +63,10 @@ def channel_finding(ch: ChannelFit) -> ResidualFinding | None:
     if power.size == 0:
         return None
     smooth = np.convolve(power, np.ones(3) / 3, mode="same")
-    runs = _runs(smooth > THRESHOLD_SIGMA**2)
-    if not runs:
+    if smooth.max() <= THRESHOLD_SIGMA**2:
         return None
+    # The band around the worst lines: where the misfit stays within 10 dB of its peak.
+    runs = _runs(smooth > max(THRESHOLD_SIGMA**2, PEAK_FRACTION * smooth.max()))
     total = power.sum()
     lo, hi = max(runs, key=lambda r: power[r[0]:r[1]].sum())
     band = slice(lo, hi)
