@@ -1,0 +1,67 @@
+"""`linpar gui`: the application object, the main window and the event loop."""
+from __future__ import annotations
+
+import logging
+import os
+import sys
+
+EXIT_OK, EXIT_NO_DISPLAY = 0, 2
+EXIT_AFTER_ENV = "LINPAR_EXIT_AFTER_S"
+# Said by the offscreen platform on every window; noise for whoever runs `make run` without a display.
+_IGNORED_QT_MESSAGES = ("This plugin does not support propagateSizeHints()",)
+
+
+def _qt_message(mode, context, message: str) -> None:
+    if message not in _IGNORED_QT_MESSAGES:
+        print(message, file=sys.stderr)
+
+
+def _no_display() -> bool:
+    """On Linux without X11/Wayland, Qt would abort inside QApplication with a cryptic message."""
+    if not sys.platform.startswith("linux") or os.environ.get("QT_QPA_PLATFORM"):
+        return False
+    return not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def _exit_after_s() -> float | None:
+    text = os.environ.get(EXIT_AFTER_ENV)
+    if not text:
+        return None
+    try:
+        seconds = float(text)
+    except ValueError:
+        print(f"linpar: ignoring {EXIT_AFTER_ENV}={text!r}: expected a number of seconds", file=sys.stderr)
+        return None
+    return max(seconds, 0.0)
+
+
+def run_gui(path: str | None = None) -> int:
+    if _no_display():
+        print("linpar: error: no display (DISPLAY and WAYLAND_DISPLAY are unset); set DISPLAY, or "
+              "QT_QPA_PLATFORM=offscreen to run without a window (tools/run-gui.sh does)", file=sys.stderr)
+        return EXIT_NO_DISPLAY
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+
+    # Qt is imported here so that the rest of the CLI never loads it.
+    from PySide6.QtCore import QTimer, qInstallMessageHandler
+    from PySide6.QtWidgets import QApplication
+
+    from app.main_window import MainWindow
+    from app.settings import APPLICATION, ORGANIZATION
+
+    qInstallMessageHandler(_qt_message)
+
+    QApplication.setOrganizationName(ORGANIZATION)
+    QApplication.setApplicationName(APPLICATION)
+    app = QApplication.instance() or QApplication(sys.argv[:1])
+    window = MainWindow()
+    window.show()
+    if path:
+        window.open_path(path)
+    exit_after = _exit_after_s()
+    if exit_after is not None:
+        # `make run` without a display: prove the window starts, then leave cleanly.
+        QTimer.singleShot(int(exit_after * 1000), window.close)
+        QTimer.singleShot(int(exit_after * 1000), lambda: app.exit(EXIT_OK))
+    code = app.exec()
+    return EXIT_OK if exit_after is not None else int(code)

@@ -1,0 +1,198 @@
+"""The Results page: validity, fit quality, Z / Hx / SPL plots and the parameter table."""
+from __future__ import annotations
+
+import dataclasses
+import html
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout,
+                               QWidget)
+
+from analysis.derived import parameter_table
+from analysis.pipeline import AnalysisResult
+from app import style
+from app.parameter_table import ParameterTable
+from app.plots import TransferPlot
+from app.spl_panel import SplPanel
+from app.workers import AnalysisOutcome
+
+EMPTY_TEXT = ("No recording loaded.\n\nOpen one with File ▸ Open recording… (Ctrl+O), "
+              "or drop a recording's .wav or .json file on this window.")
+
+
+class ValidityBox(QLabel):
+    """result.validity["overall"] in its colour, with what the state means."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setWordWrap(True)
+        self.setMargin(8)
+        self.setTextFormat(Qt.RichText)
+        self.state = "unknown"
+        self.set_state("unknown")
+
+    def set_state(self, state: str) -> None:
+        self.state = state
+        background, text = style.validity_colours(state)
+        self.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; border: 1px solid {text}; "
+                           f"border-radius: 4px; }}")
+        meaning = style.VALIDITY_TEXT.get(state, "a state this version does not know")
+        self.setText(f"<b>Validity: {html.escape(state)}</b> — {html.escape(meaning)}")
+
+
+def fit_quality_text(result: AnalysisResult) -> str:
+    fit = result.fit
+    effects = ", ".join(f"{e.title} ({e.id})" for e in fit.model.effects) or "none"
+    names = {"impedance": "Z", "displacement": "Hx"}
+    chi = ", ".join(f"{names.get(k, k)} {v:.2f}" for k, v in fit.chi2_red_by_channel().items())
+    text = (f"<b>Model</b>: lumped base + {html.escape(effects)} &nbsp;·&nbsp; <b>reduced χ²</b>: {chi}"
+            f" &nbsp;·&nbsp; AIC {fit.aic:.1f} &nbsp;·&nbsp; BIC {fit.bic:.1f}"
+            f" &nbsp;·&nbsp; {fit.n_data} data, {fit.n_varying} parameters")
+    if not fit.success:
+        text += f"<br><span style='color:#8e1b1b'><b>The fit did not converge</b>: {html.escape(fit.message)}</span>"
+    return text
+
+
+def source_text(result: AnalysisResult) -> str:
+    s = result.spectra
+    name = result.source.name if result.source else "recording"
+    channels = "Z and Hx" if s.displacement is not None else "Z only (no displacement channel)"
+    return (f"<b>{html.escape(name)}</b> &nbsp;·&nbsp; {s.sample_rate / 1000:g} kHz, {s.n_periods} periods of "
+            f"{s.period_samples} samples, {len(s.excited_bins)} lines "
+            f"{s.impedance.freqs.min():.3g}–{s.impedance.freqs.max():.4g} Hz &nbsp;·&nbsp; {channels}")
+
+
+class ResultsView(QWidget):
+    # The parameter set shown changed (a new result, or Sd edited): the new AnalysisResult.
+    result_changed = Signal(object)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.result: AnalysisResult | None = None
+        self.curves = None
+
+        self.empty = QLabel(EMPTY_TEXT)
+        self.empty.setAlignment(Qt.AlignCenter)
+        self.empty.setWordWrap(True)
+
+        # Word wrap on every long label: an unwrapped one sets the window's minimum width.
+        self.source_label = QLabel()
+        self.source_label.setTextFormat(Qt.RichText)
+        self.source_label.setWordWrap(True)
+        self.validity_box = ValidityBox()
+        self.fit_quality = QLabel()
+        self.fit_quality.setTextFormat(Qt.RichText)
+        self.fit_quality.setWordWrap(True)
+        self.fit_quality.setTextInteractionFlags(Qt.TextSelectableByMouse)
+
+        self.impedance_plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
+        self.displacement_plot = TransferPlot("|Hx| (mm/V)", 1e3, log_y=True)
+        self.no_displacement = QLabel("This recording has no displacement channel: Hx, and with it Bl, Mms, "
+                                      "Cms and the SPL prediction, need the laser.")
+        self.no_displacement.setAlignment(Qt.AlignCenter)
+        self.no_displacement.setWordWrap(True)
+        self.displacement_stack = QStackedWidget()
+        self.displacement_stack.addWidget(self.displacement_plot)
+        self.displacement_stack.addWidget(self.no_displacement)
+        self.spl_panel = SplPanel()
+
+        self.plot_tabs = QTabWidget()
+        self.plot_tabs.addTab(self.impedance_plot, "Impedance Z")
+        self.plot_tabs.addTab(self.displacement_stack, "Displacement Hx")
+        self.plot_tabs.addTab(self.spl_panel, "Predicted SPL")
+
+        self.parameter_table = ParameterTable()
+        table_box = QWidget()
+        table_layout = QVBoxLayout(table_box)
+        table_layout.setContentsMargins(0, 0, 0, 0)
+        table_title = QLabel("<b>Parameters</b> (bold: fitted; the rest derived from them)")
+        table_title.setWordWrap(True)
+        table_layout.addWidget(table_title)
+        table_layout.addWidget(self.parameter_table, 1)
+
+        splitter = QSplitter(Qt.Horizontal)
+        splitter.addWidget(self.plot_tabs)
+        splitter.addWidget(table_box)
+        splitter.setStretchFactor(0, 3)
+        splitter.setStretchFactor(1, 1)
+        splitter.setSizes([960, 420])
+        self.splitter = splitter
+
+        header = QHBoxLayout()
+        header.addWidget(self.source_label, 1)
+        content = QWidget()
+        content_layout = QVBoxLayout(content)
+        content_layout.setContentsMargins(0, 0, 0, 0)
+        content_layout.addLayout(header)
+        content_layout.addWidget(self.validity_box)
+        content_layout.addWidget(self.fit_quality)
+        line = QFrame()
+        line.setFrameShape(QFrame.HLine)
+        line.setFrameShadow(QFrame.Sunken)
+        content_layout.addWidget(line)
+        content_layout.addWidget(splitter, 1)
+
+        self.stack = QStackedWidget()
+        self.stack.addWidget(self.empty)
+        self.stack.addWidget(content)
+        self.content = content
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.stack)
+
+        self.spl_panel.sd_changed.connect(self.on_sd_changed)
+        self.spl_panel.clear()
+
+    @property
+    def has_result(self) -> bool:
+        return self.result is not None
+
+    def set_busy(self, text: str) -> None:
+        """While a first recording is analysed the empty page says so; a shown result stays until replaced."""
+        if self.result is None:
+            self.empty.setText(text)
+
+    def set_idle(self) -> None:
+        if self.result is None:
+            self.empty.setText(EMPTY_TEXT)
+
+    def show_outcome(self, outcome: AnalysisOutcome) -> None:
+        result, curves = outcome.result, outcome.curves
+        self.result, self.curves = result, curves
+        self.source_label.setText(source_text(result))
+        self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
+        self.fit_quality.setText(fit_quality_text(result))
+        self._show_parameters(result)
+        self.impedance_plot.set_curves(curves.impedance, "Impedance Z = U / I")
+        if curves.displacement is not None:
+            self.displacement_plot.set_curves(curves.displacement, "Displacement per volt Hx = X / U")
+            self.displacement_stack.setCurrentWidget(self.displacement_plot)
+        else:
+            self.displacement_plot.clear_curves()
+            self.displacement_stack.setCurrentWidget(self.no_displacement)
+        self.spl_panel.set_data(curves.displacement, result.sd_m2)
+        self.stack.setCurrentWidget(self.content)
+        self.result_changed.emit(result)
+
+    def clear(self) -> None:
+        self.result = self.curves = None
+        self.impedance_plot.clear_curves()
+        self.displacement_plot.clear_curves()
+        self.spl_panel.clear()
+        self.parameter_table.set_parameters({})
+        self.empty.setText(EMPTY_TEXT)
+        self.stack.setCurrentWidget(self.empty)
+
+    def on_sd_changed(self, sd_m2: float | None) -> None:
+        """Sd feeds only derived parameters (Vas, eta0, SPL): recomputed here, no new fit needed."""
+        if self.result is None:
+            return
+        # parameter_table propagates through the covariance: milliseconds, fine on the GUI thread.
+        result = dataclasses.replace(self.result, sd_m2=sd_m2,
+                                     parameters=parameter_table(self.result.fit, sd_m2))
+        self.result = result
+        self._show_parameters(result)
+        self.result_changed.emit(result)
+
+    def _show_parameters(self, result: AnalysisResult) -> None:
+        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
+        self.parameter_table.set_parameters(result.parameters, descriptions)

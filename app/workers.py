@@ -1,0 +1,113 @@
+"""Analysis off the GUI thread.
+
+One long-lived AnalysisWorker (a QObject of the GUI thread) owns a QThreadPool
+and the signals; each job is a plain callable run by the pool. Jobs therefore
+own no QObject whose lifetime could end in the pool thread: the signals are
+emitted from the pool thread and Qt queues them to the GUI thread's slots.
+Every signal carries the job's id, so the GUI can drop the outcome of a job it
+has replaced. What crosses over is frozen (AnalysisOutcome) or a string.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QThreadPool, Signal
+
+from analysis.fit import FitCancelled, FitError
+from analysis.model import ModelError
+from analysis.pipeline import AnalysisResult, analyze_recording
+from analysis.recording import RecordingError, read_recording
+from analysis.spectra import SpectrumError
+from analysis.startvalues import StartValueError
+from app.result_curves import ResultCurves, result_curves
+
+log = logging.getLogger(__name__)
+
+# Errors that describe the recording or the fit: their message is shown as it is.
+USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelError, OSError)
+
+
+@dataclass(frozen=True, slots=True)
+class AnalysisOutcome:
+    job: int
+    path: Path
+    result: AnalysisResult
+    curves: ResultCurves
+
+
+class AnalysisJob:
+    """Read one recording and analyse it; runs in a pool thread."""
+
+    def __init__(self, job: int, path: Path, sd_m2: float | None, worker: "AnalysisWorker"):
+        self.id = job
+        self.path = path
+        self.sd_m2 = sd_m2
+        self._worker = worker
+        # NB: set by the GUI thread, read by the fit's iteration callback in the pool thread.
+        self.cancel_event = threading.Event()
+
+    def cancel(self) -> None:
+        self.cancel_event.set()
+
+    def __call__(self) -> None:
+        signals = self._worker
+        try:
+            signals.progress.emit(self.id, f"reading {self.path.name}")
+            recording = read_recording(self.path)
+            if self.cancel_event.is_set():
+                raise FitCancelled("cancelled before the fit")
+            signals.progress.emit(self.id, f"estimating spectra and fitting {self.path.name}")
+            result = analyze_recording(recording, self.sd_m2, cancel=self.cancel_event)
+            curves = result_curves(result)
+        except FitCancelled:
+            signals.cancelled.emit(self.id)
+        except USER_ERRORS as exc:
+            signals.failed.emit(self.id, one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
+            log.exception("analysis of %s failed", self.path)
+            signals.failed.emit(self.id, f"internal error while analysing {self.path.name} "
+                                         f"({type(exc).__name__}: {one_line(exc)}); the details are in the log")
+        else:
+            signals.finished.emit(self.id, AnalysisOutcome(self.id, self.path, result, curves))
+
+
+class AnalysisWorker(QObject):
+    progress = Signal(int, str)         # job id, the stage being worked on
+    finished = Signal(int, object)      # job id, AnalysisOutcome
+    failed = Signal(int, str)           # job id, a one-line message for the user
+    cancelled = Signal(int)             # job id
+
+    def __init__(self, parent: QObject | None = None):
+        super().__init__(parent)
+        self.pool = QThreadPool(self)
+        self._ids = itertools.count(1)
+        self._jobs: dict[int, AnalysisJob] = {}
+        for signal in (self.finished, self.failed, self.cancelled):
+            signal.connect(self._forget)
+
+    def start(self, path: str | Path, sd_m2: float | None = None) -> AnalysisJob:
+        job = AnalysisJob(next(self._ids), Path(path), sd_m2, self)
+        self._jobs[job.id] = job
+        self.pool.start(job)
+        return job
+
+    def cancel_all(self) -> None:
+        for job in list(self._jobs.values()):
+            job.cancel()
+
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel every job and wait for the pool; True when all stopped in time."""
+        self.cancel_all()
+        return self.pool.waitForDone(wait_ms)
+
+    def _forget(self, job: int, *_args) -> None:
+        self._jobs.pop(job, None)
+
+
+def one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text or type(exc).__name__

@@ -1,0 +1,132 @@
+"""The Results page on synthetic recordings of the paper's driver."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+
+from app.parameter_table import STD, UNIT, VALUE
+
+from .conftest import PAPER, open_and_wait
+
+
+def _cell(table, name: str, column: int, role=Qt.DisplayRole):
+    model = table.parameter_model
+    return model.data(model.index(model.row_of(name), column), role)
+
+
+def _lengths(*items) -> list[int]:
+    return [len(item.getData()[0]) for item in items]
+
+
+@pytest.fixture
+def shown(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["paper"])
+    return window.results
+
+
+def test_parameter_table_shows_re_within_one_percent(shown):
+    value = float(_cell(shown.parameter_table, "RE", VALUE))
+    assert value == pytest.approx(PAPER.parameters["RE"], rel=0.01)
+    assert _cell(shown.parameter_table, "RE", UNIT) == "ohm"
+    assert float(_cell(shown.parameter_table, "RE", STD)) > 0
+
+
+def test_table_uses_customary_units(shown):
+    assert _cell(shown.parameter_table, "LE", UNIT) == "mH"
+    assert float(_cell(shown.parameter_table, "LE", VALUE)) == pytest.approx(PAPER.parameters["LE"] * 1e3, rel=0.01)
+    assert _cell(shown.parameter_table, "Mms", UNIT) == "g"
+    assert float(_cell(shown.parameter_table, "Mms", VALUE)) == pytest.approx(11.87, rel=0.01)
+
+
+def test_every_plot_has_measured_model_and_residual_data(shown):
+    for plot in (shown.impedance_plot, shown.displacement_plot):
+        n_lines, n_dense, *rest = _lengths(plot.magnitude_measured, plot.magnitude_model, plot.phase_measured,
+                                           plot.phase_model, plot.residual_real, plot.residual_imag)
+        assert n_lines > 50 and n_dense > n_lines
+        assert rest == [n_lines, n_dense, n_lines, n_lines]
+    spl = shown.spl_panel
+    assert spl.stack.currentWidget() is spl.plot
+    assert min(_lengths(spl.plot.measured, spl.plot.model)) > 0
+
+
+def test_residual_strip_is_in_sigma_units(shown):
+    x, y = shown.impedance_plot.residual_real.getData()
+    assert np.isfinite(y).all()
+    assert np.std(y) == pytest.approx(1.0, abs=0.3)          # noise only: unit scatter
+
+
+def test_model_line_follows_the_measured_points(shown):
+    plot = shown.impedance_plot
+    f, measured = plot.magnitude_measured.getData()
+    fd, model = plot.magnitude_model.getData()
+    assert np.interp(f, fd, model) == pytest.approx(measured, rel=0.01)
+    _, phase = shown.displacement_plot.phase_measured.getData()
+    fd, phase_model = shown.displacement_plot.phase_model.getData()
+    assert np.abs(np.interp(_, fd, phase_model) - phase).max() < 5.0      # same branch, no 360 jumps
+
+
+def test_fit_quality_and_validity(shown):
+    text = shown.fit_quality.text()
+    for part in ("lr2", "creep-log", "reduced χ²", "Z ", "Hx ", "AIC", "BIC"):
+        assert part in text
+    # a clean simulated measurement: the validity checks find nothing wrong
+    assert shown.validity_box.state == "green"
+    assert "green" in shown.validity_box.text().lower()
+
+
+def test_spl_follows_voltage(shown):
+    spl = shown.spl_panel
+    _, before = spl.plot.model.getData()
+    spl.voltage.setValue(spl.voltage.value() * 2)
+    _, after = spl.plot.model.getData()
+    assert after - before == pytest.approx(20 * np.log10(2), abs=1e-6)
+
+
+def test_without_sd_the_spl_asks_for_it_and_entering_it_recomputes(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["no_sd"])
+    results = window.results
+    spl = results.spl_panel
+    assert spl.stack.currentWidget() is spl.message
+    assert "Enter Sd" in spl.message.text()
+    assert results.result.parameters["Vas"].value is None
+    with qtbot.waitSignal(results.result_changed):
+        spl.sd.setValue(133.0)                        # cm^2
+    assert spl.stack.currentWidget() is spl.plot
+    assert results.result.sd_m2 == pytest.approx(0.0133)
+    vas = float(_cell(results.parameter_table, "Vas", VALUE))
+    assert vas == pytest.approx(10.5, rel=0.02)
+
+
+def test_without_displacement_missing_values_are_greyed_with_reasons(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["no_laser"])
+    results = window.results
+    table = results.parameter_table
+    assert _cell(table, "Bl", VALUE).startswith("n/a: not identifiable without displacement")
+    assert "Bl only appears in Hx" in _cell(table, "Bl", VALUE, Qt.ToolTipRole)
+    assert _cell(table, "Bl", VALUE, Qt.ForegroundRole) is not None
+    row = table.parameter_model.row_of("Bl")
+    assert table.columnSpan(row, VALUE) == 2
+    assert _cell(table, "RE", VALUE, Qt.ForegroundRole) is None
+    assert results.displacement_stack.currentWidget() is results.no_displacement
+    assert "no displacement channel" in results.spl_panel.message.text()
+    assert "Z only" in results.source_label.text()
+
+
+def test_a_new_recording_replaces_the_old_one(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["paper"])
+    open_and_wait(qtbot, window, recordings["no_laser"])
+    results = window.results
+    assert results.displacement_plot.magnitude_measured.getData()[0] is None or \
+        len(results.displacement_plot.magnitude_measured.getData()[0]) == 0
+    assert "no-laser.wav" in window.windowTitle()
+
+
+@pytest.mark.parametrize("state", ["green", "yellow", "red", "unknown", "something new"])
+def test_validity_box_shows_each_state_in_its_colour(qapp, state):
+    from app import style
+    from app.results_view import ValidityBox
+    box = ValidityBox()
+    box.set_state(state)
+    background, _ = style.validity_colours(state)
+    assert state in box.text() and background in box.styleSheet()
