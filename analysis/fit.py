@@ -34,6 +34,7 @@ from analysis.startvalues import linear_gain, start_context
 # noise-free (simulated) data would otherwise get infinite weights.
 RELATIVE_STD_FLOOR = 1e-9
 CHANNELS = ("impedance", "displacement")
+EVALUATIONS_PER_PARAMETER = 300
 
 
 class FitError(RuntimeError):
@@ -197,7 +198,12 @@ def _minimize(model, params, data, use_x, sigmas, cancel) -> lmfit.minimizer.Min
         return bool(cancel is not None and cancel.is_set())   # True aborts lmfit
 
     minimizer = lmfit.Minimizer(residual, params, iter_cb=iteration, scale_covar=False, nan_policy="propagate")
-    result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12, max_nfev=20000)
+    # MINPACK's own default budget is 200*(k+1) evaluations; a well-posed fit
+    # here needs far fewer. A candidate whose parameters are nearly degenerate
+    # would otherwise wander for many thousands.
+    n_varying = sum(1 for p in params.values() if p.vary)
+    result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12,
+                                max_nfev=EVALUATIONS_PER_PARAMETER * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
     return result

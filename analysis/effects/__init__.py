@@ -2,11 +2,24 @@
 from __future__ import annotations
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.effects import creep, inductance
+from analysis.effects import breakup, channels, creep, inductance
 
+# Grouped by category; within a category the effects are alternatives (one per model).
 _ALL: tuple[Effect, ...] = (
     inductance.lr2,
+    inductance.lr3,
+    inductance.leach,
+    inductance.wright,
     creep.creep_log,
+    creep.creep_log_causal,
+    creep.creep_3p,
+    creep.creep_fractional,
+    creep.creep_rs,
+    channels.delay_current,
+    channels.delay_x,
+    channels.lowpass_x,
+    channels.lowpass2_x,
+    breakup.breakup,
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}

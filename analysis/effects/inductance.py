@@ -1,7 +1,11 @@
 """Lossy voice-coil inductance: the blocked impedance beyond RE + s*LE.
 
 Eddy currents in the pole piece make the coil's inductance fall and its
-resistance rise with frequency. Each model here adds a term to Ze.
+resistance rise with frequency. Each model here adds a term to Ze; they are
+alternatives (one category), so they may share parameter names.
+
+The start values lean on the one number the data give about the top band:
+LE_high = Im(Z)/w at the top lines, the whole inductance seen there.
 """
 from __future__ import annotations
 
@@ -12,6 +16,13 @@ import numpy as np
 from analysis.effects.base import Effect, ParamSpec, Site
 
 CATEGORY = "inductance"
+
+L2 = ParamSpec("L2", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "para-inductance")
+R2 = ParamSpec("R2", "ohm", "ohm", 1.0, 0.0, 1e4, 4.0, "eddy-current loss resistance")
+
+
+def _top_angular_frequency(ctx) -> float:
+    return 2.0 * np.pi * ctx.f_max
 
 
 @dataclass(frozen=True)
@@ -30,10 +41,7 @@ lr2 = LR2(
     category=CATEGORY,
     title="LR-2 (L2 shunted by R2)",
     site=Site.BLOCKED,
-    params=(
-        ParamSpec("L2", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "para-inductance"),
-        ParamSpec("R2", "ohm", "ohm", 1.0, 0.0, 1e4, 4.0, "eddy-current loss resistance"),
-    ),
+    params=(L2, R2),
     physics=("Eddy currents in the pole piece and the magnet's iron act like a shorted secondary winding: "
              "above a few hundred hertz part of the coil's inductance is shunted by a resistance, so the "
              "inductance seems to fall and the resistance to rise with frequency."),
@@ -41,4 +49,129 @@ lr2 = LR2(
                "inductance's and the real part of Z rising; phase lower than 90 degrees at the top."),
     typical="L2 0.1 to 2 mH, R2 1 to 20 ohm (paper: L2 0.264 mH, R2 3.52 ohm)",
     reference="W. Klippel, 'Loudspeaker nonlinearities', and the LR-2 model of Klippel LPM; paper Table I",
+)
+
+
+@dataclass(frozen=True)
+class LR3(Effect):
+    """ZP(s) = s*L2*R2 / (s*L2 + R2) + s*L3*R3 / (s*L3 + R3): two shunted inductances in series with LE.
+
+    LR-2 is the special case L3 = 0. The two stages are interchangeable in
+    the formula; the start values put stage 3's corner R3/(2*pi*L3) below
+    stage 2's, and the fit keeps that order in practice.
+    """
+
+    def response(self, s, p):
+        return (s * p["L2"] * p["R2"] / (s * p["L2"] + p["R2"])
+                + s * p["L3"] * p["R3"] / (s * p["L3"] + p["R3"]))
+
+    def guess(self, ctx):
+        L = max(ctx.LE_high, 1e-6)
+        R = max(ctx.RE, 0.1)
+        # Stage 3 starts with a corner 4x lower than stage 2: it breaks the
+        # symmetry of the two stages so the fit does not sit on the saddle between them.
+        return {"L2": L, "R2": R, "L3": L, "R3": R / 4.0}
+
+
+lr3 = LR3(
+    id="lr3",
+    category=CATEGORY,
+    title="LR-3 (two LR stages: L2||R2 and L3||R3)",
+    site=Site.BLOCKED,
+    params=(L2, R2,
+            ParamSpec("L3", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "second para-inductance"),
+            ParamSpec("R3", "ohm", "ohm", 1.0, 0.0, 1e4, 1.0, "second eddy-current loss resistance")),
+    physics=("Like LR-2, but the eddy currents are modelled by two shorted secondary windings with different "
+             "corner frequencies (pole piece and front plate, or the skin depth changing with frequency): "
+             "the inductance falls in two steps, which follows the slow, spread-out fall of real motors better."),
+    signature=("After LR-2 is fitted, a wavy impedance residual above a few hundred hertz: the real and "
+               "imaginary parts of Z alternate above and below the model around the LR-2 corner frequency."),
+    typical="L2, L3 0.05 to 2 mH; R2, R3 0.5 to 30 ohm; the two corners R/(2*pi*L) a decade or so apart",
+    reference="Klippel GmbH, LPM Linear Parameter Measurement, inductance models LR-2 and LR-3 (KLIPPEL R&D System manual)",
+    notes=("Contains lr2 (L3 = 0). Adds two parameters: prefer it only when BIC drops. If both corners fall "
+           "outside the measured band the stages cannot be told apart and the standard errors say so."),
+)
+
+
+@dataclass(frozen=True)
+class Leach(Effect):
+    """ZL(s) = K * s^n, with s = jw: K*w^n*[cos(n*pi/2) + j*sin(n*pi/2)], added to RE + s*LE.
+
+    A 'semi-inductance': for 0 < n < 1 its resistance and reactance both grow
+    as w^n, in the fixed ratio cot(n*pi/2). n = 1 is an inductance, n = 0 a
+    resistance. K is in ohm*s^n.
+    """
+
+    def response(self, s, p):
+        return p["K"] * s ** p["n"]
+
+    def guess(self, ctx):
+        n = 0.6
+        w = _top_angular_frequency(ctx)
+        # Half of the reactance seen at the top lines goes to the semi-inductance.
+        K = 0.5 * max(ctx.LE_high, 1e-7) * w / (w**n * np.sin(n * np.pi / 2))
+        return {"K": K, "n": n}
+
+
+leach = Leach(
+    id="leach",
+    category=CATEGORY,
+    title="Leach semi-inductance K*(jw)^n",
+    site=Site.BLOCKED,
+    params=(ParamSpec("K", "ohm*s^n", "ohm*s^n", 1.0, 0.0, 10.0, 5e-3, "semi-inductance coefficient"),
+            ParamSpec("n", "1", "-", 1.0, 0.01, 0.99, 0.6, "exponent of the semi-inductance")),
+    physics=("Eddy currents diffuse into the iron: the deeper they reach at low frequencies, the more iron "
+             "they see. The result behaves like something between a resistance and an inductance whose "
+             "impedance grows as a power of frequency, with a fixed phase angle n*90 degrees."),
+    signature=("Impedance residual above about 500 Hz: |Z| rises more slowly than a pure inductance's "
+               "(as f^n), with a phase that stays near n*90 degrees instead of approaching 90 degrees."),
+    typical="n 0.6 to 0.8; K 1e-3 to 5e-2 ohm*s^n (|K*(jw)^n| of 1 to 20 ohm at 1 kHz)",
+    reference=("W. M. Leach, 'Loudspeaker voice-coil inductance losses: circuit models, parameter estimation, "
+               "and effect on frequency response', JAES 50(6), 2002"),
+    notes=("Here the term is added to RE + s*LE (Leach used it with or without a separate LE). n near 1 "
+           "trades against LE, n near 0 against RE: a fit ending at a bound of n means the data do not "
+           "support the semi-inductance. Not realisable as a finite circuit."),
+)
+
+
+@dataclass(frozen=True)
+class Wright(Effect):
+    """ZL(jw) = Kr*w^Er + j*Ki*w^Ei, added to RE + s*LE.
+
+    Separate power laws for the resistance and the reactance. Kr is in
+    ohm*s^Er and Ki in ohm*s^Ei (w in rad/s). Unlike Leach's K*(jw)^n the
+    phase is not fixed, and in general the model is not causal (its real and
+    imaginary parts are not a Hilbert pair unless Er = Ei).
+    """
+
+    def response(self, s, p):
+        w = np.abs(s)
+        return p["Kr"] * w ** p["Er"] + 1j * p["Ki"] * w ** p["Ei"]
+
+    def guess(self, ctx):
+        Er = Ei = 0.7
+        w = _top_angular_frequency(ctx)
+        half_top_reactance = 0.5 * max(ctx.LE_high, 1e-7) * w
+        return {"Kr": half_top_reactance / w**Er, "Er": Er, "Ki": half_top_reactance / w**Ei, "Ei": Ei}
+
+
+wright = Wright(
+    id="wright",
+    category=CATEGORY,
+    title="Wright empirical model Kr*w^Er + j*Ki*w^Ei",
+    site=Site.BLOCKED,
+    params=(ParamSpec("Kr", "ohm*s^Er", "ohm*s^Er", 1.0, 0.0, 10.0, 2e-3, "resistance coefficient"),
+            ParamSpec("Er", "1", "-", 1.0, 0.01, 2.0, 0.7, "exponent of the resistance"),
+            ParamSpec("Ki", "ohm*s^Ei", "ohm*s^Ei", 1.0, 0.0, 10.0, 5e-3, "reactance coefficient"),
+            ParamSpec("Ei", "1", "-", 1.0, 0.01, 0.99, 0.7, "exponent of the reactance")),
+    physics=("An empirical description of the lossy coil: the resistance and the reactance added by eddy "
+             "currents each grow as their own power of frequency. It fits most motors well with four "
+             "numbers, but it is a curve fit, not a circuit."),
+    signature=("Impedance residual above about 500 Hz where Leach's fixed phase angle does not fit: the real "
+               "part of Z and the imaginary part deviate with different slopes on a log-log plot."),
+    typical="Er 0.6 to 0.9, Ei 0.6 to 0.8; Kr 1e-3 to 1e-2, Ki 2e-3 to 2e-2 (e.g. Kr 0.0022, Er 0.75, Ki 0.0048, Ei 0.76)",
+    reference="J. R. Wright, 'An empirical model for loudspeaker motor impedance', JAES 38(10), 1990",
+    notes=("Here the term is added to RE + s*LE, so Ki*w^Ei is the reactance beyond a constant LE; Ei near 1 "
+           "trades against LE and Er near 0 against RE. Not causal in general: good for describing Z, "
+           "not for a time-domain simulation."),
 )

@@ -1,0 +1,87 @@
+"""Cone breakup: a second mechanical mode coupled to the voice coil.
+
+Derivation (mechanical side, velocities v of the coil, v2 of the mass m2).
+A part m2 of the moving mass is coupled to the rest through a spring k2 and a
+damper r2 acting side by side, so the force through the coupling is
+F = (r2 + k2/s)*(v - v2) and it drives m2: F = s*m2*v2. The impedance the
+coil sees through the coupling is
+
+    Z2 = F/v = 1 / (1/(r2 + k2/s) + 1/(s*m2)).
+
+At low frequencies the coupling is stiff and Z2 -> s*m2: m2 moves with the
+cone, and it is part of Mms. So the cone's own mass is Mms - m2, and the
+effect adds Z2 - s*m2 to Zm: nothing at low frequencies, the loss of m2
+above the mode. With w2^2 = k2/m2 and Q2 = w2*m2/r2 this is
+
+    Z2 - s*m2 = -m2 * s^3 / (s^2 + s*w2/Q2 + w2^2).
+
+In the model's admittance units (Y = Zm/Bl^2, where s*Mms/Bl^2 = s*CMES),
+m2/Bl^2 = mu2*CMES with mu2 = m2/Mms, so the response is
+
+    Y2(s) = -mu2*CMES * s^3 / (s^2 + s*w2/Q2 + w2^2),      w2 = 2*pi*f2.
+
+Equivalently M2E = mu2*CMES, L2E = 1/(w2^2*M2E) = Bl^2/k2 and
+R2E = Q2/(w2*M2E) = Bl^2/r2 in the network of the docstring above.
+
+What the data show: Zm -> infinity at f2 (m2 on k2 resonates and holds the
+coil still: a dip of Z towards Ze and a notch in Hx) and Zm -> 0 at
+f2/sqrt(1 - mu2) (cone and m2 move against each other: a peak in Z and Hx).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.effects.base import Effect, ParamSpec, Site
+
+CATEGORY = "breakup"
+# With only the basic start context, the mode is looked for a decade above fs
+# (where paper and plastic cones of woofers usually break up first), and
+# never above half the top line.
+DEFAULT_F2_OVER_FS = 10.0
+
+
+@dataclass(frozen=True)
+class Breakup(Effect):
+    """Y2(s) = -mu2*CMES * s^3 / (s^2 + s*w2/Q2 + w2^2), w2 = 2*pi*f2, added to Y = Zm/Bl^2.
+
+    mu2 = m2/Mms (the part of the moving mass that decouples), f2 = the
+    resonance of m2 on its coupling spring k2, Q2 = w2*m2/r2. Zm is infinite
+    at f2 and zero at f2/sqrt(1 - mu2). See the module docstring for the
+    derivation from Z2 = 1 / (1/(r2 + k2/s) + 1/(s*m2)).
+    """
+
+    def response(self, s, p):
+        w2 = 2.0 * np.pi * p["f2"]
+        return -p["mu2"] * p["CMES"] * s**3 / (s * s + s * w2 / p["Q2"] + w2 * w2)
+
+    def guess(self, ctx):
+        return {"f2": min(DEFAULT_F2_OVER_FS * ctx.fs, 0.5 * ctx.f_max), "Q2": 5.0, "mu2": 0.1}
+
+
+breakup = Breakup(
+    id="breakup",
+    category=CATEGORY,
+    title="Cone breakup (a second mechanical mode)",
+    site=Site.MECHANICAL,
+    params=(ParamSpec("f2", "Hz", "Hz", 1.0, 10.0, 1e5, 700.0, "resonance of the decoupling mass on its coupling"),
+            ParamSpec("Q2", "1", "-", 1.0, 0.1, 200.0, 5.0, "quality factor of the breakup mode"),
+            ParamSpec("mu2", "1", "%", 100.0, 1e-4, 0.95, 0.1, "decoupling mass as a fraction of Mms")),
+    physics=("Above some frequency the cone no longer moves as one piece: its outer part (a mass m2) swings "
+             "on the cone's own bending stiffness. At that resonance it holds the coil nearly still, just "
+             "above it cone and outer part move against each other, and above both the coil drives a "
+             "lighter cone."),
+    signature=("A narrow dip-then-peak wiggle in |Z| and in the phase of Z well above fs (at f2 and "
+               "f2/sqrt(1 - mu2)), and a notch followed by a peak in |Hx| at the same frequencies; above "
+               "them |Hx| is higher than the model (a lighter cone)."),
+    typical="f2 0.5 to 5 kHz for woofers (higher for small and stiff cones), Q2 2 to 20, mu2 0.05 to 0.5",
+    reference=("W. Klippel, 'Loudspeaker cone vibration and radiation' (Klippel GmbH); J. P. Den Hartog, "
+               "'Mechanical Vibrations' (the two-mass system, the dynamic vibration absorber)"),
+    notes=("Identifiable from Z alone when both frequencies are inside the band and the wiggle stands above "
+           "the noise; CMES stays the whole low-frequency moving mass, so fs and Mms keep their meaning. "
+           "The start f2 = min(10*fs, f_max/2) is only a default: a fit started far from the mode does not "
+           "find it, so a search should try several starts across the band (or start at the frequency of "
+           "the largest residual wiggle). The laser sees the coil's motion (the cone's centre); a laser spot "
+           "on the outer cone would see m2 instead."),
+)
