@@ -255,7 +255,24 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
         values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
     # Stage 3: everything together.
     result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel)
+    if result.covar is None:
+        # lmfit gives no covariance when a parameter ends on a bound (its bound
+        # transform has zero slope there): hold those at the bound, refit the rest.
+        held = _at_bounds(model, result.params)
+        if held:
+            nfev += result.nfev
+            result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
+
+
+def _at_bounds(model: Model, params: lmfit.Parameters) -> set[str]:
+    held = set()
+    for lm_name, p in params.items():
+        name = _our_name(lm_name)
+        scale = max(abs(p.value), abs(model.spec(name).default), 1e-30)
+        if p.vary and min(p.value - p.min, p.max - p.value) <= 1e-6 * scale:
+            held.add(name)
+    return held
 
 
 def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:

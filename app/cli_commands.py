@@ -20,6 +20,9 @@ USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelEr
 
 
 def dispatch(args: argparse.Namespace) -> int:
+    from app import cli_import
+    if args.command in ("addedmass", "stats") or (args.command == "analyze" and cli_import.wants_curves(args)):
+        return cli_import.dispatch(args)
     if args.command == "analyze":
         return cmd_analyze(args)
     if args.command == "diagnose":

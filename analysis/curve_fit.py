@@ -1,0 +1,246 @@
+"""Fitting imported curves: Z (and Hx) read from other tools' files.
+
+Real data are not pure lumped models, so each channel is fitted over its own
+frequency range (FitRange):
+
+- f_min, f_max bound both channels (default: everything in the files). Raise
+  f_min where the measurement itself fails (a sweep starting at 5 Hz has
+  nothing below it) and lower f_max where the blocked-impedance model stops
+  describing the coil.
+- hx_f_max bounds Hx only (default HX_MAX_OVER_FS * fs, fs read off the
+  impedance peak): above a few times fs the cone stops moving as a piston
+  (breakup) and a laser on one spot no longer sees the lumped model's x,
+  while Bl, which Hx is there to give, is fixed by the lines around and
+  below fs.
+
+Imported curves carry no per-line noise estimate: every line is weighted as
+if it had ASSUMED_RELATIVE_STD relative noise, and the parameter
+uncertainties are scaled by the scatter of the residual (reduced chi^2). They
+say how well the data pin the parameters down *given the model*; a model
+that does not fit (large reduced chi^2) makes them optimistic about the
+truth. Magnitude-only curves (no phase) work the same way, with one real
+number per line instead of two.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+from analysis.derived import ParameterValue, parameter_table
+from analysis.effects import Effect, parse_effects
+from analysis.effects.base import ParamSpec
+from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, fit_model
+from analysis.model import Model
+from analysis.pipeline import model_json
+from analysis.spectra import TransferFunction
+from analysis.startvalues import start_context
+
+HX_MAX_OVER_FS = 4.0
+# Linearly spaced exports (0.5 Hz or 1 Hz steps up to kHz) put nearly every line
+# in the top decade, where the blocked-impedance model is weakest: thinned to
+# this many lines per decade, each decade counts alike, as in a log-spaced
+# .zma (35 per octave is about 116 per decade).
+LINES_PER_DECADE = 100
+# A parameter this close (relative to its typical size) to a bound is "on" it.
+AT_BOUND_RELATIVE = 1e-6
+VALIDITY_NOTE = "imported curves: no per-line noise, no validity checks"
+UNCERTAINTY_NOTE = (f"imported curves carry no noise estimate: every line is weighted as if it had "
+                    f"{100 * ASSUMED_RELATIVE_STD:g} % relative noise and the uncertainties are scaled by the "
+                    "residual scatter (sqrt of the reduced chi^2); they are honest only where the model fits")
+
+
+class CurveFitError(ValueError):
+    """The curves cannot be fitted as asked (e.g. too few lines in the chosen range)."""
+
+
+@dataclass(frozen=True)
+class FitRange:
+    """Frequency limits in Hz; None means no limit (hx_f_max None: HX_MAX_OVER_FS * fs)."""
+
+    f_min: float | None = None
+    f_max: float | None = None
+    hx_f_max: float | None = None
+    per_decade: int | None = LINES_PER_DECADE     # None: every line
+
+    def select(self, tf: TransferFunction, upper: float | None) -> TransferFunction:
+        keep = log_thinned(tf.freqs, self.per_decade)
+        if self.f_min is not None:
+            keep &= tf.freqs >= self.f_min
+        for limit in (self.f_max, upper):
+            if limit is not None:
+                keep &= tf.freqs <= limit
+        if keep.sum() < 5:
+            raise CurveFitError(f"only {int(keep.sum())} {tf.name} lines between {self.f_min or tf.freqs[0]:g} and "
+                             f"{min(x for x in (self.f_max, upper, tf.freqs[-1]) if x is not None):g} Hz: "
+                             "widen the frequency range")
+        return tf.restricted(keep)
+
+
+def log_thinned(freqs: np.ndarray, per_decade: int | None) -> np.ndarray:
+    """Mask of the measured lines nearest to a log grid of `per_decade` points (no interpolation)."""
+    keep = np.zeros(len(freqs), dtype=bool)
+    log_f = np.log10(freqs)
+    decades = log_f[-1] - log_f[0] if len(freqs) > 1 else 0.0
+    # Data already near log spacing (a .zma) are left whole: thinning would only drop lines.
+    if per_decade is None or len(freqs) <= 1.5 * per_decade * max(decades, 1.0):
+        keep[:] = True
+        return keep
+    grid = np.arange(log_f[0], log_f[-1] + 0.5 / per_decade, 1.0 / per_decade)
+    nearest = np.clip(np.searchsorted(log_f, grid), 1, len(freqs) - 1)
+    nearest -= (grid - log_f[nearest - 1]) < (log_f[nearest] - grid)
+    keep[nearest] = True
+    return keep
+
+
+@dataclass(frozen=True)
+class CurveAnalysis:
+    fit: FitResult
+    parameters: dict[str, ParameterValue]
+    sd_m2: float | None
+    ranges: dict[str, tuple[float, float]]       # the band each channel was fitted over
+    validity: dict
+    notes: tuple[str, ...] = ()
+
+    @property
+    def model(self) -> Model:
+        return self.fit.model
+
+
+def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
+               effects: Sequence[Effect] | str | None = None, sd_m2: float | None = None,
+               f_range: FitRange | None = None, notes: Sequence[str] = ()) -> CurveAnalysis:
+    """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves."""
+    if effects is None or isinstance(effects, str):
+        effects = parse_effects(effects)
+    f_range = f_range or FitRange()
+    z = f_range.select(impedance, None)
+    x = None
+    notes = list(notes)
+    if hx is not None:
+        hx_max = f_range.hx_f_max
+        if hx_max is None:
+            fs = start_context(z).fs
+            hx_max = HX_MAX_OVER_FS * fs
+            notes.append(f"Hx fitted up to {hx_max:.4g} Hz ({HX_MAX_OVER_FS:g} x fs = {fs:.4g} Hz from the "
+                         "impedance peak): above it the cone need not move as a piston")
+        x = f_range.select(hx, hx_max)
+    data = FitData(z, x)
+    model = Model(tuple(effects), with_displacement=x is not None)
+    fit = fit_model(data, model)
+    fit, held = covariance_with_bounds(fit, lambda v: weighted_residual(model, v, data))
+    if held:
+        notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
+    ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
+    validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
+    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes))
+
+
+def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
+                   curves: Sequence[TransferFunction], notes: Sequence[str]) -> dict:
+    """The 'validity' object for imported curves: nothing checked, and how far to trust the numbers."""
+    return {
+        "overall": "unknown",
+        "note": VALIDITY_NOTE,
+        "uncertainties": UNCERTAINTY_NOTE,
+        # With relative weights, sqrt(reduced chi^2) is the rms relative misfit: what "fits" means here.
+        "rms_relative_residual": {name: float(np.sqrt(max(c, 0.0)) * ASSUMED_RELATIVE_STD)
+                                  for name, c in fit.chi2_red_by_channel().items()},
+        "magnitude_only": [tf.name for tf in curves if not tf.has_phase],
+        "ranges_hz": {name: list(r) for name, r in ranges.items()},
+        "notes": list(notes),
+    }
+
+
+def curve_json(result: CurveAnalysis) -> dict:
+    """The same shape as `linpar analyze --json` on a recording."""
+    return {
+        "parameters": {name: p.as_json() for name, p in result.parameters.items()},
+        "model": model_json(result.fit),
+        "validity": result.validity,
+    }
+
+
+def weighted_residual(model: Model, values: Mapping[str, float], data: FitData) -> np.ndarray:
+    """The fit's residual for curves without noise estimate (relative weights), as analysis.fit builds it."""
+    parts = []
+    for tf, evaluate in ((data.impedance, model.impedance), (data.displacement, model.displacement)):
+        if tf is None or (tf is data.displacement and not model.with_displacement):
+            continue
+        parts += relative_residual(evaluate(2j * np.pi * tf.freqs, values), tf)
+    return np.concatenate(parts)
+
+
+def relative_residual(model_values: np.ndarray, tf: TransferFunction) -> list[np.ndarray]:
+    sigma = ASSUMED_RELATIVE_STD * np.abs(tf.value) / np.sqrt(2.0)
+    if not tf.has_phase:
+        return [(np.abs(model_values) - tf.value.real) / sigma]
+    r = (model_values - tf.value) / sigma
+    return [r.real, r.imag]
+
+
+def at_bound(value: float, spec: ParamSpec) -> bool:
+    scale = max(abs(spec.default), abs(value), 1e-300)
+    return value - spec.min <= AT_BOUND_RELATIVE * scale or spec.max - value <= AT_BOUND_RELATIVE * scale
+
+
+def jacobian_covariance(residual: Callable[[dict], np.ndarray], values: Mapping[str, float],
+                        names: Sequence[str], specs: Mapping[str, ParamSpec]) -> np.ndarray | None:
+    """Covariance of `names` from a central-difference Jacobian, scaled by the reduced chi^2.
+
+    The scaling is lmfit's scale_covar: right for relative weights, whose
+    absolute size is unknown. None when the Jacobian is rank deficient (a
+    parameter the data do not determine).
+    """
+    base = dict(values)
+    r0 = residual(base)
+    columns = []
+    for name in names:
+        v, spec = base[name], specs[name]
+        h = 1e-6 * max(abs(v), abs(spec.default) * 1e-3, 1e-30)
+        hi, lo = min(v + h, spec.max), max(v - h, spec.min)
+        r_hi = residual({**base, name: hi})
+        r_lo = residual({**base, name: lo})
+        columns.append((r_hi - r_lo) / (hi - lo))
+    J = np.column_stack(columns)
+    dof = max(len(r0) - len(names), 1)
+    chi2_red = float(r0 @ r0) / dof
+    # Parameters span twenty decades (CMES ~1e-4 F, RES ~1e2 ohm): scale each
+    # column to unit norm so that the condition number speaks of the data only.
+    norms = np.linalg.norm(J, axis=0)
+    if not np.all(np.isfinite(J)) or np.any(norms == 0):
+        return None
+    try:
+        jtj = (J / norms).T @ (J / norms)
+        if np.linalg.cond(jtj) > 1e12:
+            return None
+        return np.linalg.inv(jtj) / np.outer(norms, norms) * chi2_red
+    except np.linalg.LinAlgError:
+        return None
+
+
+def covariance_with_bounds(fit: FitResult, residual: Callable[[dict], np.ndarray]) -> tuple[FitResult, list[str]]:
+    """The fit with a covariance even when a parameter ended on a bound.
+
+    lmfit gives none then (its bound transform has zero slope there). The
+    parameters on a bound are held at it and the covariance of the others
+    is taken from the Jacobian; the held ones get no standard error.
+    """
+    complete = fit.covar is not None and all(fit.stderr.get(n) is not None for n in fit.varying)
+    if complete:
+        return fit, []
+    specs = {s.name: s for s in fit.model.param_specs}
+    held = [n for n in fit.varying if at_bound(fit.values[n], specs[n])]
+    free = [n for n in fit.varying if n not in held]
+    sub = jacobian_covariance(residual, fit.values, free, specs) if free else None
+    if sub is None:
+        return fit, held
+    index = [fit.varying.index(n) for n in free]
+    covar = np.zeros((len(fit.varying), len(fit.varying)))
+    covar[np.ix_(index, index)] = sub
+    stderr = {n: None for n in fit.values}
+    for n, i in zip(free, range(len(free))):
+        stderr[n] = float(np.sqrt(sub[i, i])) if sub[i, i] >= 0 else None
+    return dataclasses.replace(fit, covar=covar, stderr=stderr), held

@@ -1,0 +1,134 @@
+"""Impedance and Hx curves from text files (.zma, .frd, REW exports, any delimited table).
+
+An imported curve has no per-line uncertainty (std NaN, noise_known False):
+the fit then weighs its lines relatively and takes the parameter
+uncertainties from the scatter of the residual.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from analysis.importers.columns import HX_UNITS, assign_columns, hx_unit, phase_unit
+from analysis.importers.table import Table, read_table
+from analysis.spectra import TransferFunction
+
+KINDS = {"impedance": ("ohm", "|Z| in ohm"), "displacement": ("m/V", "|Hx| in m/V")}
+# An impedance (passive) is within +-90 degrees; measured noise near +-90
+# can cross it, so only a wrapped phase beyond +-180 is refused.
+MAX_IMPEDANCE_PHASE_TURNS = 0.5
+# Hx may be unwrapped (the phase keeps falling with a sensor delay); ten turns
+# is far beyond any displacement response, and catches degrees read as radians.
+MAX_HX_PHASE_TURNS = 10.0
+# Tolerance on the range checks: exports round the last digit.
+RANGE_TOLERANCE = 1e-4
+
+
+@dataclass(frozen=True)
+class ImportedCurve:
+    """One imported curve and how it was read (so that the user can check it)."""
+
+    transfer: TransferFunction
+    path: Path
+    notes: tuple[str, ...]          # each decision taken while reading: the phase unit and why, etc.
+
+    def describe(self) -> str:
+        t = self.transfer
+        head = (f"{self.path.name}: {t.name}, {len(t.freqs)} lines, {t.freqs[0]:g} to {t.freqs[-1]:g} Hz, "
+                f"{'with phase' if t.has_phase else 'magnitude only'}")
+        return "; ".join([head, *self.notes])
+
+
+def read_curve(path: str | Path, kind: str = "impedance", phase: str | None = None,
+               unit: str | None = None) -> ImportedCurve:
+    """Read an impedance (ohm) or Hx (kind 'displacement', m/V) curve. Raises ImportFormatError.
+
+    phase: 'deg' or 'rad' to override what the file says; unit (Hx only):
+    'm/V', 'mm/V' or 'um/V' for the magnitude (returned in m/V).
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {sorted(KINDS)}, not {kind!r}")
+    if phase not in (None, "deg", "rad"):
+        raise ValueError(f"phase must be 'deg' or 'rad', not {phase!r}")
+    if unit is not None and (kind != "displacement" or unit not in HX_UNITS):
+        raise ValueError(f"unit applies to Hx only and must be one of {sorted(HX_UNITS)}, not {unit!r}")
+    table = read_table(path)
+    return curve_from_table(table, kind, phase, unit)
+
+
+def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: str | None = None) -> ImportedCurve:
+    si_unit, value_name = KINDS[kind]
+    columns = assign_columns(table, value_name)
+    freqs = table.values[:, columns.frequency]
+    check_frequencies(table, freqs)
+    notes: list[str] = []
+    if columns.is_complex:
+        value = table.values[:, columns.real] + 1j * table.values[:, columns.imag]
+        _check_positive(table, np.abs(value), f"|{value_name.split()[0].strip('|')}|")
+        notes.append("real and imaginary parts")
+    else:
+        magnitude = table.values[:, columns.magnitude]
+        _check_positive(table, magnitude, "magnitude")
+        value = magnitude.astype(complex)
+        if columns.phase is not None:
+            pu = phase_unit(table, columns, phase)
+            notes.append(pu.describe())
+            raw_phase = table.values[:, columns.phase]
+            _check_phase_range(table, raw_phase, pu, kind)
+            radians = np.deg2rad(raw_phase) if pu.unit == "deg" else raw_phase
+            value = magnitude * np.exp(1j * radians)
+            if pu.unit == "deg" and len(raw_phase) >= 10 and 0 < np.max(np.abs(raw_phase)) <= np.pi:
+                notes.append("all phases lie within +-pi degrees: if they are radians, give the unit explicitly")
+        else:
+            notes.append("no phase column: magnitude only")
+    if kind == "displacement":
+        chosen, why = hx_unit(table, columns, unit)
+        value = value * HX_UNITS[chosen]
+        notes.append(f"magnitude in {chosen} ({why})")
+    has_phase = columns.is_complex or columns.phase is not None
+    n = len(freqs)
+    tf = TransferFunction(kind, si_unit, freqs.copy(), np.arange(n), value, np.full(n, np.nan),
+                          has_phase=has_phase, noise_known=False)
+    return ImportedCurve(tf, table.path, tuple(notes))
+
+
+def check_frequencies(table: Table, freqs: np.ndarray) -> None:
+    bad = np.flatnonzero(freqs <= 0)
+    if bad.size:
+        i = bad[0]
+        raise table.error(int(table.lines[i]), f"frequency {freqs[i]:g} Hz: expected a positive frequency")
+    steps = np.flatnonzero(np.diff(freqs) <= 0)
+    if steps.size:
+        i = steps[0] + 1
+        raise table.error(int(table.lines[i]), f"frequency {freqs[i]:g} Hz is not above the previous line's "
+                          f"{freqs[i - 1]:g} Hz: expected strictly increasing frequencies")
+
+
+def _check_positive(table: Table, values: np.ndarray, what: str) -> None:
+    bad = np.flatnonzero(~(values > 0))
+    if bad.size:
+        i = bad[0]
+        raise table.error(int(table.lines[i]), f"{what} {values[i]:g}: expected a positive value")
+
+
+def _check_phase_range(table: Table, raw: np.ndarray, pu, kind: str) -> None:
+    turns = MAX_IMPEDANCE_PHASE_TURNS if kind == "impedance" else MAX_HX_PHASE_TURNS
+    limit = turns * (360.0 if pu.unit == "deg" else 2 * np.pi) * (1 + RANGE_TOLERANCE)
+    bad = np.flatnonzero(np.abs(raw) > limit)
+    if bad.size:
+        i = bad[0]
+        unit = "degrees" if pu.unit == "deg" else "radians"
+        hint = " (is it in degrees?)" if pu.unit == "rad" else ""
+        raise table.error(int(table.lines[i]), f"phase {raw[i]:g} is out of range for {unit}: expected |phase| <= "
+                          f"{limit / (1 + RANGE_TOLERANCE):.4g} for {'an impedance' if kind == 'impedance' else 'Hx'}"
+                          f"{hint}; {pu.describe()}")
+
+
+def read_impedance(path: str | Path, phase: str | None = None) -> TransferFunction:
+    return read_curve(path, "impedance", phase).transfer
+
+
+def read_hx(path: str | Path, phase: str | None = None, unit: str | None = None) -> TransferFunction:
+    return read_curve(path, "displacement", phase, unit).transfer
