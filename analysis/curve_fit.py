@@ -115,6 +115,21 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
     """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves."""
     if effects is None or isinstance(effects, str):
         effects = parse_effects(effects)
+    data, notes = curve_data(impedance, hx, f_range, notes)
+    z, x = data.impedance, data.displacement
+    model = Model(tuple(effects), with_displacement=x is not None)
+    fit = fit_model(data, model)
+    fit, held = covariance_with_bounds(fit, lambda v: weighted_residual(model, v, data))
+    if held:
+        notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
+    ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
+    validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
+    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes))
+
+
+def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
+               f_range: FitRange | None = None, notes: Sequence[str] = ()) -> tuple[FitData, list[str]]:
+    """The lines of imported curves that the fit sees, and notes on how they were chosen."""
     f_range = f_range or FitRange()
     z = f_range.select(impedance, None)
     x = None
@@ -127,15 +142,7 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
             notes.append(f"Hx fitted up to {hx_max:.4g} Hz ({HX_MAX_OVER_FS:g} x fs = {fs:.4g} Hz from the "
                          "impedance peak): above it the cone need not move as a piston")
         x = f_range.select(hx, hx_max)
-    data = FitData(z, x)
-    model = Model(tuple(effects), with_displacement=x is not None)
-    fit = fit_model(data, model)
-    fit, held = covariance_with_bounds(fit, lambda v: weighted_residual(model, v, data))
-    if held:
-        notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
-    ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
-    validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
-    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes))
+    return FitData(z, x), notes
 
 
 def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],

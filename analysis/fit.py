@@ -9,7 +9,9 @@ With known per-line uncertainties, -2 ln L = chi^2 + const, so
     AIC = chi^2 + 2k        BIC = chi^2 + k ln n
 
 (n real data points, k varying parameters): differences of these between
-models fitted to the same data are what the model lab ranks by.
+models fitted to the same data are what the model lab ranks by. Curves
+imported without a noise estimate use the unknown-variance forms,
+n ln(chi^2/n) in place of chi^2.
 
 Standard errors come from the Jacobian at the optimum (lmfit/MINPACK),
 scaled by sqrt(max(1, reduced chi^2)) (the Birge ratio) so that a model
@@ -116,12 +118,19 @@ class FitResult:
         return self.chi2 / max(self.n_data - self.n_varying, 1)
 
     @property
+    def _neg2_log_likelihood(self) -> float:
+        """chi^2 with known noise; n ln(chi^2 / n) when the noise level is unknown (imported curves)."""
+        if self.noise_known:
+            return self.chi2
+        return self.n_data * np.log(max(self.chi2, 1e-300) / self.n_data)
+
+    @property
     def aic(self) -> float:
-        return self.chi2 + 2 * self.n_varying
+        return self._neg2_log_likelihood + 2 * self.n_varying
 
     @property
     def bic(self) -> float:
-        return self.chi2 + self.n_varying * np.log(self.n_data)
+        return self._neg2_log_likelihood + self.n_varying * np.log(self.n_data)
 
     def chi2_red_by_channel(self) -> dict[str, float]:
         return {name: ch.chi2_red for name, ch in self.channels.items()}

@@ -15,9 +15,21 @@ from analysis.recording import read_recording
 from analysis.spectra import estimate_spectra
 
 
-def run_diagnosis(path: str, start: str, sd_m2: float | None):
-    recording = read_recording(path)
-    data = FitData.from_spectra(estimate_spectra(recording))
+def _data(args: argparse.Namespace) -> tuple[FitData, float | None]:
+    """The lines to diagnose: from a recording, or from imported curves."""
+    from app import cli_import
+    if cli_import.wants_curves(args):
+        from analysis.curve_fit import curve_data
+        z, hx, notes = cli_import.load_curves(args)
+        data, _ = curve_data(z, hx, cli_import.fit_range(args, args.hx_fmax), notes)
+        return data, args.sd
+    recording = read_recording(args.path)
+    return FitData.from_spectra(estimate_spectra(recording)), resolve_sd(recording, args.sd)
+
+
+def run_diagnosis(args: argparse.Namespace):
+    data, sd = _data(args)
+    start = args.start
     try:
         effects = parse_effects(start)
     except KeyError as exc:
@@ -25,7 +37,7 @@ def run_diagnosis(path: str, start: str, sd_m2: float | None):
     model = Model(effects, with_displacement=data.displacement is not None)
     with fit_executor() as executor:
         result = diagnose(data, model, executor=executor)
-    return result, resolve_sd(recording, sd_m2)
+    return result, sd
 
 
 def _fit_summary(fit: FitResult) -> dict:
@@ -75,7 +87,7 @@ def format_diagnosis(result: Diagnosis) -> str:
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
-    result, sd = run_diagnosis(args.path, args.start, args.sd)
+    result, sd = run_diagnosis(args)
     if args.json:
         print(json.dumps(diagnosis_json(result, sd), allow_nan=False, default=lambda _: None))
     else:

@@ -87,7 +87,7 @@ def dispatch(args: argparse.Namespace) -> int:
     raise KeyError(f"unknown command {args.command!r}")
 
 
-def _fit_range(args, hx_f_max=None):
+def fit_range(args, hx_f_max=None):
     from analysis.curve_fit import LINES_PER_DECADE, FitRange
     return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
 
@@ -118,9 +118,9 @@ def _finite(x: Any) -> Any:
     return x
 
 
-def cmd_analyze_curves(args: argparse.Namespace) -> int:
+def load_curves(args: argparse.Namespace):
+    """(Z, Hx or None, notes) from --impedance/--hx or --uiv, checked for conflicting options."""
     from app.cli import CliError
-    from analysis.curve_fit import curve_json, fit_curves
     from analysis.importers import read_curve, read_uiv
     if args.path and not (args.impedance or args.uiv or args.hx):
         used = [f"--{n.replace('_', '-')}" for n in CURVE_ONLY if getattr(args, n)]
@@ -145,7 +145,13 @@ def cmd_analyze_curves(args: argparse.Namespace) -> int:
             hx_curve = read_curve(args.hx, "displacement", args.phase, "mm/V" if args.mm_per_volt else None)
             hx = hx_curve.transfer
             notes.append(hx_curve.describe())
-    result = fit_curves(z, hx, _effects(args.model), args.sd, _fit_range(args, args.hx_fmax), notes)
+    return z, hx, notes
+
+
+def cmd_analyze_curves(args: argparse.Namespace) -> int:
+    from analysis.curve_fit import curve_json, fit_curves
+    z, hx, notes = load_curves(args)
+    result = fit_curves(z, hx, _effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes)
     if args.json:
         _print_json(curve_json(result))
         return 0
@@ -183,7 +189,7 @@ def cmd_addedmass(args: argparse.Namespace) -> int:
     from analysis import added_mass as am
     curves, notes = _mass_curves(args)
     effects = _effects(args.model or am.DEFAULT_EFFECTS)
-    f_range = _fit_range(args)
+    f_range = fit_range(args)
     primary = am.joint_added_mass(curves, effects, args.sd, f_range)
     checks = []
     loaded = [c for c in curves if c.added_mass_kg > 0]

@@ -143,7 +143,7 @@ def test_woofer_whole_laser_method_agrees_with_the_lecturer(woofer_fit):
 
 def test_woofer_a_causal_creep_law_fits_better_than_the_default(woofer, woofer_fit):
     default = fit_curves(woofer.impedance, woofer.displacement, "lr2,creep-log", None, FitRange(f_min=20.0))
-    assert woofer_fit.fit.bic < default.fit.bic - 1000
+    assert woofer_fit.fit.bic < default.fit.bic - 100      # BIC of unknown-noise data: n ln(chi2/n) + k ln n
     rms = default.validity["rms_relative_residual"]["displacement"]
     assert woofer_fit.validity["rms_relative_residual"]["displacement"] < 0.5 * rms
     assert np.isfinite(default.parameters["Bl"].value)
