@@ -12,6 +12,7 @@ from analysis.fit import FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.recording import Recording, read_recording
 from analysis.spectra import Spectra, estimate_spectra
+from analysis.validity import assess
 
 
 @dataclass(frozen=True)
@@ -48,7 +49,8 @@ def analyze_recording(recording: Recording, sd_m2: float | None = None,
                   with_displacement=data.displacement is not None)
     fit = fit_model(data, model, cancel=cancel)
     sd = resolve_sd(recording, sd_m2)
-    return AnalysisResult(spectra, fit, parameter_table(fit, sd), sd, recording.source)
+    validity = assess(recording, spectra).as_json()      # per channel, with the peak excursion
+    return AnalysisResult(spectra, fit, parameter_table(fit, sd), sd, recording.source, validity)
 
 
 def analyze_path(path: str | Path, sd_m2: float | None = None,

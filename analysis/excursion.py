@@ -1,0 +1,49 @@
+"""Peak excursion of a measurement (physics.md section 6): reported for every one.
+
+The peak is taken from the coherent mean period, the average of the analysed
+periods sample by sample,
+
+    x_mean[n] = (1/P) sum_p x_p[n],   peak = max_n |x_mean[n] - <x_mean>|
+
+so noise (which averages down by sqrt(P)) does not inflate it, while the
+distortion products, which are periodic, stay in. The period's own mean is
+removed: a laser measures a distance with an arbitrary offset, so the rest
+position is not known; a DC shift of the cone under drive (from an asymmetric
+Bl(x) or Kms(x)) is removed with it.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from analysis.recording import Recording
+
+
+def peak_of_period(mean_period: np.ndarray) -> float:
+    """Largest |x - mean(x)| of one (averaged) period, m."""
+    x = np.asarray(mean_period, dtype=np.float64)
+    if x.size == 0:
+        return 0.0
+    centre = x.mean()
+    return float(max(x.max() - centre, centre - x.min()))
+
+
+def peak_excursion(periods: np.ndarray) -> float:
+    """Peak of the coherent mean of a (P, N) stack of periods, m."""
+    return peak_of_period(np.asarray(periods, dtype=np.float64).mean(axis=0))
+
+
+def peak_from_spectrum(mean_spectrum: np.ndarray, period_samples: int) -> float:
+    """The same peak from the one-sided peak-amplitude mean spectrum (analysis.spectra convention)."""
+    spectrum = np.array(mean_spectrum, dtype=np.complex128)
+    spectrum[0] = 0.0                       # the period's mean, see the module docstring
+    spectrum *= period_samples / 2.0        # undo the peak-amplitude scaling of period_spectra
+    if period_samples % 2 == 0:
+        spectrum[-1] *= 2.0
+    return peak_of_period(np.fft.irfft(spectrum, period_samples))
+
+
+def recording_peak_displacement(recording: Recording) -> float | None:
+    """Peak excursion of a recording's analysed periods, m; None without a displacement channel."""
+    if recording.signal("displacement") is None:
+        return None
+    return peak_excursion(recording.periods("displacement"))

@@ -1,0 +1,190 @@
+"""Live processing, one period at a time, for the measurement panels.
+
+The measurement thread hands each analysed period of the three channels to a
+LiveAccumulator; it returns a frozen LiveFrame that crosses to the GUI as is.
+Per bin of the analysed band (first to last excited line), per channel, the
+running mean and variance follow Welford's update (one pass, stable for any
+number of periods):
+
+    n += 1,   d = X - mean,   mean += d / n,   M2 += Re(conj(d) * (X - mean))
+    var_mean = M2 / (n (n - 1))          (the variance of the mean, as analysis.spectra)
+
+Spectra are one-sided peak amplitudes (analysis.spectra.period_spectra), so
+after the last period `mean` and `var_mean` equal estimate_spectra's on the
+same periods. A frame shows, in dB re 1 V, 1 A or 1 m (20 log10 of the
+amplitude, DB_FLOOR for zero): the signal lines (excited bins), the noise floor
+at every bin (sqrt(var_mean)), and the noise + distortion lines (|mean| at the
+unexcited bins). Its traffic lights are the validity rules that apply to one
+frame (analysis.validity_spectral: no signal, SNR, distortion, displacement
+band); drift and the capture's counts are judged on the whole recording.
+Before the second period there is no noise estimate: noise is NaN and the
+lights are "unknown".
+
+Feed only analysed periods (after settling); `reset()` starts over.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Mapping, Sequence
+
+import numpy as np
+import scipy.fft
+
+from analysis.excursion import peak_of_period
+from analysis.recording import UNITS
+from analysis.spectra import ChannelSpectrum
+from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
+from analysis.validity_findings import Finding, worst
+from analysis.validity_spectral import SIGNALS, distortion_bands, spectral_checks
+
+UNKNOWN = "unknown"
+DB_FLOOR = -400.0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LiveChannel:
+    signal: str
+    unit: str
+    line_db: np.ndarray             # |mean| at the excited lines, dB re 1 unit
+    line_noise_db: np.ndarray       # noise floor at the excited lines, dB (NaN before 2 periods)
+    other_db: np.ndarray            # noise + distortion: |mean| at the unexcited lines, dB
+    other_noise_db: np.ndarray      # noise floor at the unexcited lines, dB
+    status: str                     # "green" | "yellow" | "red" | "unknown"
+    findings: tuple[Finding, ...]
+    measures: Mapping[str, float]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class LiveFrame:
+    n_periods: int
+    line_freqs: np.ndarray          # Hz, the excited lines (shared by the channels)
+    other_freqs: np.ndarray         # Hz, the unexcited lines of the band
+    channels: Mapping[str, LiveChannel]
+    status: str                     # the worst channel's
+    peak_displacement_m: float | None
+
+
+class LiveAccumulator:
+    """Running per-bin mean and variance of the periods fed so far (see the module doc)."""
+
+    def __init__(self, sample_rate: float, period_samples: int, excited_bins: Sequence[int],
+                 signals: Sequence[str] = SIGNALS, thresholds: ValidityThresholds = DEFAULT_THRESHOLDS):
+        excited = np.unique(np.asarray(excited_bins, dtype=np.int64))
+        if excited.size == 0 or excited[0] < 1 or excited[-1] > period_samples // 2 - 1:
+            raise ValueError(f"excited_bins must be non-empty and within 1 .. {period_samples // 2 - 1}")
+        unknown = [s for s in signals if s not in SIGNALS]
+        if unknown or "voltage" not in signals:
+            raise ValueError(f"signals must include 'voltage' and be among {SIGNALS}, got {tuple(signals)}")
+        self.sample_rate = float(sample_rate)
+        self.period_samples = int(period_samples)
+        self.signals = tuple(signals)
+        self.thresholds = thresholds
+        self._lo, self._hi = int(excited[0]), int(excited[-1]) + 1       # analysed band: bins lo .. hi-1
+        span = np.arange(self._lo, self._hi)
+        self._excited = excited - self._lo
+        self._unexcited = np.setdiff1d(span, excited, assume_unique=True) - self._lo
+        bin_width = self.sample_rate / self.period_samples
+        self._bin_width = bin_width
+        self._line_freqs = _frozen(excited * bin_width)
+        self._other_freqs = _frozen((self._unexcited + self._lo) * bin_width)
+        self._bands = distortion_bands(self._other_freqs, thresholds.distortion_band_octaves,
+                                       thresholds.distortion_min_bins)
+        self._x_row = self.signals.index("displacement") if "displacement" in self.signals else None
+        self._mean = np.zeros((len(self.signals), span.size), dtype=np.complex128)
+        self._m2 = np.zeros((len(self.signals), span.size))
+        self._x_mean = np.zeros(self.period_samples)
+        self._n = 0
+
+    @property
+    def n_periods(self) -> int:
+        return self._n
+
+    def reset(self) -> None:
+        self._mean[:] = 0
+        self._m2[:] = 0
+        self._x_mean[:] = 0
+        self._n = 0
+
+    def channel_spectra(self) -> dict[str, ChannelSpectrum]:
+        """The band's running mean and variance of the mean per channel (element 0 is the first excited bin)."""
+        var = self._var_mean()
+        return {name: ChannelSpectrum(name, UNITS[name], self._mean[row].copy(), var[row].copy())
+                for row, name in enumerate(self.signals)}
+
+    def add_period(self, period: Mapping[str, np.ndarray] | np.ndarray) -> LiveFrame:
+        """One period of every signal (a mapping by name, or rows in `signals` order) -> the new frame."""
+        data = self._stacked(period)
+        delta = scipy.fft.rfft(data, axis=-1)[:, self._lo:self._hi]
+        delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
+        self._n += 1
+        n = self._n
+        # In place, no temporaries of the band's size: X - mean_new = d (1 - 1/n), so M2 += |d|^2 (n-1)/n.
+        delta -= self._mean
+        self._m2 += (delta.real**2 + delta.imag**2) * ((n - 1) / n)
+        delta *= 1.0 / n
+        self._mean += delta
+        if self._x_row is not None:
+            x = data[self._x_row]
+            x -= self._x_mean                          # data is our own copy
+            x *= 1.0 / n
+            self._x_mean += x
+        return self._frame()
+
+    # --- internals ----------------------------------------------------------------------------
+
+    def _stacked(self, period) -> np.ndarray:
+        if isinstance(period, Mapping):
+            missing = [s for s in self.signals if s not in period]
+            if missing:
+                raise ValueError(f"the period lacks {', '.join(missing)}")
+            data = np.stack([np.asarray(period[s], dtype=np.float64) for s in self.signals])
+        else:
+            data = np.array(period, dtype=np.float64)       # a copy: add_period works in it
+        if data.shape != (len(self.signals), self.period_samples):
+            raise ValueError(f"expected {len(self.signals)} signals of {self.period_samples} samples, "
+                             f"got shape {data.shape}")
+        return data
+
+    def _var_mean(self) -> np.ndarray:
+        if self._n < 2:
+            return np.full(self._m2.shape, np.nan)
+        return self._m2 / (self._n * (self._n - 1))
+
+    def _frame(self) -> LiveFrame:
+        var = self._var_mean()
+        amplitude_db = _db_of_power(self._mean.real**2 + self._mean.imag**2)
+        noise_db = _db_of_power(var) if self._n >= 2 else var
+        checks = {}
+        if self._n >= 2:
+            spectra = {name: ChannelSpectrum(name, UNITS[name], self._mean[row], var[row])
+                       for row, name in enumerate(self.signals)}
+            checks = spectral_checks(spectra, self._excited, self._unexcited, self._bin_width, self.thresholds,
+                                     self._bands, first_bin=self._lo)
+        channels = {}
+        for row, name in enumerate(self.signals):
+            findings, measures = checks.get(name, ([], {}))
+            status = str(worst(f.severity for f in findings)) if name in checks else UNKNOWN
+            channels[name] = LiveChannel(
+                name, UNITS[name], _frozen(amplitude_db[row, self._excited]), _frozen(noise_db[row, self._excited]),
+                _frozen(amplitude_db[row, self._unexcited]), _frozen(noise_db[row, self._unexcited]),
+                status, tuple(findings), MappingProxyType(dict(measures)))
+        statuses = [ch.status for ch in channels.values()]
+        overall = UNKNOWN if UNKNOWN in statuses else str(worst(f.severity for ch in channels.values()
+                                                                 for f in ch.findings))
+        peak = peak_of_period(self._x_mean) if self._x_row is not None else None
+        return LiveFrame(self._n, self._line_freqs, self._other_freqs, MappingProxyType(channels), overall, peak)
+
+
+def _db_of_power(power: np.ndarray) -> np.ndarray:
+    """20 log10(amplitude) = 10 log10(amplitude^2), no square root; DB_FLOOR for zero."""
+    with np.errstate(divide="ignore"):
+        db = np.log10(power)
+    db *= 10.0
+    return np.maximum(db, DB_FLOOR, out=db)
+
+
+def _frozen(array: np.ndarray) -> np.ndarray:
+    array = np.ascontiguousarray(array)
+    array.flags.writeable = False
+    return array

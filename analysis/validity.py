@@ -1,0 +1,123 @@
+"""Whether a measurement can be trusted, channel by channel (physics.md section 5).
+
+`assess(recording)` runs every check and returns a Validity:
+
+- from the spectra (analysis.validity_spectral): no signal, SNR on the excited
+  lines, noise + distortion on the unexcited lines, and for the displacement
+  its usable band and the number of lines above the noise;
+- from the periods (analysis.validity_drift): drift between the first and the
+  last periods;
+- from the capture (analysis.validity_capture, when a CaptureInfo is given or
+  the recording's sidecar holds one under "capture"): clipping, headroom,
+  dropouts, laser error codes and out-of-range share. A "capture" object
+  that cannot be read raises CaptureInfoError (it names the key).
+
+Each channel's status is its worst finding (green when it has none); the
+overall light is the worst channel's. A recording without displacement has
+the displacement status "absent", which does not count towards the overall
+light. `Validity.as_json()` is what `linpar analyze --json` prints under
+"validity":
+
+    {"overall": "green" | "yellow" | "red",
+     "channels": {"voltage": {"status": ..., "findings": [{"code", "severity", "message", "remedy", "value"}]},
+                  "current": {...}, "displacement": {...}},
+     "peak_displacement_m": float | null}
+
+Every limit is in analysis.thresholds.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Mapping
+
+from analysis.excursion import recording_peak_displacement
+from analysis.recording import Recording
+from analysis.spectra import Spectra, estimate_spectra
+from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
+from analysis.validity_capture import CaptureInfo, CaptureInfoError, capture_findings
+from analysis.validity_drift import drift_findings
+from analysis.validity_findings import Finding, Severity, worst
+from analysis.validity_spectral import SIGNALS, spectral_checks
+
+__all__ = ["ABSENT", "CaptureInfo", "CaptureInfoError", "ChannelValidity", "Finding", "Severity", "Validity",
+           "assess", "capture_of"]
+
+ABSENT = "absent"
+CAPTURE_KEY = "capture"
+
+
+@dataclass(frozen=True, slots=True)
+class ChannelValidity:
+    signal: str
+    status: str                                  # "green" | "yellow" | "red" | "absent"
+    findings: tuple[Finding, ...] = ()
+    # The numbers the checks measured (snr_db, distortion_db, x_band_hz, drift, ...): for the GUI, not the JSON.
+    measures: Mapping[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "measures", MappingProxyType(dict(self.measures)))
+
+    def as_json(self) -> dict:
+        return {"status": self.status, "findings": [f.as_json() for f in self.findings]}
+
+
+@dataclass(frozen=True, slots=True)
+class Validity:
+    overall: Severity
+    channels: Mapping[str, ChannelValidity]      # always voltage, current and displacement
+    peak_displacement_m: float | None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "channels", MappingProxyType(dict(self.channels)))
+
+    @property
+    def findings(self) -> tuple[Finding, ...]:
+        return tuple(f for ch in self.channels.values() for f in ch.findings)
+
+    def codes(self, channel: str) -> set[str]:
+        return {f.code for f in self.channels[channel].findings}
+
+    def as_json(self) -> dict:
+        peak = self.peak_displacement_m
+        return {"overall": str(self.overall),
+                "channels": {name: ch.as_json() for name, ch in self.channels.items()},
+                "peak_displacement_m": peak if peak is not None and math.isfinite(peak) else None}
+
+
+def capture_of(recording: Recording) -> CaptureInfo | None:
+    """The CaptureInfo stored in the recording's sidecar, if any (CaptureInfoError if unreadable)."""
+    doc = recording.extra.get(CAPTURE_KEY) if recording.extra else None
+    return None if doc is None else CaptureInfo.from_json(doc)
+
+
+def assess(recording: Recording, spectra: Spectra | None = None, capture: CaptureInfo | None = None,
+           thresholds: ValidityThresholds = DEFAULT_THRESHOLDS) -> Validity:
+    """Every validity check on a recording (its spectra are computed unless given)."""
+    if spectra is None:
+        spectra = estimate_spectra(recording)
+    if capture is None:
+        capture = capture_of(recording)
+    present = tuple(s for s in SIGNALS if s in spectra.channels)
+    spectral = spectral_checks(spectra.channels, spectra.excited_bins, spectra.unexcited_bins,
+                               spectra.bin_width, thresholds)
+    drift = drift_findings(recording, spectra, thresholds)
+    captured: dict[str, list[Finding]] = {}
+    if capture is not None:
+        x = recording.signal("displacement")
+        captured = capture_findings(capture, present, 0 if x is None else x.size, thresholds)
+
+    channels = {}
+    for name in SIGNALS:
+        if name not in present:
+            channels[name] = ChannelValidity(name, ABSENT)
+            continue
+        findings, measures = spectral[name]
+        drift_found, drift_value = drift[name]
+        measures = {**measures, "drift": drift_value}
+        everything = tuple(captured.get(name, [])) + tuple(findings) + tuple(drift_found)
+        status = worst(f.severity for f in everything)
+        channels[name] = ChannelValidity(name, str(status), everything, measures)
+    overall = worst(Severity(ch.status) for ch in channels.values() if ch.status != ABSENT)
+    return Validity(overall, channels, recording_peak_displacement(recording))

@@ -1,0 +1,84 @@
+"""LiveAccumulator: Welford's running spectra equal the batch ones, and frames carry the per-frame lights."""
+import numpy as np
+import pytest
+
+from analysis.live import DB_FLOOR, UNKNOWN, LiveAccumulator
+from analysis.spectra import estimate_spectra
+from analysis.synthesis import ChannelNoise
+from tests.builders import multitone, recording
+
+MT = multitone(period_samples=8192)
+NOISE = ChannelNoise(voltage=1e-4, current=1e-4, displacement=2e-7)
+SIGNALS = ("voltage", "current", "displacement")
+
+
+def _periods(rec, p):
+    return {s: rec.periods(s)[p] for s in SIGNALS}
+
+
+def test_after_the_last_period_mean_and_variance_equal_estimate_spectra():
+    rec = recording(mt=MT, noise=NOISE, n_periods=6)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
+    for p in range(rec.n_periods):
+        acc.add_period(_periods(rec, p))
+    batch = estimate_spectra(rec)
+    lo = MT.excited_bins[0]
+    for name, live in acc.channel_spectra().items():
+        ref = batch.channels[name]
+        band = slice(lo, lo + live.mean.size)
+        np.testing.assert_allclose(live.mean, ref.mean[band], rtol=0, atol=1e-13 * np.max(np.abs(ref.mean)))
+        np.testing.assert_allclose(live.var_mean, ref.var_mean[band], rtol=1e-8)
+
+
+def test_the_first_frame_has_levels_but_no_noise_and_unknown_lights():
+    rec = recording(mt=MT, noise=NOISE, n_periods=3)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
+    frame = acc.add_period(_periods(rec, 0))
+    assert frame.n_periods == 1 and frame.status == UNKNOWN
+    voltage = frame.channels["voltage"]
+    assert voltage.status == UNKNOWN and np.all(np.isnan(voltage.line_noise_db))
+    expected = 20 * np.log10(np.abs(np.fft.rfft(rec.periods("voltage")[0])[MT.excited_bins]) * 2 / MT.period_samples)
+    np.testing.assert_allclose(voltage.line_db, expected, atol=1e-9)
+    np.testing.assert_allclose(frame.line_freqs, MT.frequencies)
+
+
+def test_frames_turn_green_and_the_noise_floor_falls_with_periods():
+    rec = recording(mt=MT, noise=NOISE, n_periods=16)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
+    frames = [acc.add_period(_periods(rec, p)) for p in range(rec.n_periods)]
+    assert all(f.status == "green" for f in frames[1:])
+    floor = [np.mean(f.channels["current"].other_noise_db) for f in (frames[3], frames[15])]
+    assert floor[0] - floor[1] == pytest.approx(10 * np.log10(16 / 4), abs=1.0)   # sqrt(P) in amplitude
+    last = frames[-1]
+    assert last.peak_displacement_m == pytest.approx(
+        np.ptp(rec.periods("displacement").mean(axis=0)) / 2, rel=0.05)
+    assert last.other_freqs.size == last.channels["voltage"].other_db.size > 0
+    for ch in last.channels.values():
+        for array in (ch.line_db, ch.line_noise_db, ch.other_db, ch.other_noise_db):
+            assert not array.flags.writeable
+
+
+def test_a_disconnected_current_turns_its_light_red_per_frame():
+    rec = recording(mt=MT, noise=NOISE, n_periods=3)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
+    for p in range(3):
+        period = _periods(rec, p)
+        period["current"] = np.zeros(MT.period_samples)
+        frame = acc.add_period(period)
+    assert frame.channels["current"].status == "red" and frame.status == "red"
+    assert {f.code for f in frame.channels["current"].findings} == {"no-signal"}
+    assert np.all(frame.channels["current"].line_db == DB_FLOOR)
+    assert frame.channels["voltage"].status == "green"
+
+
+def test_rows_in_signal_order_and_reset():
+    rec = recording(mt=MT, noise=NOISE, n_periods=2, displacement=False)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins, signals=("voltage", "current"))
+    frame = acc.add_period(np.stack([rec.periods("voltage")[0], rec.periods("current")[0]]))
+    assert set(frame.channels) == {"voltage", "current"} and frame.peak_displacement_m is None
+    acc.reset()
+    assert acc.n_periods == 0
+    with pytest.raises(ValueError, match="samples"):
+        acc.add_period(np.zeros((2, 100)))
+    with pytest.raises(ValueError, match="lacks"):
+        acc.add_period({"voltage": np.zeros(MT.period_samples)})
