@@ -6,6 +6,8 @@ import json
 import sys
 from typing import Sequence
 
+from app import cli_import
+
 EXIT_OK, EXIT_ERROR = 0, 2
 
 
@@ -35,18 +37,25 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     analyze = sub.add_parser("analyze", help="fit the parameters of a recording")
-    analyze.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
+    analyze.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
     analyze.add_argument("--sd", type=_positive_float, metavar="M2", help="effective radiating area in m^2")
     analyze.add_argument("--model", metavar="EFFECTS",
                          help="effect ids separated by commas (default lr2,creep-log; 'none' for the textbook model)")
     analyze.add_argument("--json", action="store_true", help="print one JSON object")
+    cli_import.add_analyze_options(analyze)
 
     diagnose = sub.add_parser("diagnose", help="find which physical effect the model lacks")
-    diagnose.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
+    diagnose.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
     diagnose.add_argument("--from", dest="start", metavar="EFFECTS", default="none",
                           help="the starting model's effect ids (default: the textbook model)")
     diagnose.add_argument("--sd", type=_positive_float, metavar="M2")
     diagnose.add_argument("--json", action="store_true")
+    cli_import.add_analyze_options(diagnose)
+
+    cli_import.add_commands(sub)
+
+    from app import cli_rig
+    cli_rig.add_commands(sub)
 
     effects = sub.add_parser("effects", help="list the effects catalogue")
     effects.add_argument("--json", action="store_true")
@@ -69,6 +78,12 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    if args.command == "rig":
+        from app import cli_rig
+        try:
+            return cli_rig.run(args)
+        except cli_rig.USER_ERRORS as exc:
+            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
     if args.command == "gui":
         from app.main import run_gui
         return run_gui(args.path)

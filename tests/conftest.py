@@ -1,0 +1,34 @@
+"""Session-wide fixtures. Keep each one small, documented, and lazy (nothing runs unless a test asks)."""
+from __future__ import annotations
+
+import os
+import shutil
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def virtual_rig(tmp_path_factory):
+    """The virtual rig (instruments.rig) on a JACK server of its own, for the whole session.
+
+    Yields an instruments.rig.manager.RigHandle: ``.state`` has the JACK
+    server's name, the calibration and the channel map that match the rig;
+    ``.command("fault", set=[...])`` changes its faults (clear them after).
+    Skipped only when jackd is not installed (Debian package jackd2, which
+    tools/system-packages.sh installs). At the end PortAudio is released
+    before the rig stops: PortAudio aborts the process if its JACK server
+    vanishes under it (instruments/audio/portaudio.py).
+    """
+    if shutil.which("jackd") is None:
+        pytest.skip("jackd is not installed: install the Debian package jackd2 (tools/system-packages.sh)")
+    from instruments.audio import portaudio
+    from instruments.rig.manager import start_rig, stop_rig
+
+    runtime_dir = tmp_path_factory.mktemp("rig")
+    name = f"linpar-test-{os.getpid()}"
+    handle = start_rig(name, runtime_dir=runtime_dir, seed=1)
+    try:
+        yield handle
+    finally:
+        portaudio.release()
+        stop_rig(name, runtime_dir=runtime_dir)
