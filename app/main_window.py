@@ -10,6 +10,7 @@ from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QP
                                QTabWidget)
 
 from app import style
+from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
 from app.results_view import ResultsView
 from app.settings import Settings
@@ -49,10 +50,15 @@ class MainWindow(QMainWindow):
         self.setAcceptDrops(True)
 
         self.results = ResultsView()
+        self.model_lab = ModelLab()
+        # The lab starts from each result the Results page shows; its versions go back there.
+        self.results.result_changed.connect(self.model_lab.set_result)
+        self.model_lab.model_adopted.connect(self.results.show_outcome)
+        built = {"Results": self.results, "Model lab": self.model_lab}
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
-            self.pages.addTab(self.results if name == "Results" else PlaceholderPage(name), name)
+            self.pages.addTab(built[name] if name in built else PlaceholderPage(name), name)
         self.pages.setCurrentWidget(self.results)
         self.setCentralWidget(self.pages)
 
@@ -232,5 +238,6 @@ class MainWindow(QMainWindow):
     # -- closing -----------------------------------------------------------
     def closeEvent(self, event) -> None:
         self.worker.shutdown(CLOSE_WAIT_MS)
+        self.model_lab.shutdown(CLOSE_WAIT_MS)
         self.settings.save_window(self.saveGeometry(), self.saveState())
         super().closeEvent(event)

@@ -16,13 +16,6 @@ PAGES = {
         "lines while the periods are averaged, and save the recording.",
         "Until then, open an existing recording (NAME.wav with its NAME.json) with File ▸ Open recording…",
     ),
-    "Model lab": (
-        "This page will compare models of the driver: add, remove or swap effects from the catalogue (eddy "
-        "currents, suspension creep, …), refit, and rank the models by reduced χ², AIC and BIC with their "
-        "residuals side by side.",
-        "Until then, the Results page fits the default model, and the command line fits any other: "
-        "linpar analyze RECORDING --model EFFECTS (linpar effects lists them).",
-    ),
     "QA": (
         "This page will check drivers against a reference: tolerance limits on the parameters, the validity "
         "of each measurement, and a pass/fail report per driver.",

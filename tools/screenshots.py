@@ -3,8 +3,10 @@
     QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR]
 
 Writes results.png (and one PNG per Results plot tab and per other page) to
-docs/screenshots/ unless OUTDIR is given. Nothing of the user's settings is
-touched: the window gets a QSettings file in the temporary folder.
+docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
+model-lab-after.png: a recording whose laser lags by 100 us, diagnosed in the
+Model lab, before and after applying the top candidate. Nothing of the user's
+settings is touched: the window gets a QSettings file in the temporary folder.
 """
 from __future__ import annotations
 
@@ -20,13 +22,15 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEventLoop, QSettings, QTimer  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
-from analysis.drivers import load_driver
+from analysis.drivers import load_driver  # noqa: E402
+from analysis.effects import get_effect  # noqa: E402
 from analysis.multitone import design_multitone  # noqa: E402
 from analysis.recording import write_recording  # noqa: E402
 from analysis.synthesis import ChannelNoise, synthesize_recording  # noqa: E402
 
 SIZE = (1400, 900)
 ANALYSIS_TIMEOUT_S = 120
+HIDDEN_DELAY_S = 100e-6     # the laser's latency the default model does not know about
 
 
 def synthetic_recording(folder: Path, name: str = "paper-synthetic", laser: bool = True) -> Path:
@@ -42,6 +46,43 @@ def synthetic_recording(folder: Path, name: str = "paper-synthetic", laser: bool
                                      seed=3, driver=info)
     wav, _ = write_recording(folder / name, recording)
     return wav
+
+
+def hidden_delay_recording(folder: Path) -> Path:
+    """The paper's driver seen through a laser that lags by HIDDEN_DELAY_S: the default model misses it."""
+    driver = load_driver("paper")
+    model = driver.model()
+    model = model.with_effects(model.effects + (get_effect("delay-x"),))
+    mt = design_multitone(48000, 16384, 5.0, 10000.0, rms=1.0)
+    recording = synthesize_recording(model, {**driver.parameters, "tau_x": HIDDEN_DELAY_S}, mt.waveform,
+                                     mt.excited_bins, mt.sample_rate, 8, 1, ChannelNoise(1e-4, 1e-4, 1e-8),
+                                     seed=3, driver={"name": "paper (synthetic, laser 100 us late)",
+                                                     "sd_m2": driver.sd_m2})
+    wav, _ = write_recording(folder / "paper-laser-late", recording)
+    return wav
+
+
+def model_lab_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Model lab diagnosing a missing effect: before and after applying the top candidate."""
+    window.open_path(hidden_delay_recording(folder))
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the laser-late recording was not analysed in time", file=sys.stderr)
+        return []
+    lab = window.model_lab
+    window.pages.setCurrentWidget(lab)
+    settle(app)
+    lab.candidates.diagnose_button.click()
+    if not wait_for(lab.diagnosis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the diagnosis did not finish in time", file=sys.stderr)
+        return []
+    settle(app)
+    written = [out / "model-lab-before.png", out / "model-lab-after.png"]
+    window.grab().save(str(written[0]))
+    lab.candidates.select(0)
+    lab.candidates.apply_button.click()
+    settle(app)
+    window.grab().save(str(written[1]))
+    return written
 
 
 def wait_for(signal, timeout_s: float) -> bool:
@@ -105,6 +146,7 @@ def main(argv: list[str]) -> int:
             path = out / "results-no-laser.png"
             window.grab().save(str(path))
             written.append(path)
+        written += model_lab_screenshots(app, window, folder, out)
         window.close()
     for path in written:
         print(path)

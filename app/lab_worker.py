@@ -1,0 +1,257 @@
+"""The model lab's fits off the GUI thread: refits of one model, and diagnoses.
+
+Built like app.workers: one long-lived LabWorker (a QObject of the GUI
+thread) owns a QThreadPool and the signals; each job is a plain callable run
+by the pool, and every signal carries the job's id so the page can drop the
+outcome of a job it has replaced. What crosses to the GUI thread is frozen
+(LabFit, DiagnosisOutcome) and already holds everything the page draws: the
+parameter table, the dense model curves and the residual in words.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import itertools
+import logging
+import threading
+from dataclasses import dataclass
+from typing import Callable
+
+from PySide6.QtCore import QObject, QThreadPool, Signal
+
+from analysis import residuals
+from analysis.derived import parameter_table
+from analysis.diagnosis import MAX_STEPS, Candidate, diagnose, explain
+from analysis.effects import Effect
+from analysis.fit import FitCancelled, FitData, FitResult, fit_model
+from analysis.model import Model
+from analysis.parallel import fit_executor
+from analysis.pipeline import AnalysisResult
+from app.result_curves import ResultCurves, result_curves
+from app.workers import USER_ERRORS, one_line
+
+log = logging.getLogger(__name__)
+
+CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
+
+
+@dataclass(frozen=True, slots=True)
+class LabFit:
+    """One fitted model, ready to show: its AnalysisResult, curves and residual description."""
+
+    result: AnalysisResult      # the lab's recording with this fit and its parameter table
+    curves: ResultCurves
+    residual: str               # analysis.residuals.describe(fit)
+
+    @property
+    def fit(self) -> FitResult:
+        return self.result.fit
+
+
+def lab_fit(base: AnalysisResult, fit: FitResult) -> LabFit:
+    """`fit` dressed for display; milliseconds, but run in the worker with the fit it follows."""
+    result = dataclasses.replace(base, fit=fit, parameters=parameter_table(fit, base.sd_m2))
+    return LabFit(result, result_curves(result), residuals.describe(fit))
+
+
+@dataclass(frozen=True, slots=True)
+class CandidateRow:
+    """One ranked candidate of a diagnosis: the move, its numbers and its explanation."""
+
+    action: str                     # "add" or "replace"
+    effect: Effect
+    replaces: Effect | None
+    delta_bic: float                # inf when the refit failed
+    explanation: str                # analysis.diagnosis.explain
+    fitted: LabFit | None           # None when the refit failed
+    error: str | None = None
+
+    @property
+    def chi2_red(self) -> dict[str, float]:
+        return self.fitted.fit.chi2_red_by_channel() if self.fitted else {}
+
+    @property
+    def move(self) -> str:
+        if self.replaces is not None:
+            return f"replace {self.replaces.id} by {self.effect.id}"
+        return f"add {self.effect.id}"
+
+
+@dataclass(frozen=True, slots=True)
+class DiagnosisOutcome:
+    ranked_from: FitResult                  # the model the candidates are one move away from
+    candidates: tuple[CandidateRow, ...]    # best first
+    path: tuple[LabFit, ...]                # greedy path: the models taken, in order (empty: ranking only)
+    residual: str                           # where the residual of ranked_from sits
+
+
+def _row(base: AnalysisResult, ranked_from: FitResult, c: Candidate) -> CandidateRow:
+    return CandidateRow(c.action, c.effect, c.replaces, c.delta_bic, explain(ranked_from, c),
+                        lab_fit(base, c.fit) if c.fit is not None else None, c.error)
+
+
+class DiagnosisCancelled(Exception):
+    """Deliberately not a FitError: rank_candidates records those as failed candidates and goes on."""
+
+
+class _PollingFuture:
+    """A pool future whose result() wakes up to look at the cancel flag.
+
+    rank_candidates waits on each refit with result() and no timeout, and an
+    Event cannot be sent to the worker processes: without this a cancelled
+    diagnosis would run every remaining refit to the end.
+    """
+
+    def __init__(self, future: concurrent.futures.Future, owner: "_CancellableExecutor"):
+        self._future = future
+        self._owner = owner
+
+    def result(self, timeout=None):
+        while True:
+            try:
+                return self._future.result(timeout=CANCEL_POLL_S)
+            except concurrent.futures.TimeoutError:
+                self._owner.check()
+
+
+class _CancellableExecutor:
+    def __init__(self, pool: concurrent.futures.Executor, cancel: threading.Event):
+        self._pool = pool
+        self._cancel = cancel
+
+    def check(self) -> None:
+        if self._cancel.is_set():
+            # Refits not yet started are dropped; the one or two running finish in well under a second.
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            raise DiagnosisCancelled("diagnosis cancelled")
+
+    def submit(self, fn, *args, **kwargs) -> _PollingFuture:
+        self.check()
+        return _PollingFuture(self._pool.submit(fn, *args, **kwargs), self)
+
+
+class LabJob:
+    """A job of the lab; subclasses say what `run` computes and which signal carries it."""
+
+    kind = "job"
+
+    def __init__(self, job: int, worker: "LabWorker", base: AnalysisResult, data: FitData):
+        self.id = job
+        self._worker = worker
+        self.base = base
+        self.data = data
+        # NB: set by the GUI thread, read by the fit's iteration callback in the pool thread.
+        self.cancel_event = threading.Event()
+
+    def cancel(self) -> None:
+        self.cancel_event.set()
+
+    def run(self) -> None:
+        raise NotImplementedError
+
+    def __call__(self) -> None:
+        signals = self._worker
+        try:
+            self.run()
+        except (FitCancelled, DiagnosisCancelled):
+            signals.cancelled.emit(self.id)
+        except USER_ERRORS as exc:
+            if self.cancel_event.is_set():      # a cancelled fit may fail on its way out: still a cancel
+                signals.cancelled.emit(self.id)
+            else:
+                signals.failed.emit(self.id, one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
+            log.exception("model lab %s failed", self.kind)
+            signals.failed.emit(self.id, f"internal error in the model lab's {self.kind} "
+                                         f"({type(exc).__name__}: {one_line(exc)}); the details are in the log")
+
+
+class RefitJob(LabJob):
+    kind = "refit"
+
+    def __init__(self, job, worker, base, data, model: Model, start: dict[str, float]):
+        super().__init__(job, worker, base, data)
+        self.model = model
+        self.start = start
+
+    def run(self) -> None:
+        self._worker.progress.emit(self.id, f"fitting {self.model.describe()}")
+        fit = fit_model(self.data, self.model, start=self.start, cancel=self.cancel_event)
+        if self.cancel_event.is_set():
+            raise FitCancelled("cancelled after the fit")
+        self._worker.refit_finished.emit(self.id, lab_fit(self.base, fit))
+
+
+class DiagnoseJob(LabJob):
+    """Rank the candidates from `start` (follow=False) or follow the greedy path from it (follow=True).
+
+    `taken`, when known, is the candidate a previous ranking of `start` chose:
+    the greedy path then goes on from it instead of ranking `start` again.
+    """
+
+    kind = "diagnosis"
+
+    def __init__(self, job, worker, base, data, start: FitResult, follow: bool, taken: LabFit | None = None):
+        super().__init__(job, worker, base, data)
+        self.start = start
+        self.follow = follow
+        self.taken = taken
+
+    def run(self) -> None:
+        begin = self.taken.fit if self.taken is not None else self.start
+        progress: Callable[[str], None] = lambda text: self._worker.progress.emit(self.id, text)
+        with fit_executor() as pool:
+            executor = None if pool is None else _CancellableExecutor(pool, self.cancel_event)
+            result = diagnose(self.data, begin.model, executor=executor, cancel=self.cancel_event,
+                              start_fit=begin, progress=progress, max_steps=MAX_STEPS if self.follow else 1)
+        if self.cancel_event.is_set():
+            raise DiagnosisCancelled("cancelled after the diagnosis")
+        if self.follow:
+            steps = result.steps
+            last = steps[-1]
+            path = ((self.taken,) if self.taken is not None else ()) + tuple(
+                lab_fit(self.base, step.fit) for step in steps[1:])
+        else:
+            last, path = result.steps[0], ()
+        rows = tuple(_row(self.base, last.fit, c) for c in last.candidates)
+        self._worker.diagnosis_finished.emit(self.id, DiagnosisOutcome(last.fit, rows, path, last.residual))
+
+
+class LabWorker(QObject):
+    progress = Signal(int, str)                 # job id, what is being worked on
+    refit_finished = Signal(int, object)        # job id, LabFit
+    diagnosis_finished = Signal(int, object)    # job id, DiagnosisOutcome
+    failed = Signal(int, str)                   # job id, a one-line message for the user
+    cancelled = Signal(int)                     # job id
+
+    def __init__(self, parent: QObject | None = None):
+        super().__init__(parent)
+        self.pool = QThreadPool(self)
+        self._ids = itertools.count(1)
+        self._jobs: dict[int, LabJob] = {}
+        for signal in (self.refit_finished, self.diagnosis_finished, self.failed, self.cancelled):
+            signal.connect(self._forget)
+
+    def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabJob:
+        return self._start(RefitJob(next(self._ids), self, base, data, model, dict(start)))
+
+    def diagnose(self, base: AnalysisResult, data: FitData, start: FitResult, follow: bool = False,
+                 taken: LabFit | None = None) -> LabJob:
+        return self._start(DiagnoseJob(next(self._ids), self, base, data, start, follow, taken))
+
+    def _start(self, job: LabJob) -> LabJob:
+        self._jobs[job.id] = job
+        self.pool.start(job)
+        return job
+
+    def cancel_all(self) -> None:
+        for job in list(self._jobs.values()):
+            job.cancel()
+
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel every job and wait for the pool; True when all stopped in time."""
+        self.cancel_all()
+        return self.pool.waitForDone(wait_ms)
+
+    def _forget(self, job: int, *_args) -> None:
+        self._jobs.pop(job, None)

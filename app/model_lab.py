@@ -1,0 +1,404 @@
+"""The Model lab page: add, remove or swap effects, refit in the background, diagnose, and watch
+reduced chi^2 fall towards the noise floor version after version.
+
+The lab starts from the model the Results page fitted and keeps its own
+history of versions. Every refit is warm-started from the current version's
+values; a diagnosis ranks every model one move away (analysis.diagnosis) and
+its candidates can be adopted without a refit, their fits being computed
+already. The current version is handed back to the Results page
+(model_adopted), so that both pages show the same model.
+"""
+from __future__ import annotations
+
+import dataclasses
+import html
+from dataclasses import dataclass
+from pathlib import Path
+
+from PySide6.QtCore import Qt, Signal, Slot
+from PySide6.QtWidgets import (QHBoxLayout, QLabel, QProgressBar, QPushButton, QSplitter, QStackedWidget,
+                               QVBoxLayout, QWidget)
+
+from analysis import residuals
+from analysis.derived import parameter_table
+from analysis.diagnosis import MIN_BIC_GAIN
+from analysis.effects import get_effect
+from analysis.fit import FitData
+from analysis.model import Model, ModelError
+from analysis.pipeline import AnalysisResult
+from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
+from app.model_lab_candidates import CandidatesPanel
+from app.model_lab_catalogue import EffectCatalogue
+from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
+from app.parameter_table import ParameterTable
+from app.result_curves import result_curves
+from app.workers import AnalysisOutcome
+
+EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
+              "Results page fits, and from there you add, remove or swap effects.")
+
+
+@dataclass(frozen=True, slots=True)
+class LabVersion:
+    number: int          # 1, 2, ...: the x axis of the chi^2 chart
+    fitted: LabFit
+    how: str             # how it came about, for the chart's tooltip and the header
+
+    @property
+    def effects(self) -> str:
+        return ", ".join(self.fitted.fit.model.effect_ids) or "textbook"
+
+
+def move_text(old: Model, new: Model) -> str:
+    """What changed from `old` to `new`, in the words of the catalogue: 'added delay-x; removed lr2'."""
+    before = {e.category: e for e in old.effects}
+    after = {e.category: e for e in new.effects}
+    moves = []
+    for category, effect in before.items():
+        if category not in after:
+            moves.append(f"removed {effect.id}")
+        elif after[category].id != effect.id:
+            moves.append(f"replaced {effect.id} by {after[category].id}")
+    moves += [f"added {e.id}" for c, e in after.items() if c not in before]
+    return "; ".join(moves) or "refitted"
+
+
+def changed_model(current: Model, checked: tuple[str, ...]) -> Model:
+    """The current model with the checked effects: kept in place, swapped in place, new ones at the end."""
+    chosen = {}
+    for effect_id in checked:
+        effect = get_effect(effect_id)
+        chosen[effect.category] = effect
+    effects = []
+    for effect in current.effects:
+        new = chosen.pop(effect.category, None)
+        if new is not None:
+            effects.append(new)
+    return current.with_effects(effects + list(chosen.values()))
+
+
+class ModelLab(QWidget):
+    version_added = Signal(object)      # LabVersion, after the page shows it
+    diagnosis_shown = Signal(object)    # DiagnosisOutcome, after the table shows it
+    job_failed = Signal(str)            # the message shown
+    job_cancelled = Signal()
+    model_adopted = Signal(object)      # AnalysisOutcome of a new current model, for the Results page
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.worker = LabWorker(self)
+        self.base: AnalysisResult | None = None     # the recording as the Results page analysed it
+        self.data: FitData | None = None
+        self.versions: list[LabVersion] = []
+        self.job: LabJob | None = None              # the job whose outcome will be shown
+        self.diagnosis: DiagnosisOutcome | None = None
+        self.diagnosis_version = 0                  # the version the shown candidates are one move from
+
+        self.empty = QLabel(EMPTY_TEXT)
+        self.empty.setAlignment(Qt.AlignCenter)
+        self.empty.setWordWrap(True)
+
+        self.model_label = QLabel()
+        self.model_label.setTextFormat(Qt.RichText)
+        self.model_label.setWordWrap(True)
+        self.model_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.status_label = QLabel()
+        self.status_label.setWordWrap(True)
+        self.status_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
+        self.progress = QProgressBar()
+        self.progress.setRange(0, 0)          # fits report no fraction: a busy indicator
+        self.progress.setMaximumWidth(120)
+        self.cancel_button = QPushButton("Cancel")
+        self.cancel_button.setToolTip("Stop the refit or diagnosis; the current version stays")
+        header = QHBoxLayout()
+        header.addWidget(self.model_label, 3)
+        header.addWidget(self.status_label, 1)
+        header.addWidget(self.progress)
+        header.addWidget(self.cancel_button)
+
+        self.catalogue = EffectCatalogue()
+        self.residual_panel = ResidualPanel()
+        self.candidates = CandidatesPanel()
+        self.chart = ChiSquareChart()
+        self.parameter_table = ParameterTable()
+        table_box = QWidget()
+        table_layout = QVBoxLayout(table_box)
+        table_layout.setContentsMargins(0, 0, 0, 0)
+        table_title = QLabel("<b>Parameters</b> of the current version (bold: fitted)")
+        table_title.setWordWrap(True)
+        table_layout.addWidget(table_title)
+        table_layout.addWidget(self.parameter_table, 1)
+
+        middle = QSplitter(Qt.Vertical)
+        middle.addWidget(self.residual_panel)
+        middle.addWidget(self.candidates)
+        middle.setSizes([440, 360])
+        right = QSplitter(Qt.Vertical)
+        right.addWidget(self.chart)
+        right.addWidget(table_box)
+        right.setSizes([330, 470])
+        splitter = QSplitter(Qt.Horizontal)
+        splitter.addWidget(self.catalogue)
+        splitter.addWidget(middle)
+        splitter.addWidget(right)
+        splitter.setStretchFactor(1, 1)
+        splitter.setSizes([330, 640, 410])
+        self.splitter = splitter
+
+        content = QWidget()
+        content_layout = QVBoxLayout(content)
+        content_layout.setContentsMargins(0, 0, 0, 0)
+        content_layout.addLayout(header)
+        content_layout.addWidget(splitter, 1)
+        self.content = content
+        self.stack = QStackedWidget()
+        self.stack.addWidget(self.empty)
+        self.stack.addWidget(content)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.stack)
+
+        self.catalogue.selection_changed.connect(self.on_selection_changed)
+        self.candidates.diagnose_button.clicked.connect(self.on_diagnose)
+        self.candidates.apply_button.clicked.connect(self.on_apply)
+        self.candidates.follow_button.clicked.connect(self.on_follow)
+        self.candidates.selected_changed.connect(self.on_candidate_selected)
+        self.cancel_button.clicked.connect(self.on_cancel)
+        self.worker.progress.connect(self.on_progress)
+        self.worker.refit_finished.connect(self.on_refit_finished)
+        self.worker.diagnosis_finished.connect(self.on_diagnosis_finished)
+        self.worker.failed.connect(self.on_failed)
+        self.worker.cancelled.connect(self.on_cancelled)
+        self._set_busy(False)
+
+    # -- state -------------------------------------------------------------
+    @property
+    def current(self) -> LabVersion | None:
+        return self.versions[-1] if self.versions else None
+
+    @property
+    def busy(self) -> bool:
+        return self.job is not None
+
+    @Slot(object)
+    def set_result(self, result: AnalysisResult) -> None:
+        """A result from the Results page: a new recording restarts the lab from its model."""
+        if self.base is not None and result.spectra is self.base.spectra:
+            # The same recording: the Results page shows one of our versions, or Sd was edited.
+            self._sync_sd(result.sd_m2)
+            return
+        self._drop_job()
+        self.base = result
+        self.data = FitData.from_spectra(result.spectra)
+        self.versions = []
+        self.diagnosis, self.diagnosis_version = None, 0
+        self.candidates.set_outcome(None)
+        self.catalogue.set_displacement_available(result.fit.model.with_displacement)
+        # Curves and the residual in words take well under a millisecond: no worker needed.
+        first = LabFit(result, result_curves(result), residuals.describe(result.fit))
+        self._add_version(first, "as fitted on the Results page", adopt=False)
+        self.status_label.setText("")
+        self.stack.setCurrentWidget(self.content)
+
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel the lab's work and wait for it; True when it stopped in time."""
+        self.job = None
+        return self.worker.shutdown(wait_ms)
+
+    def _sync_sd(self, sd_m2: float | None) -> None:
+        if self.base is None or sd_m2 == self.base.sd_m2:
+            return
+        self.base = dataclasses.replace(self.base, sd_m2=sd_m2)
+        version = self.versions[-1]
+        self.versions[-1] = dataclasses.replace(version, fitted=self._with_sd(version.fitted))
+        self._show_parameters()
+
+    def _with_sd(self, fitted: LabFit) -> LabFit:
+        """`fitted` with the lab's current Sd (it feeds derived parameters only; milliseconds)."""
+        if fitted.result.sd_m2 == self.base.sd_m2:
+            return fitted
+        result = dataclasses.replace(fitted.result, sd_m2=self.base.sd_m2,
+                                     parameters=parameter_table(fitted.fit, self.base.sd_m2))
+        return dataclasses.replace(fitted, result=result)
+
+    def _add_version(self, fitted: LabFit, how: str, adopt: bool = True, announce: bool = True) -> LabVersion:
+        version = LabVersion(len(self.versions) + 1, self._with_sd(fitted), how)
+        self.versions.append(version)
+        self._show_current()
+        if self.diagnosis is not None and self.diagnosis_version != version.number:
+            self.candidates.mark_stale(version.number)
+        if adopt and announce:
+            result = version.fitted.result
+            self.model_adopted.emit(AnalysisOutcome(version.number, result.source or Path(), result,
+                                                    version.fitted.curves))
+        if announce:
+            self.version_added.emit(version)
+        return version
+
+    # -- showing -----------------------------------------------------------
+    def _show_current(self) -> None:
+        version = self.versions[-1]
+        fit = version.fitted.fit
+        text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
+                f"<span style='color:#555'>({html.escape(version.how)})</span> &nbsp;·&nbsp; "
+                f"<b>reduced χ²</b> {chi2_text(fit.chi2_red_by_channel())} &nbsp;·&nbsp; BIC {fit.bic:.1f}"
+                f" &nbsp;·&nbsp; {fit.n_varying} parameters")
+        if not fit.success:
+            text += (f"<br><span style='color:#8e1b1b'><b>The fit did not converge</b>: "
+                     f"{html.escape(fit.message)}</span>")
+        self.model_label.setText(text)
+        self.catalogue.set_checked(fit.model.effect_ids)
+        self.residual_panel.set_fit(version.fitted.curves, version.fitted.residual)
+        self._show_parameters()
+        self.chart.set_points([ChartPoint(v.number, v.effects, v.how, v.fitted.fit.chi2_red_by_channel())
+                               for v in self.versions])
+        self._update_buttons()
+
+    def _show_parameters(self) -> None:
+        result = self.versions[-1].fitted.result
+        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
+        self.parameter_table.set_parameters(result.parameters, descriptions)
+
+    def _set_busy(self, busy: bool, text: str = "") -> None:
+        self.progress.setVisible(busy)
+        self.cancel_button.setVisible(busy)
+        if text:
+            self.status_label.setText(text)
+        self._update_buttons()
+
+    def _update_buttons(self) -> None:
+        ready = self.current is not None and not self.busy
+        self.candidates.diagnose_button.setEnabled(ready)
+        self.candidates.follow_button.setEnabled(ready)
+        row = self.candidates.selected()
+        self.candidates.apply_button.setEnabled(
+            ready and row is not None and row.fitted is not None and not self.candidates.stale)
+
+    # -- jobs --------------------------------------------------------------
+    def _drop_job(self) -> None:
+        """Cancel the running job and ignore whatever it still reports."""
+        if self.job is not None:
+            self.job.cancel()
+            self.job = None
+            self._set_busy(False)
+
+    def _take(self, job: int) -> LabJob | None:
+        if self.job is None or self.job.id != job:
+            return None
+        current, self.job = self.job, None
+        self._set_busy(False)
+        return current
+
+    @Slot(tuple)
+    def on_selection_changed(self, checked: tuple) -> None:
+        """A checkbox changed: refit the changed model, warm-started from the current version."""
+        if self.current is None:
+            return
+        current = self.current.fitted.fit.model
+        try:
+            model = changed_model(current, checked)
+        except (KeyError, ModelError) as exc:
+            self.catalogue.set_checked(current.effect_ids)
+            self.status_label.setText(f"Cannot build that model: {exc}")
+            return
+        self._drop_job()         # a newer choice replaces a refit or diagnosis still running
+        if model.effect_ids == current.effect_ids:
+            return
+        self.job = self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values)
+        self._set_busy(True, f"Refitting {model.describe()} ({move_text(current, model)})…")
+
+    @Slot()
+    def on_diagnose(self) -> None:
+        if self.current is None or self.busy:
+            return
+        self.job = self.worker.diagnose(self.base, self.data, self.current.fitted.fit)
+        self._set_busy(True, f"Diagnosing version {self.current.number}…")
+
+    @Slot()
+    def on_follow(self) -> None:
+        if self.current is None or self.busy:
+            return
+        taken = None
+        if self.diagnosis is not None and self.diagnosis_version == self.current.number and self.diagnosis.candidates:
+            best = self.diagnosis.candidates[0]
+            if best.fitted is not None and best.delta_bic < -MIN_BIC_GAIN:
+                taken = best.fitted       # ranked already: the path goes on from there
+        self.job = self.worker.diagnose(self.base, self.data, self.current.fitted.fit, follow=True, taken=taken)
+        self._set_busy(True, f"Following the greedy path from version {self.current.number}…")
+
+    @Slot()
+    def on_apply(self) -> None:
+        row = self.candidates.selected()
+        if row is None or row.fitted is None or self.busy or self.candidates.stale:
+            return
+        old = self.current
+        self._add_version(row.fitted, f"{move_text(old.fitted.fit.model, row.fitted.fit.model)} "
+                                      f"from the diagnosis of version {old.number}")
+        self.status_label.setText(f"Applied: {row.move} (ΔBIC {row.delta_bic:+.4g})")
+
+    @Slot()
+    def on_candidate_selected(self) -> None:
+        row = self.candidates.selected()
+        if row is not None:
+            self.catalogue.show_effect(row.effect.id)     # the whole catalogue entry of the candidate
+        self._update_buttons()
+
+    @Slot()
+    def on_cancel(self) -> None:
+        if self.job is not None:
+            self.job.cancel()
+            self.status_label.setText("Cancelling…")
+
+    # -- the worker's signals ------------------------------------------------
+    @Slot(int, str)
+    def on_progress(self, job: int, text: str) -> None:
+        if self.job is not None and self.job.id == job:
+            self.status_label.setText(text[:1].upper() + text[1:] + "…")
+
+    @Slot(int, object)
+    def on_refit_finished(self, job: int, fitted: LabFit) -> None:
+        if self._take(job) is None:
+            return
+        old = self.current
+        self._add_version(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
+        self.status_label.setText(f"Refitted: reduced χ² {chi2_text(old.fitted.fit.chi2_red_by_channel())} → "
+                                  f"{chi2_text(fitted.fit.chi2_red_by_channel())}")
+
+    @Slot(int, object)
+    def on_diagnosis_finished(self, job: int, outcome: DiagnosisOutcome) -> None:
+        finished = self._take(job)
+        if finished is None:
+            return
+        start = self.current.number
+        for step, fitted in enumerate(outcome.path, start=1):
+            previous = self.current.fitted.fit.model
+            last = step == len(outcome.path)
+            self._add_version(fitted, f"greedy path from version {start}, step {step}: "
+                                      f"{move_text(previous, fitted.fit.model)}", announce=last)
+        self.diagnosis, self.diagnosis_version = outcome, self.current.number
+        self.candidates.set_outcome(outcome, self.current.number, self.current.effects)
+        if outcome.path:
+            self.status_label.setText(f"Greedy path: {len(outcome.path)} step(s), now version {self.current.number}")
+        elif getattr(finished, "follow", False):
+            self.status_label.setText(f"The greedy path stops at once: no candidate lowers BIC by more than "
+                                      f"{MIN_BIC_GAIN:g}")
+        else:
+            self.status_label.setText(f"Diagnosed version {self.current.number}: {len(outcome.candidates)} "
+                                      f"candidates")
+        self._update_buttons()
+        self.diagnosis_shown.emit(outcome)
+
+    @Slot(int, str)
+    def on_failed(self, job: int, message: str) -> None:
+        if self._take(job) is None:
+            return
+        self.catalogue.set_checked(self.current.fitted.fit.model.effect_ids)
+        self.status_label.setText(f"Failed: {message}; still version {self.current.number}")
+        self.job_failed.emit(message)
+
+    @Slot(int)
+    def on_cancelled(self, job: int) -> None:
+        if self._take(job) is None:
+            return
+        self.catalogue.set_checked(self.current.fitted.fit.model.effect_ids)
+        self.status_label.setText(f"Cancelled: still version {self.current.number}")
+        self.job_cancelled.emit()

@@ -1,0 +1,142 @@
+"""The diagnosis in the model lab: ranked candidates, the explanation of the selected one, and the
+buttons that start a diagnosis, apply a candidate and follow the greedy path."""
+from __future__ import annotations
+
+import html
+import math
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QFont
+from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QTableWidget,
+                               QTableWidgetItem, QTextBrowser, QVBoxLayout, QWidget)
+
+from analysis.diagnosis import MIN_BIC_GAIN
+from app.lab_worker import CandidateRow, DiagnosisOutcome
+from app.model_lab_catalogue import category_title
+
+COLUMNS = ("#", "Action", "Effect", "Category", "ΔBIC", "χ²ᵣ Z", "χ²ᵣ Hx")
+RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, CHI2_Z, CHI2_X = range(len(COLUMNS))
+CHI2_COLUMNS = {"impedance": CHI2_Z, "displacement": CHI2_X}
+NO_DIAGNOSIS = ("Diagnose tries every effect one move away from the current model (add one of a new category, "
+                "or swap one for an alternative), refits each and ranks them by how much they lower BIC.")
+
+
+def bic_text(delta_bic: float) -> str:
+    return f"{delta_bic:+.4g}" if math.isfinite(delta_bic) else "failed"
+
+
+class CandidatesPanel(QWidget):
+    selected_changed = Signal()
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.rows: tuple[CandidateRow, ...] = ()
+        self.stale = False
+        self._heading = "<b>Diagnosis</b>"
+
+        self.diagnose_button = QPushButton("Diagnose")
+        self.diagnose_button.setToolTip("Refit every candidate one move away from the current model and rank them "
+                                        "by ΔBIC (in the background, on every core)")
+        self.apply_button = QPushButton("Apply")
+        self.apply_button.setToolTip("Adopt the selected candidate: its fit is already computed")
+        self.follow_button = QPushButton("Follow the greedy path")
+        self.follow_button.setToolTip(f"Take the best candidate while it lowers BIC by more than "
+                                      f"{MIN_BIC_GAIN:g}, then stop; every step becomes a version")
+        buttons = QHBoxLayout()
+        buttons.setContentsMargins(0, 0, 0, 0)
+        for button in (self.diagnose_button, self.apply_button, self.follow_button):
+            buttons.addWidget(button)
+        buttons.addStretch(1)
+        self.title = QLabel("<b>Diagnosis</b>")
+        self.title.setTextFormat(Qt.RichText)
+        self.title.setWordWrap(True)
+
+        self.table = QTableWidget(0, len(COLUMNS))
+        self.table.setHorizontalHeaderLabels(COLUMNS)
+        self.table.setSelectionBehavior(QAbstractItemView.SelectRows)
+        self.table.setSelectionMode(QAbstractItemView.SingleSelection)
+        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
+        self.table.setAlternatingRowColors(True)
+        self.table.verticalHeader().setVisible(False)
+        self.table.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 6)
+        header = self.table.horizontalHeader()
+        for column in range(len(COLUMNS)):
+            header.setSectionResizeMode(column, QHeaderView.ResizeToContents)
+        header.setSectionResizeMode(CATEGORY, QHeaderView.Stretch)
+        self.table.itemSelectionChanged.connect(self.on_selection_changed)
+
+        self.explanation = QTextBrowser()
+        self.explanation.setMinimumHeight(60)
+        self.explanation.setHtml(f"<p>{html.escape(NO_DIAGNOSIS)}</p>")
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addLayout(buttons)
+        layout.addWidget(self.title)
+        layout.addWidget(self.table, 3)
+        layout.addWidget(self.explanation, 2)
+
+    def set_outcome(self, outcome: DiagnosisOutcome | None, version: int = 0, effects: str = "") -> None:
+        """Show the candidates of a diagnosis of version `version` (None: no diagnosis yet)."""
+        self.stale = False
+        self.table.clearSelection()
+        self.rows = outcome.candidates if outcome is not None else ()
+        self.table.setRowCount(len(self.rows))
+        for r, row in enumerate(self.rows):
+            # Read across, "replace lr2 by" + "lr3" is the move; the effect column stays a plain id.
+            action = f"replace {row.replaces.id} by" if row.replaces is not None else "add"
+            cells = {RANK: str(r + 1), ACTION: action, EFFECT: row.effect.id,
+                     CATEGORY: category_title(row.effect.category), DELTA_BIC: bic_text(row.delta_bic)}
+            for channel, column in CHI2_COLUMNS.items():
+                value = row.chi2_red.get(channel)
+                cells[column] = f"{value:.3g}" if value is not None else ("–" if row.fitted else "failed")
+            for column, text in cells.items():
+                item = QTableWidgetItem(text)
+                if column in (RANK, DELTA_BIC, CHI2_Z, CHI2_X):
+                    item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
+                if column == EFFECT:
+                    item.setToolTip(row.effect.title)
+                if column == DELTA_BIC and row.delta_bic < -MIN_BIC_GAIN:
+                    font = QFont()
+                    font.setBold(True)     # the data ask for it: it pays for its parameters
+                    item.setFont(font)
+                    item.setToolTip(f"lowers BIC by more than {MIN_BIC_GAIN:g}: strong evidence")
+                self.table.setItem(r, column, item)
+        if outcome is None:
+            self._heading = "<b>Diagnosis</b>"
+            self.title.setText(self._heading)
+            self.explanation.setHtml(f"<p>{html.escape(NO_DIAGNOSIS)}</p>")
+        else:
+            self._heading = f"<b>Diagnosis</b> of version {version} ({html.escape(effects)})"
+            self.title.setText(f"{self._heading}: {len(self.rows)} candidates, best first")
+            if self.rows:
+                self.table.selectRow(0)
+            else:
+                self.explanation.setHtml("<p>No candidate was ranked from this model: Diagnose to rank "
+                                         "from it.</p>")
+        self.selected_changed.emit()
+
+    def mark_stale(self, version: int) -> None:
+        """The model changed since the diagnosis: its candidates are one move from an older version."""
+        if not self.rows or self.stale:
+            return
+        self.stale = True
+        self.title.setText(f"{self._heading}: the model is now version {version}; Diagnose again to rank "
+                           f"from it")
+        self.selected_changed.emit()
+
+    def selected(self) -> CandidateRow | None:
+        rows = self.table.selectionModel().selectedRows()
+        if not rows or rows[0].row() >= len(self.rows):
+            return None
+        return self.rows[rows[0].row()]
+
+    def select(self, index: int) -> None:
+        self.table.selectRow(index)
+
+    def on_selection_changed(self) -> None:
+        row = self.selected()
+        if row is not None:
+            self.explanation.setHtml(f"<p><b>{html.escape(row.move)}</b> ({html.escape(row.effect.title)}): "
+                                     f"{html.escape(row.explanation)}</p>")
+        self.selected_changed.emit()

@@ -1,0 +1,202 @@
+"""The effects catalogue of the model lab: checkboxes by category, and a pane explaining each effect.
+
+Effects of one category are alternatives (analysis.model allows one per
+category): checking a second one swaps it for the first, like radio buttons
+that may also all be off.
+"""
+from __future__ import annotations
+
+import html
+
+from PySide6.QtCore import QEvent, Qt, Signal
+from PySide6.QtGui import QBrush, QColor, QFont
+from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter, QTextBrowser, QTreeWidget,
+                               QTreeWidgetItem, QVBoxLayout, QWidget)
+
+from analysis.effects import Effect, Site, categories
+from app import style
+
+EFFECT_ROLE = Qt.UserRole
+CATEGORY_TITLES = {       # the ids are for code; these are for the reader
+    "inductance": "Voice-coil inductance",
+    "creep": "Suspension creep",
+    "electrical-channel": "Current channel",
+    "displacement-sensor": "Displacement sensor",
+    "breakup": "Cone break-up",
+}
+NO_DISPLACEMENT = "needs the displacement channel, which this recording does not have"
+HINT = ("Check an effect to add it to the model and refit; uncheck it to remove it. One effect per category: "
+        "checking another swaps it. Point at an effect to read what it is.")
+
+
+def category_title(category: str) -> str:
+    return CATEGORY_TITLES.get(category, category.replace("-", " ").capitalize())
+
+
+def effect_html(effect: Effect, available: bool = True) -> str:
+    """The catalogue entry of an effect, for the detail pane."""
+    e = html.escape
+    rows = "".join(
+        f"<tr><td><b>{e(p.name)}</b></td><td>{e(p.display_unit)}</td><td>{e(p.description)}</td></tr>"
+        for p in effect.params)
+    parts = [
+        f"<h3 style='margin-bottom:2px'>{e(effect.title)}</h3>",
+        f"<p style='margin-top:0'><code>{e(effect.id)}</code> · {e(category_title(effect.category))} · "
+        f"acts on the {e(effect.site.value)}</p>",
+    ]
+    if not available:
+        parts.append(f"<p style='color:{style.MISSING_TEXT}'><i>Not available: {e(NO_DISPLACEMENT)}.</i></p>")
+    parts += [
+        f"<p><b>Physics.</b> {e(effect.physics)}</p>",
+        f"<p><b>The residual it cures.</b> {e(effect.signature)}</p>",
+        f"<p><b>Typical values.</b> {e(effect.typical)}</p>",
+        f"<p><b>Parameters</b></p><table cellspacing='0' cellpadding='2'>{rows}</table>",
+        f"<p><b>Reference.</b> {e(effect.reference)}</p>",
+    ]
+    if effect.notes:
+        parts.append(f"<p><b>Notes.</b> {e(effect.notes)}</p>")
+    return "".join(parts)
+
+
+class EffectCatalogue(QWidget):
+    # The user changed the checked effects: their ids, in catalogue order.
+    selection_changed = Signal(tuple)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._items: dict[str, QTreeWidgetItem] = {}
+        self._by_category: dict[str, list[str]] = {}
+        self._available: dict[str, bool] = {}
+        self._updating = False
+
+        self.tree = QTreeWidget()
+        self.tree.setHeaderHidden(True)
+        # The id with its checkbox, then the title: the titles are long and QTreeView cannot wrap
+        # text in an indented column, so the title is the part that gets elided (the pane has it whole).
+        self.tree.setColumnCount(2)
+        self.tree.setSelectionMode(QAbstractItemView.SingleSelection)
+        self.tree.setMouseTracking(True)           # itemEntered: explain the effect under the pointer
+        self.tree.header().setSectionResizeMode(0, QHeaderView.ResizeToContents)
+        # Categories are headings, always open: no expand arrows, and little indentation, so the
+        # narrow column keeps its room for the titles.
+        self.tree.setRootIsDecorated(False)
+        self.tree.setItemsExpandable(False)
+        self.tree.setIndentation(10)
+        self.tree.header().setStretchLastSection(True)
+        self.tree.viewport().installEventFilter(self)
+        bold = QFont()
+        bold.setBold(True)
+        for category, effects in categories().items():
+            head = QTreeWidgetItem([category_title(category)])
+            head.setFont(0, bold)
+            head.setFlags(Qt.ItemIsEnabled)
+            head.setToolTip(0, f"{category_title(category)}: at most one of these in a model")
+            self.tree.addTopLevelItem(head)
+            head.setFirstColumnSpanned(True)
+            self._by_category[category] = []
+            for effect in effects:
+                item = QTreeWidgetItem([effect.id, effect.title])
+                item.setData(0, EFFECT_ROLE, effect)
+                item.setFlags(Qt.ItemIsEnabled | Qt.ItemIsSelectable | Qt.ItemIsUserCheckable)
+                item.setCheckState(0, Qt.Unchecked)
+                self._set_tooltip(item, f"{effect.title}. Cures: {effect.signature}")
+                head.addChild(item)
+                self._items[effect.id] = item
+                self._by_category[category].append(effect.id)
+                self._available[effect.id] = True
+        self.tree.expandAll()
+        self.tree.itemChanged.connect(self.on_item_changed)
+        self.tree.itemEntered.connect(self.on_item_entered)
+        self.tree.currentItemChanged.connect(self.on_current_changed)
+
+        self.detail = QTextBrowser()
+        self.detail.setOpenExternalLinks(False)
+        self.detail.setHtml(f"<p>{html.escape(HINT)}</p>")
+
+        title = QLabel("<b>Effects</b> (one per category)")
+        splitter = QSplitter(Qt.Vertical)
+        splitter.addWidget(self.tree)
+        splitter.addWidget(self.detail)
+        splitter.setSizes([320, 420])     # the list needs ~300 px; the rest goes to the explanation
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(title)
+        layout.addWidget(splitter, 1)
+
+    # -- state -------------------------------------------------------------
+    def checked(self) -> tuple[str, ...]:
+        return tuple(i for i, item in self._items.items() if item.checkState(0) == Qt.Checked)
+
+    def item(self, effect_id: str) -> QTreeWidgetItem:
+        return self._items[effect_id]
+
+    def set_checked(self, effect_ids) -> None:
+        """Show a model's effects; emits nothing (the model is already fitted)."""
+        wanted = set(effect_ids)
+        self._updating = True
+        try:
+            for effect_id, item in self._items.items():
+                item.setCheckState(0, Qt.Checked if effect_id in wanted else Qt.Unchecked)
+        finally:
+            self._updating = False
+
+    def set_displacement_available(self, available: bool) -> None:
+        """Without Hx, effects on the displacement channel have nothing to act on: shown, but not checkable."""
+        self._updating = True
+        try:
+            for effect_id, item in self._items.items():
+                effect: Effect = item.data(0, EFFECT_ROLE)
+                ok = available or effect.site is not Site.DISPLACEMENT
+                self._available[effect_id] = ok
+                flags = Qt.ItemIsEnabled | Qt.ItemIsSelectable | (Qt.ItemIsUserCheckable if ok else Qt.NoItemFlags)
+                item.setFlags(flags)
+                for column in (0, 1):
+                    item.setForeground(column, QBrush() if ok else QBrush(QColor(style.MISSING_TEXT)))
+                self._set_tooltip(item, f"{effect.title}. Cures: {effect.signature}" if ok
+                                  else f"{effect.title}: {NO_DISPLACEMENT}")
+        finally:
+            self._updating = False
+
+    @staticmethod
+    def _set_tooltip(item: QTreeWidgetItem, text: str) -> None:
+        for column in (0, 1):
+            item.setToolTip(column, text)
+
+    def show_effect(self, effect_id: str) -> None:
+        item = self._items[effect_id]
+        self.detail.setHtml(effect_html(item.data(0, EFFECT_ROLE), self._available[effect_id]))
+
+    # -- slots -------------------------------------------------------------
+    def on_item_changed(self, item: QTreeWidgetItem, _column: int) -> None:
+        effect: Effect | None = item.data(0, EFFECT_ROLE)
+        if self._updating or effect is None:
+            return
+        if item.checkState(0) == Qt.Checked:
+            self._updating = True
+            try:
+                for other in self._by_category[effect.category]:
+                    if other != effect.id:
+                        self._items[other].setCheckState(0, Qt.Unchecked)
+            finally:
+                self._updating = False
+        self.show_effect(effect.id)
+        self.selection_changed.emit(self.checked())
+
+    def on_item_entered(self, item: QTreeWidgetItem, _column: int) -> None:
+        effect: Effect | None = item.data(0, EFFECT_ROLE)
+        if effect is not None:
+            self.show_effect(effect.id)
+
+    def on_current_changed(self, current: QTreeWidgetItem | None, _previous) -> None:
+        effect: Effect | None = current.data(0, EFFECT_ROLE) if current is not None else None
+        if effect is not None:
+            self.show_effect(effect.id)
+
+    def eventFilter(self, watched, event) -> bool:
+        # Leaving the list: back to the selected effect, so hovering never loses what was being read.
+        if event.type() == QEvent.Leave:
+            current = self.tree.currentItem()
+            effect = current.data(0, EFFECT_ROLE) if current is not None else None
+            if effect is not None:
+                self.show_effect(effect.id)
+        return super().eventFilter(watched, event)

@@ -1,0 +1,286 @@
+"""The Model lab on the paper's driver (lr2, creep-log) started from a model that lacks creep (lr2).
+
+The lab is driven through its real widgets; every wait is on a signal. Fits
+are real except where a test needs one to block (cancel) or to be watched
+(which thread runs it).
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import threading
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+
+import analysis.diagnosis
+import app.lab_worker
+from analysis.diagnosis import MIN_BIC_GAIN
+from analysis.effects import CATALOGUE, categories, get_effect
+from analysis.fit import FitCancelled, FitError
+from analysis.pipeline import analyze_recording
+from analysis.recording import read_recording
+from app import style
+from app.model_lab import ModelLab
+from app.model_lab_catalogue import EFFECT_ROLE
+from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT
+from app.parameter_table import VALUE
+
+from .conftest import ANALYSIS_TIMEOUT_MS, PAPER, open_and_wait
+
+CLOSE_WAIT_MS = 10_000
+
+
+def _analysed(path, effect_ids):
+    return analyze_recording(read_recording(path), effects=tuple(get_effect(i) for i in effect_ids))
+
+
+@pytest.fixture(scope="session")
+def lr2_result(recordings):
+    """The paper's recording fitted without creep: the model lacks an effect the data have."""
+    return _analysed(recordings["paper"], ("lr2",))
+
+
+@pytest.fixture(scope="session")
+def full_result(recordings):
+    return _analysed(recordings["paper"], ("lr2", "creep-log"))
+
+
+@pytest.fixture
+def make_lab(qtbot):
+    labs = []
+
+    def make(result) -> ModelLab:
+        style.configure_pyqtgraph()
+        lab = ModelLab()
+        qtbot.addWidget(lab)
+        lab.resize(1400, 850)
+        lab.show()
+        lab.set_result(result)
+        labs.append(lab)
+        return lab
+    yield make
+    for lab in labs:
+        assert lab.shutdown(CLOSE_WAIT_MS), "the lab's worker did not stop"
+
+
+@pytest.fixture
+def lab(make_lab, lr2_result):
+    return make_lab(lr2_result)
+
+
+def _chi2(lab: ModelLab) -> dict[str, float]:
+    return lab.current.fitted.fit.chi2_red_by_channel()
+
+
+def _toggle(qtbot, lab: ModelLab, effect_id: str, checked: bool):
+    """Check or uncheck an effect as a click on its box does, and wait for the refit's version."""
+    with qtbot.waitSignal(lab.version_added, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+        lab.catalogue.item(effect_id).setCheckState(0, Qt.Checked if checked else Qt.Unchecked)
+    return blocker.args[0]
+
+
+def _diagnose(qtbot, lab: ModelLab, button=None):
+    with qtbot.waitSignal(lab.diagnosis_shown, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+        qtbot.mouseClick(button or lab.candidates.diagnose_button, Qt.LeftButton)
+    return blocker.args[0]
+
+
+def _parameter(lab: ModelLab, name: str) -> float:
+    model = lab.parameter_table.parameter_model
+    return float(model.data(model.index(model.row_of(name), VALUE)))
+
+
+def test_the_catalogue_groups_every_effect_by_category_and_explains_it(qtbot, lab):
+    tree = lab.catalogue.tree
+    grouped = categories()
+    assert tree.topLevelItemCount() == len(grouped)
+    listed = {}
+    for i in range(tree.topLevelItemCount()):
+        head = tree.topLevelItem(i)
+        listed[head.text(0)] = [head.child(j).data(0, EFFECT_ROLE).id for j in range(head.childCount())]
+    assert sorted(sum(listed.values(), [])) == sorted(CATALOGUE)
+    assert sorted(map(sorted, listed.values())) == sorted(sorted(e.id for e in es) for es in grouped.values())
+    assert lab.catalogue.checked() == ("lr2",)          # the model the lab started from
+
+    creep = get_effect("creep-log")
+    qtbot.mouseMove(tree.viewport(), tree.visualItemRect(lab.catalogue.item("creep-log")).center())
+    text = lab.catalogue.detail.toPlainText()
+    for part in (creep.title, creep.physics, creep.signature, creep.typical, creep.reference):
+        assert " ".join(part.split()) in " ".join(text.split())
+    tree.setCurrentItem(lab.catalogue.item("delay-x"))              # selected
+    assert get_effect("delay-x").signature in " ".join(lab.catalogue.detail.toPlainText().split())
+
+
+def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, lab):
+    before = _chi2(lab)
+    assert min(before.values()) > 100        # the hidden creep is far above the noise
+    assert lab.residual_panel.text.text().count("sigma") >= 1
+    outcome = _diagnose(qtbot, lab)
+
+    table = lab.candidates.table
+    assert table.rowCount() == len(outcome.candidates) > 5
+    top = outcome.candidates[0]
+    assert top.effect.category == "creep"
+    assert table.item(0, CATEGORY).text() == "Suspension creep"
+    assert table.item(0, ACTION).text() == "add" and table.item(0, EFFECT).text() == top.effect.id
+    assert float(table.item(0, DELTA_BIC).text()) < -MIN_BIC_GAIN
+    deltas = [c.delta_bic for c in outcome.candidates]
+    assert deltas == sorted(deltas)
+    assert lab.candidates.selected() is top
+    assert "It cures:" in lab.candidates.explanation.toPlainText()
+    assert lab.candidates.apply_button.isEnabled()
+    assert len(lab.versions) == 1             # diagnosing adopts nothing
+
+    with qtbot.waitSignal(lab.model_adopted, timeout=1000) as adopted:
+        qtbot.mouseClick(lab.candidates.apply_button, Qt.LeftButton)
+    assert adopted.args[0].result.fit is top.fitted.fit          # its fit, not a refit
+    after = _chi2(lab)
+    assert lab.current.number == 2 and top.effect.id in lab.current.fitted.fit.model.effect_ids
+    for channel in before:
+        assert after[channel] <= before[channel] / 10, channel
+        assert after[channel] < 2
+    for channel in before:
+        versions, chi2 = lab.chart.data(channel)
+        assert list(versions) == [1, 2]
+        assert chi2[1] == pytest.approx(after[channel]) and chi2[1] < chi2[0] / 10
+    spots = lab.chart.series["impedance"].scatter.points()
+    tip = lab.chart.series["impedance"].scatter.opts["tip"](x=0.0, y=0.0, data=spots[-1].data())
+    assert tip.startswith("version 2: lr2, creep-log") and "added creep-log" in tip     # hovering the point
+    assert top.effect.id in lab.catalogue.checked()
+    assert "noise floor" in lab.residual_panel.text.text()
+    assert _parameter(lab, "lambda") == pytest.approx(PAPER.parameters["lambda"], rel=0.05)
+    assert lab.candidates.stale and not lab.candidates.apply_button.isEnabled()
+
+
+def test_unchecking_an_effect_refits_and_raises_chi2(qtbot, make_lab, full_result):
+    lab = make_lab(full_result)
+    before = _chi2(lab)
+    version = _toggle(qtbot, lab, "creep-log", checked=False)
+    assert version.number == 2 and version.how == "removed creep-log"
+    assert lab.current.fitted.fit.model.effect_ids == ("lr2",)
+    assert lab.catalogue.checked() == ("lr2",)
+    after = _chi2(lab)
+    for channel in before:
+        assert after[channel] > 10 * before[channel], channel
+        versions, chi2 = lab.chart.data(channel)
+        assert list(versions) == [1, 2] and chi2[1] > chi2[0]
+    with pytest.raises(KeyError):
+        lab.parameter_table.parameter_model.row_of("lambda")     # the table follows the model
+
+
+def test_checking_a_second_effect_of_a_category_swaps_it(qtbot, lab):
+    with qtbot.waitSignal(lab.version_added, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+        lab.catalogue.item("lr3").setCheckState(0, Qt.Checked)
+        assert lab.catalogue.checked() == ("lr3",)         # swapped at once, before the refit ends
+    version = blocker.args[0]
+    assert version.fitted.fit.model.effect_ids == ("lr3",)
+    assert version.how == "replaced lr2 by lr3"
+    assert "R3" in version.fitted.fit.values and "R2" in version.fitted.fit.values
+
+
+def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
+    threads = []
+
+    def spy(real):
+        def call(*args, **kwargs):
+            threads.append(threading.current_thread())
+            return real(*args, **kwargs)
+        return call
+    monkeypatch.setattr(app.lab_worker, "fit_model", spy(app.lab_worker.fit_model))
+    monkeypatch.setattr(app.lab_worker, "diagnose", spy(app.lab_worker.diagnose))
+    _toggle(qtbot, lab, "creep-log", checked=True)
+    _diagnose(qtbot, lab)
+    assert len(threads) == 2
+    assert all(t is not threading.main_thread() for t in threads)
+    assert threading.current_thread() is threading.main_thread()
+
+
+def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
+    started = threading.Event()
+
+    def blocked(data, model, start=None, cancel=None):
+        started.set()
+        if not cancel.wait(30):            # only the Cancel button ends this "fit"
+            raise AssertionError("never cancelled")
+        raise FitCancelled("fit cancelled")
+    monkeypatch.setattr(app.lab_worker, "fit_model", blocked)
+    lab.catalogue.item("creep-log").setCheckState(0, Qt.Checked)
+    qtbot.waitUntil(started.is_set, timeout=10_000)
+    assert lab.busy and lab.cancel_button.isVisible() and lab.progress.isVisible()
+    assert not lab.candidates.diagnose_button.isEnabled()
+    with qtbot.waitSignal(lab.job_cancelled, timeout=10_000):
+        qtbot.mouseClick(lab.cancel_button, Qt.LeftButton)
+    assert not lab.busy and not lab.cancel_button.isVisible()
+    assert len(lab.versions) == 1 and lab.catalogue.checked() == ("lr2",)
+    assert "cancelled" in lab.status_label.text().lower()
+
+
+def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
+    """The refits run in other processes, out of reach of the cancel flag: the wait on them is what stops,
+    and the refits not yet started are dropped."""
+    calls = []
+
+    def slow_refit(data, model, start, cancel):
+        calls.append(model.effect_ids)
+        threading.Event().wait(1.0)        # a refit in flight when Cancel comes
+        raise FitError("too slow for this test")
+
+    @contextlib.contextmanager
+    def one_process_pool(workers=None):     # a thread stands in for the process: same Executor interface
+        with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
+            yield pool
+    monkeypatch.setattr(analysis.diagnosis, "_refit", slow_refit)
+    monkeypatch.setattr(app.lab_worker, "fit_executor", one_process_pool)
+    qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
+    qtbot.waitUntil(lambda: bool(calls), timeout=10_000)
+    with qtbot.waitSignal(lab.job_cancelled, timeout=10_000):
+        qtbot.mouseClick(lab.cancel_button, Qt.LeftButton)
+    assert len(calls) <= 2 < len(analysis.diagnosis.candidate_models(lab.current.fitted.fit.model))
+    assert lab.candidates.table.rowCount() == 0 and len(lab.versions) == 1
+    assert lab.candidates.diagnose_button.isEnabled()
+
+
+def test_follow_the_greedy_path_after_a_diagnosis(qtbot, lab, monkeypatch):
+    starts = []
+    real = app.lab_worker.diagnose
+
+    def spy(data, model, **kwargs):
+        starts.append(kwargs["start_fit"].model.effect_ids)
+        return real(data, model, **kwargs)
+    monkeypatch.setattr(app.lab_worker, "diagnose", spy)
+    _diagnose(qtbot, lab)
+    outcome = _diagnose(qtbot, lab, lab.candidates.follow_button)
+    # The ranking of version 1 is not repeated: the path goes on from its best candidate.
+    assert starts == [("lr2",), ("lr2", "creep-log")]
+    assert [v.fitted.fit.model.effect_ids for v in lab.versions] == [("lr2",), ("lr2", "creep-log")]
+    assert "greedy path" in lab.current.how
+    assert all(c.delta_bic > -MIN_BIC_GAIN for c in outcome.candidates)   # nothing more to add
+    assert not lab.candidates.stale and lab.candidates.table.rowCount() == len(outcome.candidates)
+    assert max(_chi2(lab).values()) < 2
+
+
+def test_without_the_laser_displacement_effects_cannot_be_checked(make_lab, recordings):
+    lab = make_lab(_analysed(recordings["no_laser"], ("lr2",)))
+    item = lab.catalogue.item("delay-x")
+    assert not item.flags() & Qt.ItemIsUserCheckable
+    assert lab.catalogue.item("creep-log").flags() & Qt.ItemIsUserCheckable
+    assert lab.residual_panel.displacement.isHidden() and not lab.residual_panel.no_displacement.isHidden()
+    assert list(lab.chart.data("displacement")[0]) == []
+
+
+def test_the_main_window_hands_its_result_to_the_lab_and_shows_the_labs_model(qtbot, window, recordings):
+    assert window.pages.widget(window.pages.indexOf(window.model_lab)) is window.model_lab
+    assert window.pages.tabText(window.pages.indexOf(window.model_lab)) == "Model lab"
+    open_and_wait(qtbot, window, recordings["paper"])
+    lab = window.model_lab
+    assert lab.current.number == 1 and lab.current.fitted.fit is window.results.result.fit
+    _toggle(qtbot, lab, "creep-log", checked=False)
+    assert window.results.result.fit is lab.current.fitted.fit     # the Results page shows the lab's model
+    assert len(lab.versions) == 2                                   # and that did not restart the lab
+    window.results.on_sd_changed(0.02)
+    assert lab.current.fitted.result.sd_m2 == 0.02 and len(lab.versions) == 2
+    vas = lab.current.fitted.result.parameters["Vas"]
+    assert vas.value == pytest.approx(window.results.result.parameters["Vas"].value)
+    assert np.isfinite(vas.value)
