@@ -19,8 +19,9 @@ from dataclasses import dataclass
 from typing import Callable, Sequence
 
 from analysis.effects import CATALOGUE, Effect
-from analysis.fit import FitData, FitError, FitResult, fit_model
+from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
 from analysis.model import Model
+from analysis.startvalues import start_context
 from analysis import residuals
 
 MIN_BIC_GAIN = 10.0
@@ -86,32 +87,60 @@ def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
     return fit_model(data, model, start=start, cancel=cancel)
 
 
+def _run(calls, executor: Executor | None, cancel: threading.Event | None) -> list:
+    """Results (fit, error) of the calls, in order, on the pool when there is one."""
+    if executor is not None:
+        futures = [executor.submit(fn, *args) for fn, args in calls]
+        return [_outcome(f.result) for f in futures]
+    return [_outcome(lambda: fn(*args), cancel) for fn, args in calls]
+
+
+def _best_starts(data: FitData, current: FitResult, moves, executor, cancel) -> dict[int, dict]:
+    """For effects that ask for several start points (a narrow resonance), the most promising one.
+
+    Each start is screened by a short fit of the new effect's parameters
+    alone; only the best goes on to the full refit.
+    """
+    ctx = start_context(data.impedance)
+    calls, owners = [], []
+    for index, (_, effect, _, model) in enumerate(moves):
+        starts = effect.starts(ctx)
+        if len(starts) > 1:
+            for start in starts:
+                calls.append((screen_fit, (data, model, {**current.values, **start}, set(effect.param_names))))
+                owners.append(index)
+    best: dict[int, tuple[float, dict]] = {}
+    for index, (fit, _) in zip(owners, _run(calls, executor, cancel)):
+        if fit is not None and (index not in best or fit.chi2 < best[index][0]):
+            best[index] = (fit.chi2, fit.values)
+    return {index: values for index, (_, values) in best.items()}
+
+
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
                     cancel: threading.Event | None = None) -> tuple[Candidate, ...]:
+    """Every candidate refitted, warm-started from `current`, ranked by delta BIC (best first)."""
     moves = candidate_models(current.model)
-    start = dict(current.values)
-    if executor is not None:
-        futures = [executor.submit(_refit, data, m, start, None) for _, _, _, m in moves]
-        outcomes = []
-        for f in futures:
-            try:
-                outcomes.append((f.result(), None))
-            except (FitError, ValueError, ArithmeticError) as exc:
-                outcomes.append((None, str(exc)))
-    else:
-        outcomes = []
-        for _, _, _, m in moves:
-            try:
-                outcomes.append((_refit(data, m, start, cancel), None))
-            except (FitError, ValueError, ArithmeticError) as exc:
-                if cancel is not None and cancel.is_set():
-                    raise
-                outcomes.append((None, str(exc)))
-    candidates = [
-        Candidate(action, effect, replaces, fit, (fit.bic - current.bic) if fit else float("inf"), error)
-        for (action, effect, replaces, _), (fit, error) in zip(moves, outcomes)
-    ]
+    screened = _best_starts(data, current, moves, executor, cancel)
+    ctx = start_context(data.impedance)
+    calls = []
+    for index, (_, effect, _, model) in enumerate(moves):
+        # The new effect starts from its guess; the rest from the current fit.
+        start = screened.get(index) or {**current.values, **effect.guess(ctx)}
+        calls.append((_refit, (data, model, start, None if executor else cancel)))
+    candidates = []
+    for (action, effect, replaces, _), (fit, error) in zip(moves, _run(calls, executor, cancel)):
+        candidates.append(Candidate(action, effect, replaces, fit,
+                                    (fit.bic - current.bic) if fit else float("inf"), error))
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
+
+
+def _outcome(call, cancel: threading.Event | None = None) -> tuple[FitResult | None, str | None]:
+    try:
+        return call(), None
+    except (FitError, ValueError, ArithmeticError) as exc:
+        if cancel is not None and cancel.is_set():
+            raise
+        return None, str(exc)
 
 
 def explain(current: FitResult, candidate: Candidate) -> str:

@@ -196,7 +196,8 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
     return {_our_name(name): p.value for name, p in params.items()}
 
 
-def _minimize(model, params, data, use_x, sigmas, cancel) -> lmfit.minimizer.MinimizerResult:
+def _minimize(model, params, data, use_x, sigmas, cancel,
+              per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
     def residual(prm):
         r = _residual_vector(model, _values(prm), data, use_x, sigmas)
         # A parameter set where the model is undefined is simply very bad:
@@ -212,7 +213,7 @@ def _minimize(model, params, data, use_x, sigmas, cancel) -> lmfit.minimizer.Min
     # would otherwise wander for many thousands.
     n_varying = sum(1 for p in params.values() if p.vary)
     result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12,
-                                max_nfev=EVALUATIONS_PER_PARAMETER * (n_varying + 1))
+                                max_nfev=per_parameter * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
     return result
@@ -228,15 +229,31 @@ def start_values(model: Model, data: FitData) -> dict[str, float]:
     return values
 
 
-def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = None,
-              cancel: threading.Event | None = None) -> FitResult:
-    """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values."""
-    use_x = model.with_displacement
+def _sigmas(data: FitData, use_x: bool) -> dict[str, np.ndarray]:
     if use_x and data.displacement is None:
         raise FitError("the model needs Hx but the data have no displacement channel")
     sigmas = {"impedance": _sigma(data.impedance)}
     if use_x:
         sigmas["displacement"] = _sigma(data.displacement)
+    return sigmas
+
+
+def screen_fit(data: FitData, model: Model, start: Mapping[str, float], vary: set[str],
+               per_parameter: int = 20) -> FitResult:
+    """A short fit of `vary` alone, the rest held at `start`: ranks start points cheaply."""
+    use_x = model.with_displacement
+    sigmas = _sigmas(data, use_x)
+    values = {**start_values(model, data), **{k: v for k, v in start.items()}}
+    values = {spec.name: values[spec.name] for spec in model.param_specs}
+    result = _minimize(model, _params(model, values, set(values) - vary), data, use_x, sigmas, None, per_parameter)
+    return _result(model, result, data, use_x, sigmas, result.nfev)
+
+
+def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = None,
+              cancel: threading.Event | None = None) -> FitResult:
+    """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values."""
+    use_x = model.with_displacement
+    sigmas = _sigmas(data, use_x)
 
     values = start_values(model, data)
     warm = dict(start or {})

@@ -73,6 +73,10 @@ class Effect:
         """Start values from the data; the defaults when nothing better is known."""
         return {spec.name: spec.default for spec in self.params}
 
+    def starts(self, ctx: "StartContext") -> list[dict[str, float]]:
+        """Start values to try in turn when one is not enough (a narrow resonance); the lowest chi^2 wins."""
+        return [self.guess(ctx)]
+
     def describe(self) -> dict:
         """The catalogue entry as plain data (for the CLI, the GUI and reports)."""
         return {
@@ -81,7 +85,7 @@ class Effect:
             "title": self.title,
             "acts_on": self.site.value,
             "parameters": [
-                {"name": p.name, "unit": p.unit, "display_unit": p.display_unit,
+                {"name": p.name, "unit": p.unit, "display_unit": p.display_unit, "display_scale": p.display_scale,
                  "min": p.min, "max": p.max, "default": p.default, "description": p.description}
                 for p in self.params
             ],

@@ -20,8 +20,10 @@ m2/Bl^2 = mu2*CMES with mu2 = m2/Mms, so the response is
 
     Y2(s) = -mu2*CMES * s^3 / (s^2 + s*w2/Q2 + w2^2),      w2 = 2*pi*f2.
 
-Equivalently M2E = mu2*CMES, L2E = 1/(w2^2*M2E) = Bl^2/k2 and
-R2E = Q2/(w2*M2E) = Bl^2/r2 in the network of the docstring above.
+As an electrical analogue: a branch of a capacitance M2E = mu2*CMES (= m2/Bl^2)
+in series with L2E = 1/(w2^2*M2E) (= Bl^2/k2) parallel to R2E = Q2/(w2*M2E)
+(= Bl^2/r2), across the motional branch CMES || LCES || RES, with M2E taken
+out of CMES so that the total low-frequency mass stays CMES.
 
 What the data show: Zm -> infinity at f2 (m2 on k2 resonates and holds the
 coil still: a dip of Z towards Ze and a notch in Hx) and Zm -> 0 at
@@ -40,6 +42,13 @@ CATEGORY = "breakup"
 # (where paper and plastic cones of woofers usually break up first), and
 # never above half the top line.
 DEFAULT_F2_OVER_FS = 10.0
+# A fit converges when it starts within about a factor 1.5 of f2 (a narrow
+# feature: farther away the model's wiggle and the data's do not overlap and
+# the fit removes the mode instead of moving it). A search over the band
+# therefore steps f2 by this ratio, from 2*fs to just below the top line.
+START_GRID_RATIO = 1.4
+START_Q2 = 3.0      # broad enough to overlap a mode some way off, sharpened by the fit
+START_MU2 = 0.1
 
 
 @dataclass(frozen=True)
@@ -57,7 +66,15 @@ class Breakup(Effect):
         return -p["mu2"] * p["CMES"] * s**3 / (s * s + s * w2 / p["Q2"] + w2 * w2)
 
     def guess(self, ctx):
-        return {"f2": min(DEFAULT_F2_OVER_FS * ctx.fs, 0.5 * ctx.f_max), "Q2": 5.0, "mu2": 0.1}
+        return {"f2": min(DEFAULT_F2_OVER_FS * ctx.fs, 0.5 * ctx.f_max), "Q2": START_Q2, "mu2": START_MU2}
+
+    def starts(self, ctx) -> list[dict[str, float]]:
+        """Start values stepping f2 across the band, for a search that keeps the lowest chi^2."""
+        lo, hi = 2.0 * ctx.fs, ctx.f_max / 1.2
+        if hi <= lo:
+            return [self.guess(ctx)]
+        n = int(np.ceil(np.log(hi / lo) / np.log(START_GRID_RATIO))) + 1
+        return [{"f2": float(f2), "Q2": START_Q2, "mu2": START_MU2} for f2 in np.geomspace(lo, hi, n)]
 
 
 breakup = Breakup(
@@ -66,8 +83,8 @@ breakup = Breakup(
     title="Cone breakup (a second mechanical mode)",
     site=Site.MECHANICAL,
     params=(ParamSpec("f2", "Hz", "Hz", 1.0, 10.0, 1e5, 700.0, "resonance of the decoupling mass on its coupling"),
-            ParamSpec("Q2", "1", "-", 1.0, 0.1, 200.0, 5.0, "quality factor of the breakup mode"),
-            ParamSpec("mu2", "1", "%", 100.0, 1e-4, 0.95, 0.1, "decoupling mass as a fraction of Mms")),
+            ParamSpec("Q2", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of the breakup mode"),
+            ParamSpec("mu2", "1", "%", 100.0, 1e-4, 0.95, START_MU2, "decoupling mass as a fraction of Mms")),
     physics=("Above some frequency the cone no longer moves as one piece: its outer part (a mass m2) swings "
              "on the cone's own bending stiffness. At that resonance it holds the coil nearly still, just "
              "above it cone and outer part move against each other, and above both the coil drives a "
@@ -80,8 +97,9 @@ breakup = Breakup(
                "'Mechanical Vibrations' (the two-mass system, the dynamic vibration absorber)"),
     notes=("Identifiable from Z alone when both frequencies are inside the band and the wiggle stands above "
            "the noise; CMES stays the whole low-frequency moving mass, so fs and Mms keep their meaning. "
-           "The start f2 = min(10*fs, f_max/2) is only a default: a fit started far from the mode does not "
-           "find it, so a search should try several starts across the band (or start at the frequency of "
-           "the largest residual wiggle). The laser sees the coil's motion (the cone's centre); a laser spot "
+           "The start f2 = min(10*fs, f_max/2) is only a default: a fit started more than about a factor "
+           "1.5 from the mode does not find it, so a search should try the starts of Breakup.starts(ctx) "
+           "(f2 stepped by 1.4 across the band) and keep the lowest chi^2. From Z alone, modes below about "
+           "7*fs carrying much of the mass (mu2 > 0.2) are hard to reach even then. The laser sees the coil's motion (the cone's centre); a laser spot "
            "on the outer cone would see m2 instead."),
 )

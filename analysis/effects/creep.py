@@ -54,7 +54,10 @@ creep_log = CreepLog(
     typical="lambda 0.05 to 0.4 (paper: 0.376)",
     reference=_LOG_LAW_REFERENCE,
     notes=("Real-valued: the compliance changes with frequency without any loss, which is not causal. "
-           "It is what the reference paper fits; creep-log-causal is the same law with its loss."),
+           "It is what the reference paper fits; creep-log-causal is the same law with its loss. "
+           "The factor reaches zero at fs*10^(1/lambda) (32 kHz for the paper's 0.376, 1.5 kHz for "
+           "lambda 0.76): above that the model has a spurious resonance, so a fit that drives lambda up "
+           "until the zero enters the band is imitating some other high-frequency effect (e.g. breakup)."),
 )
 
 
@@ -86,7 +89,7 @@ creep_log_causal = CreepLogCausal(
     typical="lambda 0.05 to 0.3; the loss factor is 0.68*lambda (e.g. 0.07 for lambda 0.1)",
     reference=_LOG_LAW_REFERENCE,
     notes=("RES then holds only the frequency-independent part of the mechanical losses: at fs the creep "
-           "loss adds a conductance 0.682*lambda/(ws*LCES) to 1/RES, so RES comes out higher than with "
+           "loss adds a conductance of about 0.682*lambda/(ws*LCES) to 1/RES, so RES comes out higher than with "
            "creep-log on the same data."),
 )
 
@@ -100,8 +103,9 @@ class CreepThreeParameter(Effect):
     compliance kappa*CMS yields with the retardation time tau_r = r*kappa*CMS.
     Three parameters for the suspension: CMS (here LCES), kappa, tau_r.
     Above 1/tau_r the factor tends to 1 (LCES is the high-frequency
-    compliance), below it to 1 + kappa (the static compliance); the loss peaks
-    at w = sqrt(1 + kappa)/tau_r.
+    compliance), below it to 1 + kappa (the static compliance); the loss
+    factor of the stiffness, kappa*w*tau_r / (1 + kappa + (w*tau_r)^2),
+    peaks at w = sqrt(1 + kappa)/tau_r.
     """
 
     def response(self, s, p):

@@ -49,6 +49,8 @@ lr2 = LR2(
                "inductance's and the real part of Z rising; phase lower than 90 degrees at the top."),
     typical="L2 0.1 to 2 mH, R2 1 to 20 ohm (paper: L2 0.264 mH, R2 3.52 ohm)",
     reference="W. Klippel, 'Loudspeaker nonlinearities', and the LR-2 model of Klippel LPM; paper Table I",
+    notes=("The reference paper's model. One corner frequency R2/(2*pi*L2): when the fall of the inductance "
+           "is spread over more than a decade, try lr3 (two corners) or the power laws leach and wright."),
 )
 
 
@@ -136,42 +138,50 @@ leach = Leach(
 
 @dataclass(frozen=True)
 class Wright(Effect):
-    """ZL(jw) = Kr*w^Er + j*Ki*w^Ei, added to RE + s*LE.
+    """ZL(jw) = Rw*(w/w_ref)^Er + j*Xw*(w/w_ref)^Ei, added to RE + s*LE; w_ref = 2*pi*1 kHz.
 
-    Separate power laws for the resistance and the reactance. Kr is in
-    ohm*s^Er and Ki in ohm*s^Ei (w in rad/s). Unlike Leach's K*(jw)^n the
-    phase is not fixed, and in general the model is not causal (its real and
-    imaginary parts are not a Hilbert pair unless Er = Ei).
+    Wright's separate power laws for the resistance and the reactance,
+    written at a reference frequency: Rw and Xw are the resistance and
+    reactance the term adds at 1 kHz, in ohm. Wright's own coefficients
+    follow as Kr = Rw / w_ref^Er and Ki = Xw / w_ref^Ei (ohm*s^E). Written
+    with Kr, Ki the fit would have to move a coefficient by decades whenever
+    an exponent moves a little; at 1 kHz the four numbers are nearly
+    independent. Unlike Leach's K*(jw)^n the phase is not fixed, and in
+    general the model is not causal (its real and imaginary parts are not a
+    Hilbert pair unless Er = Ei).
     """
 
     def response(self, s, p):
-        w = np.abs(s)
-        return p["Kr"] * w ** p["Er"] + 1j * p["Ki"] * w ** p["Ei"]
+        w = np.abs(s) / WRIGHT_REFERENCE_RAD_S
+        return p["Rw"] * w ** p["Er"] + 1j * p["Xw"] * w ** p["Ei"]
 
     def guess(self, ctx):
-        Er = Ei = 0.7
-        w = _top_angular_frequency(ctx)
-        half_top_reactance = 0.5 * max(ctx.LE_high, 1e-7) * w
-        return {"Kr": half_top_reactance / w**Er, "Er": Er, "Ki": half_top_reactance / w**Ei, "Ei": Ei}
+        # Half the reactance seen at 1 kHz by the one-number estimate LE_high.
+        half_reactance = 0.5 * max(ctx.LE_high, 1e-7) * WRIGHT_REFERENCE_RAD_S
+        return {"Rw": half_reactance, "Er": 0.7, "Xw": half_reactance, "Ei": 0.7}
 
+
+WRIGHT_REFERENCE_RAD_S = 2.0 * np.pi * 1000.0
 
 wright = Wright(
     id="wright",
     category=CATEGORY,
-    title="Wright empirical model Kr*w^Er + j*Ki*w^Ei",
+    title="Wright empirical model Rw*(w/w_ref)^Er + j*Xw*(w/w_ref)^Ei",
     site=Site.BLOCKED,
-    params=(ParamSpec("Kr", "ohm*s^Er", "ohm*s^Er", 1.0, 0.0, 10.0, 2e-3, "resistance coefficient"),
+    params=(ParamSpec("Rw", "ohm", "ohm", 1.0, 0.0, 1e3, 1.0, "resistance the term adds at 1 kHz"),
             ParamSpec("Er", "1", "-", 1.0, 0.01, 2.0, 0.7, "exponent of the resistance"),
-            ParamSpec("Ki", "ohm*s^Ei", "ohm*s^Ei", 1.0, 0.0, 10.0, 5e-3, "reactance coefficient"),
+            ParamSpec("Xw", "ohm", "ohm", 1.0, 0.0, 1e3, 2.0, "reactance the term adds at 1 kHz"),
             ParamSpec("Ei", "1", "-", 1.0, 0.01, 0.99, 0.7, "exponent of the reactance")),
     physics=("An empirical description of the lossy coil: the resistance and the reactance added by eddy "
              "currents each grow as their own power of frequency. It fits most motors well with four "
              "numbers, but it is a curve fit, not a circuit."),
     signature=("Impedance residual above about 500 Hz where Leach's fixed phase angle does not fit: the real "
                "part of Z and the imaginary part deviate with different slopes on a log-log plot."),
-    typical="Er 0.6 to 0.9, Ei 0.6 to 0.8; Kr 1e-3 to 1e-2, Ki 2e-3 to 2e-2 (e.g. Kr 0.0022, Er 0.75, Ki 0.0048, Ei 0.76)",
+    typical=("Er 0.6 to 0.9, Ei 0.6 to 0.8; Rw 0.3 to 3 ohm, Xw 1 to 10 ohm at 1 kHz "
+             "(Wright's Kr 1e-3 to 1e-2, Ki 2e-3 to 2e-2 ohm*s^E)"),
     reference="J. R. Wright, 'An empirical model for loudspeaker motor impedance', JAES 38(10), 1990",
-    notes=("Here the term is added to RE + s*LE, so Ki*w^Ei is the reactance beyond a constant LE; Ei near 1 "
+    notes=("Wright's coefficients: Kr = Rw / w_ref^Er, Ki = Xw / w_ref^Ei with w_ref = 2*pi*1000 rad/s. "
+           "Here the term is added to RE + s*LE, so the reactance term is what lies beyond a constant LE; Ei near 1 "
            "trades against LE and Er near 0 against RE. Not causal in general: good for describing Z, "
            "not for a time-domain simulation."),
 )

@@ -1,0 +1,291 @@
+"""The effects catalogue: every effect's equation, its limits, and the catalogue's bookkeeping."""
+import itertools
+import json
+import math
+
+import numpy as np
+import pytest
+
+from analysis.effects import CATALOGUE, DEFAULT_EFFECTS, categories, get_effect, parse_effects
+from analysis.effects.base import Site
+from analysis.effects.breakup import breakup
+from analysis.model import Model
+from analysis.startvalues import StartContext
+
+# The paper's driver (physics.md section 7): fs = 70.5 Hz.
+BASE = {"RE": 3.02, "LE": 0.132e-3, "CMES": 433e-6, "LCES": 11.75e-3, "RES": 12.08, "Bl": 5.23}
+FS = 1.0 / (2 * math.pi * math.sqrt(BASE["CMES"] * BASE["LCES"]))
+FREQS = np.array([3.0, 20.0, 70.0, 400.0, 2500.0, 15000.0])
+
+
+def _eddy(L, R, w):
+    """j*w*L in parallel with R, by the textbook rule Z1*Z2/(Z1 + Z2)."""
+    return (1j * w * L) * R / (1j * w * L + R)
+
+
+def _breakup_from_the_network(p, w):
+    """Z2 - s*m2 from the masses, spring and damper themselves, in the model's admittance units."""
+    Mms = p["CMES"] * p["Bl"] ** 2
+    m2 = p["mu2"] * Mms
+    w2 = 2 * math.pi * p["f2"]
+    k2 = w2**2 * m2
+    r2 = w2 * m2 / p["Q2"]
+    s = 1j * w
+    Z2 = 1.0 / (1.0 / (r2 + k2 / s) + 1.0 / (s * m2))
+    return (Z2 - s * m2) / p["Bl"] ** 2
+
+
+# (effect id, parameter values, the documented equation as a function of w), written out independently.
+EQUATIONS = {
+    "lr2": ({"L2": 0.264e-3, "R2": 3.52}, lambda p, w: _eddy(p["L2"], p["R2"], w)),
+    "lr3": ({"L2": 0.264e-3, "R2": 3.52, "L3": 0.5e-3, "R3": 0.8},
+            lambda p, w: _eddy(p["L2"], p["R2"], w) + _eddy(p["L3"], p["R3"], w)),
+    "leach": ({"K": 0.008, "n": 0.65},
+              lambda p, w: p["K"] * w ** p["n"] * (math.cos(p["n"] * math.pi / 2) + 1j * math.sin(p["n"] * math.pi / 2))),
+    "wright": ({"Rw": 0.45, "Er": 0.7, "Xw": 0.6, "Ei": 0.65},
+               lambda p, w: p["Rw"] * (w / (2 * np.pi * 1000)) ** p["Er"] + 1j * p["Xw"] * (w / (2 * np.pi * 1000)) ** p["Ei"]),
+    "creep-log": ({"lambda": 0.376}, lambda p, w: 1 - p["lambda"] * np.log10(w / (2 * math.pi * FS))),
+    "creep-log-causal": ({"lambda": 0.2},
+                         lambda p, w: 1 - p["lambda"] * (np.log10(w / (2 * math.pi * FS)) + 1j * math.pi / 2 / math.log(10))),
+    "creep-3p": ({"kappa": 0.4, "tau_r": 0.01},
+                 lambda p, w: 1 + p["kappa"] * (1 - 1j * w * p["tau_r"]) / (1 + (w * p["tau_r"]) ** 2)),
+    "creep-fractional": ({"beta": 0.1},
+                         lambda p, w: (w / (2 * math.pi * FS)) ** -p["beta"] * np.exp(-1j * p["beta"] * math.pi / 2)),
+    "creep-rs": ({"lambda": 0.3},
+                 lambda p, w: 1 + p["lambda"] * (np.log10(np.abs(1 - 1.5j * 2 * math.pi * FS / w))
+                                                 + 1j * np.angle(1 - 1.5j * 2 * math.pi * FS / w) / math.log(10))),
+    "delay-current": ({"tau_i": 20e-6}, lambda p, w: np.cos(w * p["tau_i"]) + 1j * np.sin(w * p["tau_i"])),
+    "delay-x": ({"tau_x": 250e-6}, lambda p, w: np.cos(w * p["tau_x"]) - 1j * np.sin(w * p["tau_x"])),
+    "lowpass-x": ({"fc_x": 2000.0}, lambda p, w: 1 / (1 + 1j * w / (2 * math.pi * p["fc_x"]))),
+    "lowpass2-x": ({"fc_x": 3000.0, "Q_x": 0.8},
+                   lambda p, w: 1 / (1 - (w / (2 * math.pi * p["fc_x"])) ** 2 + 1j * w / (2 * math.pi * p["fc_x"]) / p["Q_x"])),
+    "breakup": ({"f2": 1000.0, "Q2": 5.0, "mu2": 0.2}, _breakup_from_the_network),
+}
+REQUIRED_CATEGORIES = {"inductance", "creep", "electrical-channel", "displacement-sensor", "breakup"}
+# Categories with a single effect, and why.
+SINGLE_EFFECT_CATEGORIES = {
+    "electrical-channel": "a current-sense gain error is not identifiable (see delay-current's notes)",
+    "breakup": "one mode network; a second mode would be a second category",
+}
+
+
+def _response(effect_id, values, f):
+    return get_effect(effect_id).response(2j * np.pi * np.asarray(f, dtype=float), {**BASE, **values})
+
+
+def test_every_effect_has_an_equation_test():
+    assert set(EQUATIONS) == set(CATALOGUE)
+
+
+@pytest.mark.parametrize("effect_id", sorted(EQUATIONS))
+def test_response_is_the_documented_equation(effect_id):
+    values, equation = EQUATIONS[effect_id]
+    got = _response(effect_id, values, FREQS)
+    want = np.array([equation({**BASE, **values}, 2 * math.pi * f) for f in FREQS])
+    np.testing.assert_allclose(got, want, rtol=1e-10, atol=0)
+
+
+@pytest.mark.parametrize("effect_id", ["lr2", "lr3", "leach", "wright"])
+def test_blocked_impedance_terms_vanish_at_dc(effect_id):
+    values, _ = EQUATIONS[effect_id]
+    assert np.all(np.abs(_response(effect_id, values, [1e-6])) < 1e-4)
+    # ... and above DC they only add: a resistance growing with frequency, and a positive reactance.
+    z = _response(effect_id, values, FREQS)
+    assert np.all(np.diff(z.real) > 0) and np.all(z.imag > 0)
+
+
+def test_lr3_contains_lr2():
+    values = {"L2": 0.264e-3, "R2": 3.52, "L3": 0.0, "R3": 1.0}
+    np.testing.assert_allclose(_response("lr3", values, FREQS), _response("lr2", values, FREQS), rtol=1e-12)
+
+
+def test_leach_has_a_constant_phase_of_n_times_90_degrees():
+    z = _response("leach", {"K": 0.01, "n": 0.6}, FREQS)
+    np.testing.assert_allclose(np.angle(z), 0.6 * np.pi / 2, rtol=1e-12)
+
+
+@pytest.mark.parametrize("effect_id", ["creep-log", "creep-log-causal"])
+def test_log_creep_laws_leave_the_compliance_unchanged_at_fs(effect_id):
+    c = _response(effect_id, {"lambda": 0.3}, [FS])
+    assert c.real == pytest.approx([1.0], abs=1e-12)
+
+
+def test_creep_log_is_real_and_rises_by_lambda_per_decade_below_fs():
+    c = _response("creep-log", {"lambda": 0.3}, [FS / 10, FS, FS * 10])
+    np.testing.assert_allclose(c, [1.3, 1.0, 0.7], rtol=1e-12)
+
+
+@pytest.mark.parametrize("effect_id, values", [
+    ("creep-log-causal", {"lambda": 0.2}), ("creep-3p", {"kappa": 0.4, "tau_r": 0.01}),
+    ("creep-fractional", {"beta": 0.1}), ("creep-rs", {"lambda": 0.3}),
+])
+def test_causal_creep_laws_are_lossy_and_softer_below_fs(effect_id, values):
+    c = _response(effect_id, values, FREQS)
+    assert np.all(c.imag < 0)                   # stiffness 1/c with a positive imaginary part: a loss
+    assert np.all(np.diff(c.real) < 0)          # more compliant towards low frequencies
+
+
+def test_creep_fractional_has_unit_magnitude_at_fs():
+    assert abs(_response("creep-fractional", {"beta": 0.1}, [FS])[0]) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_creep_3p_goes_from_one_plus_kappa_at_dc_to_one_at_high_frequencies():
+    c = _response("creep-3p", {"kappa": 0.4, "tau_r": 0.01}, [1e-6, 1e7])
+    np.testing.assert_allclose(c, [1.4, 1.0], atol=1e-6)
+
+
+def test_creep_rs_tends_to_one_above_fs_and_to_the_log_law_well_below():
+    values = {"lambda": 0.3}
+    assert abs(_response("creep-rs", values, [1e9])[0] - 1) < 1e-6
+    f = np.array([FS / 1e3, FS / 1e4])
+    rs = _response("creep-rs", values, f)
+    causal = _response("creep-log-causal", values, f)
+    # Well below w0 = 1.5*ws: the same slope as the causal log law, offset by lambda*log10(1.5).
+    np.testing.assert_allclose(rs - causal, 0.3 * math.log10(1.5), atol=1e-3)
+
+
+@pytest.mark.parametrize("effect_id, values", [("delay-current", {"tau_i": -30e-6}), ("delay-x", {"tau_x": 300e-6})])
+def test_delays_only_turn_the_phase(effect_id, values):
+    np.testing.assert_allclose(np.abs(_response(effect_id, values, FREQS)), 1.0, rtol=1e-12)
+
+
+def test_delay_signs_positive_tau_means_that_channel_lags():
+    f = 1000.0
+    # Current lags -> the measured current's phase is late -> U/I_measured leads: phase + w*tau.
+    assert np.angle(_response("delay-current", {"tau_i": 10e-6}, [f])[0]) == pytest.approx(2 * math.pi * f * 10e-6)
+    # Displacement lags -> X_measured/U is late: phase - w*tau.
+    assert np.angle(_response("delay-x", {"tau_x": 10e-6}, [f])[0]) == pytest.approx(-2 * math.pi * f * 10e-6)
+
+
+def test_first_order_lowpass_is_one_at_dc_and_minus_3_db_at_fc():
+    h = _response("lowpass-x", {"fc_x": 2000.0}, [1e-6, 2000.0])
+    assert h[0] == pytest.approx(1.0, abs=1e-9)
+    assert 20 * np.log10(abs(h[1])) == pytest.approx(-3.0103, abs=1e-4)
+    assert np.angle(h[1]) == pytest.approx(-math.pi / 4)
+
+
+def test_second_order_lowpass_is_one_at_dc_and_q_at_fc():
+    h = _response("lowpass2-x", {"fc_x": 3000.0, "Q_x": 0.8}, [1e-6, 3000.0])
+    assert h[0] == pytest.approx(1.0, abs=1e-9)
+    assert abs(h[1]) == pytest.approx(0.8)
+    assert np.angle(h[1]) == pytest.approx(-math.pi / 2)
+
+
+def test_breakup_is_negligible_far_below_f2_and_takes_mu2_of_the_mass_far_above():
+    values = {**BASE, "f2": 1000.0, "Q2": 5.0, "mu2": 0.2}
+    s = 2j * np.pi * np.array([10.0, 1e6])
+    y2 = breakup.response(s, values)
+    mass_term = s * values["CMES"]
+    assert abs(y2[0] / mass_term[0]) < 1e-3                          # ~ mu2 * (f/f2)^2
+    assert abs(y2[1] / mass_term[1] - (-0.2)) < 1e-4                # the cone is lighter by m2
+
+
+def test_breakup_blocks_the_cone_at_f2_and_resonates_at_f2_over_sqrt_1_minus_mu2():
+    values = {**BASE, "f2": 1000.0, "Q2": 1e6, "mu2": 0.2}
+    mass_and_mode = lambda f: 2j * np.pi * f * values["CMES"] + breakup.response(np.array([2j * np.pi * f]), values)[0]
+    reference = abs(2j * np.pi * 1000.0 * values["CMES"])
+    assert abs(mass_and_mode(1000.0 * (1 + 1e-7))) > 1e5 * reference      # Zm -> infinity: the coil stands still
+    assert abs(mass_and_mode(1000.0 / math.sqrt(0.8))) < 1e-5 * reference  # Zm -> 0: cone and m2 in anti-phase
+
+
+def test_breakup_start_grid_covers_the_band_in_steps_of_1_4():
+    ctx = StartContext(RE=3.0, fs=70.0, RES=12.0, Qms=3.0, LE_high=2e-4, f_min=5.0, f_max=10000.0)
+    f2 = np.array([s["f2"] for s in breakup.starts(ctx)])
+    assert f2[0] == pytest.approx(140.0) and f2[-1] < 10000.0
+    assert np.all(f2[1:] / f2[:-1] <= 1.4 + 1e-12)
+
+
+def _legal_models():
+    groups = list(categories().values())
+    for choice in itertools.product(*[[None, *group] for group in groups]):
+        yield tuple(e for e in choice if e is not None)
+
+
+def test_parameter_names_are_unique_in_every_legal_model():
+    n = 0
+    for effects in _legal_models():
+        for with_displacement in (True, False):
+            model = Model(effects, with_displacement)      # raises ModelError on a name collision
+            names = [p.name for p in model.param_specs]
+            assert len(names) == len(set(names))
+            n += 1
+    assert n > 100
+
+
+def test_categories_are_separate_namespaces():
+    by_category = {c: {n for e in group for n in e.param_names} for c, group in categories().items()}
+    for a, b in itertools.combinations(by_category, 2):
+        assert not by_category[a] & by_category[b], (a, b)
+
+
+def test_every_required_category_exists_with_alternatives():
+    groups = categories()
+    assert REQUIRED_CATEGORIES <= set(groups)
+    for category in REQUIRED_CATEGORIES - set(SINGLE_EFFECT_CATEGORIES):
+        assert len(groups[category]) >= 2, category
+    for category in SINGLE_EFFECT_CATEGORIES:
+        assert len(groups[category]) >= 1, category
+
+
+def test_the_current_gain_error_is_documented_as_not_identifiable():
+    notes = get_effect("delay-current").notes
+    assert "gain" in notes and "NOT identifiable" in notes
+    assert not any("gain" in e.id for e in CATALOGUE.values())
+
+
+def test_each_category_acts_at_one_site():
+    sites = {c: {e.site for e in group} for c, group in categories().items()}
+    assert all(len(s) == 1 for s in sites.values()), sites
+    assert sites["electrical-channel"] == {Site.CURRENT}
+    assert sites["displacement-sensor"] == {Site.DISPLACEMENT}
+    assert sites["breakup"] == {Site.MECHANICAL}
+
+
+@pytest.mark.parametrize("effect_id", sorted(CATALOGUE))
+def test_every_field_is_filled_in(effect_id):
+    effect = get_effect(effect_id)
+    for field in ("id", "category", "title", "physics", "signature", "typical", "reference", "notes"):
+        assert getattr(effect, field).strip(), field
+    assert effect.params
+    for spec in effect.params:
+        assert spec.name and spec.unit and spec.display_unit and spec.description
+        assert spec.display_scale > 0
+        assert spec.min <= spec.default <= spec.max and spec.min < spec.max
+    assert effect.__doc__ and "=" in type(effect).__doc__       # the equation is in the docstring
+
+
+@pytest.mark.parametrize("effect_id", sorted(CATALOGUE))
+def test_describe_is_json(effect_id):
+    text = json.dumps(get_effect(effect_id).describe(), allow_nan=False)
+    assert json.loads(text)["id"] == effect_id
+
+
+@pytest.mark.parametrize("ctx", [
+    StartContext(RE=3.02, fs=70.5, RES=12.08, Qms=3.3, LE_high=2.5e-4, f_min=5.0, f_max=10000.0),
+    StartContext(RE=5.2, fs=18.0, RES=40.0, Qms=6.0, LE_high=2e-3, f_min=3.0, f_max=2000.0),
+    StartContext(RE=3.6, fs=180.0, RES=8.0, Qms=2.0, LE_high=4e-5, f_min=20.0, f_max=20000.0),
+], ids=["paper", "woofer-18in", "fullrange-2in"])
+@pytest.mark.parametrize("effect_id", sorted(CATALOGUE))
+def test_start_values_are_inside_the_bounds_and_the_response_is_finite_there(effect_id, ctx):
+    effect = get_effect(effect_id)
+    start = effect.guess(ctx)
+    assert set(start) == set(effect.param_names)
+    for spec in effect.params:
+        assert spec.min <= start[spec.name] <= spec.max, spec.name
+    f = np.geomspace(ctx.f_min, ctx.f_max, 50)
+    assert np.all(np.isfinite(effect.response(2j * np.pi * f, {**BASE, **start})))
+
+
+def test_parse_effects_round_trips_every_legal_model():
+    for effects in _legal_models():
+        ids = [e.id for e in effects]
+        assert parse_effects(",".join(ids) or "none") == effects
+        assert Model(effects).describe() == (",".join(ids) or "textbook")
+
+
+def test_parse_effects_defaults_and_errors():
+    assert tuple(e.id for e in parse_effects(None)) == DEFAULT_EFFECTS
+    assert parse_effects("textbook") == ()
+    assert parse_effects(" lr3 , creep-rs ") == (get_effect("lr3"), get_effect("creep-rs"))
+    with pytest.raises(KeyError, match="known effects"):
+        parse_effects("lr2,no-such-effect")
