@@ -1,6 +1,9 @@
 """Synthetic recordings for tests: known drivers, a multitone, chosen noise."""
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 
 from analysis.drivers import load_driver
@@ -43,3 +46,8 @@ def recording(values=None, effects="lr2,creep-log", *, n_periods=8, settle=1, no
 
 # Noise that gives a realistic measurement: ~60-70 dB SNR on the lines.
 TYPICAL_NOISE = ChannelNoise(voltage=1e-4, current=1e-4, displacement=1e-8)
+
+
+# The real measurements of ../shared/data/real (beside the repository, in CI too).
+REPO_ROOT = Path(__file__).resolve().parent.parent
+REAL_DATA = Path(os.environ.get("LINPAR_SHARED", REPO_ROOT.parent / "shared")) / "data" / "real"

@@ -10,8 +10,9 @@ from analysis.model import Model
 from analysis.recording import write_recording
 from app.cli import main
 from tests.builders import PAPER, TYPICAL_NOISE, recording
+from tests.builders import REAL_DATA
 
-REAL = Path("/work/shared/data/real")
+REAL = REAL_DATA
 SEAS = REAL / "seas_l16rnx"
 FREQS = np.logspace(np.log10(5.0), np.log10(20e3), 300)
 

@@ -13,8 +13,9 @@ from analysis.added_mass import (MassCurve, compare_with_laser, joint_added_mass
                                  single_added_mass)
 from analysis.curve_fit import FitRange, fit_curves
 from analysis.importers import read_curve, read_uiv
+from tests.builders import REAL_DATA
 
-REAL = Path("/work/shared/data/real")
+REAL = REAL_DATA
 SEAS = REAL / "seas_l16rnx"
 DAYTON = REAL / "dayton_ls10-44"
 WOOFER = REAL / "woofer_uiv_laser" / "meas_data_UIV_spectra_1Hz-10kHz.csv"
