@@ -42,6 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
     analyze.add_argument("--model", metavar="EFFECTS",
                          help="effect ids separated by commas (default lr2,creep-log; 'none' for the textbook model)")
     analyze.add_argument("--json", action="store_true", help="print one JSON object")
+    analyze.add_argument("--limits", metavar="FILE",
+                         help="QA limits (JSON): print pass/fail; exit 0 pass, 1 fail, 2 error")
     cli_import.add_analyze_options(analyze)
 
     diagnose = sub.add_parser("diagnose", help="find which physical effect the model lacks")
@@ -57,6 +59,10 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_rig
     cli_rig.add_commands(sub)
 
+    from app import cli_archive, cli_report
+    cli_archive.add_commands(sub)
+    cli_report.add_commands(sub)
+
     effects = sub.add_parser("effects", help="list the effects catalogue")
     effects.add_argument("--json", action="store_true")
 
@@ -65,9 +71,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _archive_parser() -> argparse.ArgumentParser:
+    """`linpar archive` alone: listing must not wait for the other commands' imports (the rig loads scipy)."""
+    from app import cli_archive
+    parser = _Parser(prog="linpar")
+    cli_archive.add_commands(parser.add_subparsers(dest="command", required=True, parser_class=_Parser))
+    return parser
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = build_parser().parse_args(argv)
+        args = (_archive_parser() if argv[:1] == ["archive"] else build_parser()).parse_args(argv)
         return _run(args)
     except CliError as exc:
         print(f"linpar: error: {exc}", file=sys.stderr)
@@ -83,6 +98,12 @@ def _run(args: argparse.Namespace) -> int:
         try:
             return cli_rig.run(args)
         except cli_rig.USER_ERRORS as exc:
+            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+    if args.command in ("archive", "report", "export"):
+        from app import cli_archive, cli_report
+        try:
+            return cli_archive.run(args) if args.command == "archive" else cli_report.run(args)
+        except cli_report.user_errors() as exc:
             raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
     if args.command == "gui":
         from app.main import run_gui

@@ -9,6 +9,7 @@ from analysis.derived import ParameterValue
 from analysis.drivers import DriverFileError
 from analysis.effects import CATALOGUE, categories, parse_effects
 from analysis.fit import FitError
+from analysis.limits import LimitsError
 from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult, analyze_path, result_json
 from analysis.recording import RecordingError
@@ -16,12 +17,15 @@ from analysis.spectra import SpectrumError
 from analysis.startvalues import StartValueError
 
 USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelError, DriverFileError,
-               KeyError, OSError)
+               LimitsError, KeyError, OSError)
+EXIT_QA_FAIL = 1
 
 
 def dispatch(args: argparse.Namespace) -> int:
     from app import cli_import
     if args.command in ("addedmass", "stats") or (args.command == "analyze" and cli_import.wants_curves(args)):
+        if getattr(args, "limits", None):
+            raise LimitsError("--limits applies to recordings, not to imported curves")
         return cli_import.dispatch(args)
     if args.command == "analyze":
         return cmd_analyze(args)
@@ -41,12 +45,24 @@ def _effects(text: str | None):
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
+    from analysis import limits as qa
+    path = getattr(args, "limits", None)
+    limits = qa.load_limits(path) if path else None    # a bad limits file fails before the analysis
     result = analyze_path(args.path, args.sd, _effects(args.model))
+    overall = result.validity.get("overall", "unknown")
+    doc = result_json(result)
+    if limits is not None:
+        doc["limits"] = qa.judge_result(limits, result.parameters, overall)
     if args.json:
-        print(json.dumps(result_json(result), allow_nan=False, default=_json_number))
+        print(json.dumps(doc, allow_nan=False, default=_json_number))
     else:
         print(format_result(result))
-    return 0
+        if limits is not None:
+            print("\n" + qa.format_verdicts(limits, result.parameters, overall))
+    if limits is None:
+        return 0
+    # 0 pass, 1 fail, 2 (an error: the measurement must be repeated) when it is invalid.
+    return {"pass": 0, "fail": EXIT_QA_FAIL}.get(doc["limits"]["verdict"], 2)
 
 
 def _json_number(value):
