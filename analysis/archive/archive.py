@@ -1,0 +1,300 @@
+"""The measurement archive: one folder per measurement and an SQLite index over them.
+
+    root/
+      index.sqlite                         the index (a cache: rebuilt from the folders when needed)
+      measurements/
+        20240501-120301-3fa2c1-paper-sn42/ one folder per measurement, named by generated id (+ a slug)
+          measurement.json                 everything the index holds (analysis.archive.record)
+          recording.wav, recording.json    the recording, byte for byte as it was read
+          results.json                     the analysis (analysis.archive.results)
+          settings.json, calibration.json  what the caller gave (and the recording's "capture" data)
+          laser.<ext>                      the raw laser stream, when there is one
+
+A folder is written complete under a hidden temporary name and renamed into
+place, so the archive never holds half a measurement; only then is it added
+to the index. Nothing in a folder is code: JSON, WAV and the raw laser bytes.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any, Mapping
+
+from analysis.archive.atomic import DIR_MODE, FILE_MODE, fsync_dir, write_atomic
+from analysis.archive.index import Filter, Index, RebuildReport, insert
+from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, clean_text, folder_name, inside,
+                                    new_measurement_id, safe_suffix)
+from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
+from analysis.archive.schema import KEY_PARAMETERS
+
+MeasurementId = str
+FOLDERS = "measurements"
+RESULTS_FILE = "results.json"
+
+
+def default_root() -> Path:
+    env = os.environ.get("LINPAR_ARCHIVE")
+    return Path(env).expanduser() if env else Path.home() / ".local" / "share" / "linpar" / "archive"
+
+
+@dataclass(frozen=True)
+class MeasurementMeta:
+    """Who measured what, where and when; settings and calibration as the measuring program had them."""
+
+    driver: str = ""                 # default: the recording's driver name
+    serial: str = ""
+    operator: str = ""
+    station: str = ""
+    measured_at: str | None = None   # ISO 8601; default: the time of storing
+    notes: str = ""
+    settings: Mapping[str, Any] = field(default_factory=dict)
+    calibration: Mapping[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def coerce(cls, meta) -> "MeasurementMeta":
+        if meta is None:
+            return cls()
+        if isinstance(meta, cls):
+            return meta
+        if isinstance(meta, Mapping):
+            unknown = set(meta) - set(cls.__dataclass_fields__)
+            if unknown:
+                raise ArchiveError(f"meta: unknown key(s) {sorted(unknown)}; expected {sorted(cls.__dataclass_fields__)}")
+            return cls(**meta)
+        raise ArchiveError(f"meta: expected a MeasurementMeta or a mapping, found {type(meta).__name__}")
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """One stored measurement: its record and where its files are."""
+
+    entry: Entry
+    folder: Path
+    record: dict
+
+    @property
+    def id(self) -> MeasurementId:
+        return self.entry.id
+
+    def path(self, role: str) -> Path | None:
+        """The file of a role ('recording', 'sidecar', 'results', 'settings', 'calibration', 'laser_stream')."""
+        name = self.record.get("files", {}).get(role)
+        return inside(self.folder, name) if isinstance(name, str) else None
+
+    def load_json(self, role: str) -> dict:
+        path = self.path(role)
+        if path is None:
+            return {}
+        try:
+            return json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise ArchiveError(f"{path}: not readable JSON ({exc})") from None
+
+    def result(self):
+        """The analysis as stored (analysis.archive.results.StoredResult)."""
+        from analysis.archive.results import ResultsFormatError, StoredResult
+        try:
+            return StoredResult.from_json(self.load_json("results"))
+        except ResultsFormatError as exc:
+            raise ArchiveError(f"{self.path('results')}: {exc}") from None
+
+    def recording_path(self) -> Path | None:
+        return self.path("recording")
+
+
+def _json_bytes(doc: Any) -> bytes:
+    return (json.dumps(doc, indent=1, ensure_ascii=False, allow_nan=False, default=_jsonable) + "\n").encode()
+
+
+def _jsonable(value):
+    if isinstance(value, Mapping):
+        return dict(value)
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"{type(value).__name__} cannot be stored as JSON")
+
+
+def _iso(text: str | None, field_name: str) -> str | None:
+    if text is None:
+        return None
+    try:
+        when = datetime.fromisoformat(str(text))
+    except ValueError:
+        raise ArchiveError(f"meta.{field_name}: {text!r} is not an ISO 8601 date or time") from None
+    if when.tzinfo is None:
+        when = when.replace(tzinfo=timezone.utc)
+    return when.astimezone(timezone.utc).isoformat(timespec="seconds").replace("+00:00", "Z")
+
+
+def _share(folder: Path) -> None:
+    """mkdtemp and mkstemp make private files; an archive is shared by the people at the station."""
+    os.chmod(folder, DIR_MODE)
+    for item in folder.iterdir():
+        os.chmod(item, FILE_MODE)
+
+
+class Archive:
+    def __init__(self, root: str | Path | None = None):
+        self.root = Path(root) if root is not None else default_root()
+        self.folders = self.root / FOLDERS
+        self._index = Index(self.root, self.folders)
+
+    @property
+    def notes(self) -> list[str]:
+        """What opening the index had to repair (a rebuild, folders added), for the user to see."""
+        return self._index.notes
+
+    def _connect(self):
+        self.folders.mkdir(parents=True, exist_ok=True)
+        return self._index.connect()
+
+    # --- storing --------------------------------------------------------------------
+
+    def store(self, recording, result, meta=None, laser_stream: str | Path | None = None,
+              now: datetime | None = None) -> MeasurementId:
+        """Store a measurement; return its id.
+
+        recording: a path (NAME, NAME.wav or NAME.json; copied byte for byte)
+        or an analysis.recording.Recording (written as float32). result: an
+        analysis.pipeline.AnalysisResult or its results document (a dict, as
+        analysis.archive.results.results_document makes). meta: MeasurementMeta or a dict.
+        """
+        from analysis.archive.results import results_document
+        from analysis.recording import Recording, read_recording, recording_paths, write_recording
+        meta = MeasurementMeta.coerce(meta)
+        rec_obj = recording if isinstance(recording, Recording) else read_recording(recording)
+        doc = result if isinstance(result, Mapping) else results_document(result, rec_obj)
+        for key in ("parameters", "model", "validity"):
+            if not isinstance(doc.get(key), Mapping):
+                raise ArchiveError(f"result: {key}: expected an object (a results document)")
+
+        stored_at = (now or datetime.now(timezone.utc)).astimezone(timezone.utc)
+        mid = new_measurement_id(stored_at)
+        text = {k: clean_text(getattr(meta, k), k) for k in TEXT_FIELDS}
+        if not text["driver"]:
+            text["driver"] = clean_text(str((rec_obj.driver or {}).get("name", "")), "driver")
+        name = folder_name(mid, text["driver"], text["serial"])
+        self.folders.mkdir(parents=True, exist_ok=True)
+        final = inside(self.folders, name)
+        if final.exists():
+            raise ArchiveError(f"{final}: already exists")
+
+        settings = {**dict(doc.get("settings") or {}), **dict(meta.settings)}
+        calibration = dict(meta.calibration)
+        extra = dict(rec_obj.extra or {})
+        for key in ("calibration", "capture", "audio_capture"):
+            if key in extra and key not in calibration:
+                calibration[key] = extra[key]
+        files = {"recording": "recording.wav", "sidecar": "recording.json", "results": RESULTS_FILE,
+                 "settings": "settings.json", "calibration": "calibration.json"}
+        if laser_stream is not None:
+            files["laser_stream"] = "laser" + safe_suffix(str(laser_stream))
+        params = doc["parameters"]
+        record = {
+            "format": RECORD_FORMAT, "id": mid, "folder": name,
+            "measured_at": _iso(meta.measured_at, "measured_at") or stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
+            "stored_at": stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
+            **text, "notes": clean_text(meta.notes, "notes", 2000),
+            "validity": str(doc["validity"].get("overall", "unknown")),
+            "effects": list(doc["model"].get("effects", [])), "sd_m2": doc.get("sd_m2"),
+            "key_parameters": {k: {"value": params[k].get("value"), "std": params[k].get("std"),
+                                   "unit": params[k].get("unit", "")} for k in KEY_PARAMETERS if k in params},
+            "files": files,
+        }
+        conn = self._connect()
+        tmp = Path(tempfile.mkdtemp(dir=self.folders, prefix=".incoming-"))
+        try:
+            if isinstance(recording, Recording):
+                write_recording(tmp / "recording", recording)
+            else:
+                for src, dst in zip(recording_paths(recording), ("recording.wav", "recording.json")):
+                    shutil.copyfile(src, tmp / dst)
+            if laser_stream is not None:
+                shutil.copyfile(laser_stream, tmp / files["laser_stream"])
+            write_atomic(tmp / RESULTS_FILE, _json_bytes(doc))
+            write_atomic(tmp / "settings.json", _json_bytes(settings))
+            write_atomic(tmp / "calibration.json", _json_bytes(calibration))
+            write_atomic(tmp / RECORD_FILE, _json_bytes(record))     # last: a folder with it is complete
+            _share(tmp)
+            os.rename(tmp, final)
+            fsync_dir(self.folders)
+        except BaseException:
+            conn.close()
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        try:
+            with conn:   # a crash before this line is repaired by the next open (folders vs index)
+                insert(conn, record)
+        finally:
+            conn.close()
+        return mid
+
+    # --- reading ----------------------------------------------------------------------
+
+    def list(self, flt: Filter | None = None, **kwargs) -> list[Entry]:
+        """Measurements, newest first. Filter fields may also be given as keywords (driver='xyz', limit=10)."""
+        flt = flt or Filter(**kwargs)
+        if not self.root.is_dir():
+            return []        # reading never creates an archive
+        conn = self._connect()
+        try:
+            return self._index.query(conn, flt)
+        finally:
+            conn.close()
+
+    def resolve(self, id_or_prefix: str) -> tuple[MeasurementId, str]:
+        """(id, folder) of the one measurement whose id is, or starts with, the text."""
+        check_id_prefix(id_or_prefix)
+        if not self.root.is_dir():
+            raise ArchiveError(f"no archive at {self.root} (store a measurement first, or give --root)")
+        conn = self._connect()
+        try:
+            found = self._index.matching_ids(conn, id_or_prefix)
+        finally:
+            conn.close()
+        if not found:
+            raise ArchiveError(f"no measurement {id_or_prefix!r} in the archive {self.root}")
+        if len(found) > 1:
+            shown = ", ".join(f[0] for f in found[:5]) + (" ..." if len(found) > 5 else "")
+            raise ArchiveError(f"{id_or_prefix!r} matches {len(found)} measurements ({shown}): give more of the id")
+        return found[0]
+
+    def get(self, id_or_prefix: str) -> Measurement:
+        mid, folder = self.resolve(id_or_prefix)
+        path = inside(self.folders, folder)
+        record = read_record(path)
+        if record["id"] != check_id(mid):
+            raise ArchiveError(f"{path / RECORD_FILE}: id {record['id']!r}, but the index says {mid!r}: "
+                               "run 'linpar archive rebuild'")
+        return Measurement(entry_of(record), path, record)
+
+    def rebuild(self) -> RebuildReport:
+        self.folders.mkdir(parents=True, exist_ok=True)
+        return self._index.rebuild()
+
+    def export(self, id_or_prefix: str, directory: str | Path) -> Path:
+        """Copy a measurement's folder into `directory` (made if missing); return the copy's path."""
+        m = self.get(id_or_prefix)
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        target = directory / m.folder.name
+        if target.exists():
+            raise ArchiveError(f"{target}: already exists; choose another directory")
+        tmp = Path(tempfile.mkdtemp(dir=directory, prefix=f".{m.folder.name}."))
+        try:
+            for item in m.folder.iterdir():
+                if item.is_file() and not item.is_symlink():
+                    shutil.copy2(item, tmp / item.name)
+            _share(tmp)
+            os.rename(tmp, target)
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+        return target

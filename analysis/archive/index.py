@@ -1,0 +1,265 @@
+"""The SQLite index of the archive's folders: checked on every open, rebuilt when it cannot be trusted.
+
+On open the index is checked, cheapest first: the file exists, starts with
+SQLite's magic bytes, passes `PRAGMA quick_check`, has a schema_version this
+program knows (older ones are migrated) and the expected columns. A file
+that fails any check is renamed aside (index.sqlite.broken-<time>, kept for
+a look) and the index is rebuilt from the folders. Then the set of folders
+is compared with the set of indexed ones, so that a folder stored by a
+program that crashed before it reached the index, or one removed by hand,
+is picked up: the folders are the truth, the index only a cache.
+
+A rebuild writes a new database next to the old one and renames it into
+place: readers see the old index or the new one.
+"""
+from __future__ import annotations
+
+import os
+import sqlite3
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+from analysis.archive.atomic import fsync_dir
+from analysis.archive.names import ArchiveError
+from analysis.archive.record import Entry, entry_of, read_record
+from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate
+
+SQLITE_MAGIC = b"SQLite format 3\x00"
+INDEX_FILE = "index.sqlite"
+MISSING = "the database file is missing"
+
+
+@dataclass(frozen=True)
+class Filter:
+    """What `list` selects: substrings (case-insensitive) of the text fields, validity, a date range."""
+
+    driver: str | None = None
+    serial: str | None = None
+    operator: str | None = None
+    station: str | None = None
+    validity: str | None = None
+    since: str | None = None       # ISO date or date-time, inclusive
+    until: str | None = None       # ISO date or date-time, inclusive (a bare date means the whole day)
+    limit: int | None = None
+
+
+@dataclass
+class RebuildReport:
+    indexed: int = 0
+    skipped: list[str] = field(default_factory=list)     # folders whose measurement.json could not be read
+    reason: str = ""
+
+    def describe(self) -> str:
+        text = f"index rebuilt ({self.reason}): {self.indexed} measurement(s)"
+        if self.skipped:
+            text += f"; {len(self.skipped)} folder(s) skipped: " + "; ".join(self.skipped)
+        return text
+
+
+def _like(text: str) -> str:
+    return "%" + text.replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_") + "%"
+
+
+class Index:
+    def __init__(self, root: Path, folders: Path):
+        self.path = root / INDEX_FILE
+        self.folders = folders
+        self.notes: list[str] = []      # what opening had to repair, for the user
+
+    # --- opening and checking ---------------------------------------------
+
+    def connect(self) -> sqlite3.Connection:
+        problem = self._problem()
+        if problem:
+            report = self.rebuild(problem)
+            if report.indexed or report.skipped or self.path.name != INDEX_FILE or problem != MISSING:
+                self.notes.append(report.describe())     # a new, empty archive is no news
+        conn = self._open()
+        try:
+            migrate(conn)
+            check_columns(conn)
+        except (sqlite3.DatabaseError, SchemaError) as exc:
+            # Changed under our feet between the check and now: rebuild once more.
+            conn.close()
+            self.notes.append(self.rebuild(f"unusable: {exc}").describe())
+            conn = self._open()
+        self._sync(conn)
+        return conn
+
+    def _open(self, path: Path | None = None) -> sqlite3.Connection:
+        conn = sqlite3.connect(path or self.path, timeout=10.0)
+        conn.execute("PRAGMA foreign_keys = ON")
+        return conn
+
+    def _problem(self) -> str | None:
+        """Why the database file cannot be used as it is, or None."""
+        if not self.path.exists():
+            return MISSING
+        try:
+            with open(self.path, "rb") as f:
+                head = f.read(len(SQLITE_MAGIC))
+        except OSError as exc:
+            return f"the database file cannot be read ({exc.strerror or exc})"
+        if len(head) == 0:
+            return "the database file is empty"
+        if head != SQLITE_MAGIC:
+            return "the database file is not an SQLite database"
+        try:
+            conn = self._open()
+            try:
+                status = conn.execute("PRAGMA quick_check").fetchone()[0]
+                if status != "ok":
+                    return f"the database is damaged ({status})"
+                migrate(conn)
+                check_columns(conn)
+            finally:
+                conn.close()
+        except sqlite3.DatabaseError as exc:
+            return f"the database is damaged ({exc})"
+        except SchemaError as exc:
+            return f"wrong schema ({exc})"
+        return None
+
+    def _folder_names(self) -> set[str]:
+        if not self.folders.is_dir():
+            return set()
+        with os.scandir(self.folders) as it:
+            return {e.name for e in it if e.is_dir(follow_symlinks=False) and not e.name.startswith(".")}
+
+    def _sync(self, conn: sqlite3.Connection) -> None:
+        on_disk = self._folder_names()
+        indexed = {row[0] for row in conn.execute("SELECT folder FROM measurements")}
+        if on_disk == indexed:
+            return
+        added = skipped = 0
+        with conn:
+            for name in sorted(indexed - on_disk):
+                conn.execute("DELETE FROM measurements WHERE folder = ?", (name,))
+            for name in sorted(on_disk - indexed):
+                try:
+                    insert(conn, read_record(self.folders / name))
+                    added += 1
+                except (ArchiveError, sqlite3.IntegrityError):
+                    skipped += 1
+        if indexed - on_disk or added:
+            self.notes.append(f"index brought up to date with the folders: {added} added, "
+                              f"{len(indexed - on_disk)} removed" + (f", {skipped} unreadable" if skipped else ""))
+
+    # --- rebuilding -----------------------------------------------------------
+
+    def rebuild(self, reason: str = "asked for") -> RebuildReport:
+        report = RebuildReport(reason=reason)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = self.path.with_name(f".{INDEX_FILE}.{os.getpid()}.{time.monotonic_ns()}.tmp")
+        conn = self._open(tmp)
+        try:
+            migrate(conn)
+            with conn:
+                for name in sorted(self._folder_names()):
+                    try:
+                        insert(conn, read_record(self.folders / name))
+                        report.indexed += 1
+                    except ArchiveError as exc:
+                        report.skipped.append(str(exc))
+                    except sqlite3.IntegrityError as exc:
+                        report.skipped.append(f"{name}: {exc}")
+            conn.close()
+            self._set_aside()
+            os.replace(tmp, self.path)
+            fsync_dir(self.path.parent)
+        except BaseException:
+            conn.close()
+            tmp.unlink(missing_ok=True)
+            raise
+        return report
+
+    def _set_aside(self) -> None:
+        """Keep a damaged database for a look, and never let its journal touch the new one."""
+        if not self.path.exists():
+            return
+        if self._problem_is_damage():
+            stamp = time.strftime("%Y%m%d-%H%M%S")
+            os.replace(self.path, self.path.with_name(f"{INDEX_FILE}.broken-{stamp}"))
+        for suffix in ("-journal", "-wal", "-shm"):
+            Path(str(self.path) + suffix).unlink(missing_ok=True)
+
+    def _problem_is_damage(self) -> bool:
+        # A sound database that is merely being rebuilt on request is simply replaced.
+        return self._problem() is not None
+
+    # --- reading ----------------------------------------------------------------
+
+    def query(self, conn: sqlite3.Connection, flt: Filter = Filter()) -> list[Entry]:
+        where, args = [], []
+        for column in ("driver", "serial", "operator", "station"):
+            text = getattr(flt, column)
+            if text:
+                where.append(f"{column} LIKE ? ESCAPE '\\'")
+                args.append(_like(text))
+        if flt.validity:
+            where.append("validity = ?")
+            args.append(flt.validity)
+        if flt.since:
+            where.append("measured_at >= ?")
+            args.append(flt.since)
+        if flt.until:
+            where.append("measured_at <= ?")
+            args.append(flt.until + ("T99" if len(flt.until) == 10 else ""))   # a bare date: the whole day
+        sql = "SELECT id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects " \
+              "FROM measurements" + (" WHERE " + " AND ".join(where) if where else "") + \
+              " ORDER BY measured_at DESC, id DESC"
+        if flt.limit is not None:
+            sql += " LIMIT ?"
+            args.append(int(flt.limit))
+        rows = conn.execute(sql, args).fetchall()
+        entries = {r[0]: Entry(*r[:9], tuple(e for e in r[9].split(",") if e), {}) for r in rows}
+        for mid, name, value, std, unit in self._parameters(conn, list(entries)):
+            entries[mid].parameters[name] = {"value": value, "std": std, "unit": unit}
+        return list(entries.values())
+
+    def _parameters(self, conn, ids: list[str]) -> Iterable[tuple]:
+        if not ids:
+            return []
+        if len(ids) > 500:     # SQLite's bound-variable limit: take them all, keep ours
+            wanted = set(ids)
+            return [r for r in conn.execute("SELECT measurement_id, name, value, std, unit FROM parameters")
+                    if r[0] in wanted]
+        marks = ",".join("?" * len(ids))
+        return conn.execute(f"SELECT measurement_id, name, value, std, unit FROM parameters "
+                            f"WHERE measurement_id IN ({marks})", ids).fetchall()
+
+    def matching_ids(self, conn: sqlite3.Connection, prefix: str) -> list[tuple[str, str]]:
+        """(id, folder) of every measurement whose id starts with `prefix`."""
+        return conn.execute("SELECT id, folder FROM measurements WHERE substr(id, 1, ?) = ? ORDER BY id",
+                            (len(prefix), prefix)).fetchall()
+
+
+def insert(conn: sqlite3.Connection, record: dict) -> None:
+    """Add one record, all of it or nothing (a savepoint), replacing any orphaned parameter rows."""
+    conn.execute("SAVEPOINT record")
+    try:
+        _insert(conn, record)
+    except BaseException:
+        conn.execute("ROLLBACK TO record")
+        conn.execute("RELEASE record")
+        raise
+    conn.execute("RELEASE record")
+
+
+def _insert(conn: sqlite3.Connection, record: dict) -> None:
+    e = entry_of(record)
+    conn.execute("DELETE FROM parameters WHERE measurement_id = ?", (e.id,))
+    conn.execute("INSERT INTO measurements (id, folder, measured_at, stored_at, driver, serial, operator, station, "
+                 "validity, effects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                 (e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station,
+                  e.validity, ",".join(e.effects)))
+    for name in KEY_PARAMETERS:
+        p = e.parameters.get(name)
+        if p is None:
+            continue
+        value, std = p.get("value"), p.get("std")
+        conn.execute("INSERT INTO parameters VALUES (?, ?, ?, ?, ?)",
+                     (e.id, name, value if isinstance(value, (int, float)) else None,
+                      std if isinstance(std, (int, float)) else None, str(p.get("unit", ""))))

@@ -1,0 +1,212 @@
+"""The results of one analysis as a JSON document, and that document read back.
+
+`results_document(result, recording)` is what the archive keeps as
+results.json: everything a report or an export needs without fitting again:
+the parameter table (SI, with the customary unit and its scale), the model
+(effect ids, fitted values, standard errors, reduced chi^2 per channel, AIC,
+BIC), the validity, and the measured lines of Z and Hx with their per-line
+uncertainty and the model at those lines. `StoredResult.from_json` reads it
+back; a report of a fresh analysis goes the same way, so archived and fresh
+reports cannot differ.
+
+JSON has no NaN: a missing or non-finite number is null.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from analysis.derived import ParameterValue
+
+FORMAT = "linpar-results/1"
+CHANNELS = ("impedance", "displacement")
+
+
+def _num(x) -> float | None:
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _list(a) -> list:
+    return [_num(v) for v in np.asarray(a, dtype=float)]
+
+
+def _settings_of(recording, result) -> dict:
+    spectra = result.spectra
+    freqs = result.fit.channels["impedance"].freqs
+    out = {
+        "sample_rate_hz": spectra.sample_rate,
+        "period_samples": spectra.period_samples,
+        "periods_analysed": spectra.n_periods,
+        "excited_lines": len(spectra.excited_bins),
+        "f_min_hz": _num(freqs.min()) if len(freqs) else None,
+        "f_max_hz": _num(freqs.max()) if len(freqs) else None,
+    }
+    if recording is not None:
+        out["settle_periods"] = recording.settle_periods
+        out["duration_s"] = recording.duration_s
+        out["channels"] = [c.signal for c in recording.channels]
+        u = recording.signal("voltage")
+        if u is not None:
+            out["voltage_rms_v"] = _num(np.sqrt(np.mean(np.square(u))))
+    return out
+
+
+def results_document(result, recording=None) -> dict:
+    """The JSON document of an analysis.pipeline.AnalysisResult (and of its recording's settings)."""
+    fit = result.fit
+    curves = {}
+    for name, ch in fit.channels.items():
+        curves[name] = {"unit": "ohm" if name == "impedance" else "m/V", "has_phase": bool(ch.has_phase),
+                        "freqs_hz": _list(ch.freqs), "measured_re": _list(np.real(ch.measured)),
+                        "measured_im": _list(np.imag(ch.measured)), "std": _list(ch.std),
+                        "model_re": _list(np.real(ch.model)), "model_im": _list(np.imag(ch.model))}
+    parameters = {}
+    for name, p in result.parameters.items():
+        parameters[name] = {"value": _num(p.value), "std": _num(p.std), "unit": p.unit,
+                            "display_unit": p.display_unit, "display_scale": p.display_scale,
+                            "reason": p.reason, "fitted": p.fitted}
+    return {
+        "format": FORMAT,
+        "parameters": parameters,
+        "model": {"effects": list(fit.model.effect_ids), "with_displacement": fit.model.with_displacement,
+                  "values": {k: _num(v) for k, v in fit.values.items()},
+                  "stderr": {k: _num(v) for k, v in fit.stderr.items()},
+                  "chi2_red": {k: _num(v) for k, v in fit.chi2_red_by_channel().items()},
+                  "aic": _num(fit.aic), "bic": _num(fit.bic), "n_data": fit.n_data,
+                  "n_parameters": fit.n_varying, "converged": bool(fit.success), "message": fit.message,
+                  "noise_known": fit.noise_known},
+        "validity": result.validity,
+        "sd_m2": _num(result.sd_m2),
+        "settings": _settings_of(recording, result),
+        "curves": curves,
+    }
+
+
+@dataclass(frozen=True)
+class Curve:
+    """Measured lines of one channel, their uncertainty and the model at the same lines."""
+
+    name: str
+    unit: str
+    freqs: np.ndarray
+    measured: np.ndarray      # complex (magnitude only when has_phase is False)
+    std: np.ndarray
+    model: np.ndarray
+    has_phase: bool = True
+
+    @property
+    def normalized_residual(self) -> np.ndarray:
+        """As analysis.fit.ChannelFit: (model - measured) per component in units of its std."""
+        sigma = self.std / np.sqrt(2.0)
+        if not self.has_phase:
+            return (np.abs(self.model) - self.measured.real) / sigma
+        return (self.model - self.measured) / sigma
+
+
+class ResultsFormatError(ValueError):
+    pass
+
+
+def _get(doc: Mapping, key: str, kind, where: str):
+    if not isinstance(doc, Mapping) or key not in doc:
+        raise ResultsFormatError(f"{where}{key}: missing")
+    value = doc[key]
+    if kind is not None and not isinstance(value, kind):
+        raise ResultsFormatError(f"{where}{key}: expected a JSON {kind.__name__ if isinstance(kind, type) else 'value'}")
+    return value
+
+
+def _array(values, where: str) -> np.ndarray:
+    if not isinstance(values, list):
+        raise ResultsFormatError(f"{where}: expected a list of numbers")
+    try:
+        return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
+    except (TypeError, ValueError):
+        raise ResultsFormatError(f"{where}: expected a list of numbers") from None
+
+
+@dataclass(frozen=True)
+class StoredResult:
+    parameters: dict[str, ParameterValue]
+    effects: tuple[str, ...]
+    with_displacement: bool
+    values: dict[str, float]
+    model_info: dict[str, Any]
+    validity: dict
+    sd_m2: float | None
+    settings: dict
+    curves: dict[str, Curve] = field(default_factory=dict)
+
+    @classmethod
+    def from_json(cls, doc: Mapping) -> "StoredResult":
+        if _get(doc, "format", str, "") != FORMAT:
+            raise ResultsFormatError(f"format: expected {FORMAT!r}")
+        parameters = {}
+        for name, p in _get(doc, "parameters", dict, "").items():
+            where = f"parameters.{name}."
+            parameters[name] = ParameterValue(name, p.get("value"), p.get("std"), _get(p, "unit", str, where),
+                                              _get(p, "display_unit", str, where),
+                                              float(_get(p, "display_scale", (int, float), where)),
+                                              p.get("reason"), bool(p.get("fitted", False)))
+        model = _get(doc, "model", dict, "")
+        effects = tuple(str(e) for e in _get(model, "effects", list, "model."))
+        values = {k: float(v) for k, v in _get(model, "values", dict, "model.").items() if v is not None}
+        curves = {}
+        for name, c in _get(doc, "curves", dict, "").items():
+            if name not in CHANNELS:
+                continue
+            where = f"curves.{name}."
+            arr = {k: _array(_get(c, k, list, where), where + k)
+                   for k in ("freqs_hz", "measured_re", "measured_im", "std", "model_re", "model_im")}
+            if len({len(a) for a in arr.values()}) != 1:
+                raise ResultsFormatError(f"{where}: the lists differ in length")
+            curves[name] = Curve(name, str(c.get("unit", "")), arr["freqs_hz"],
+                                 arr["measured_re"] + 1j * arr["measured_im"], arr["std"],
+                                 arr["model_re"] + 1j * arr["model_im"], bool(c.get("has_phase", True)))
+        sd = doc.get("sd_m2")
+        return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
+                   dict(model), dict(doc.get("validity") or {"overall": "unknown"}),
+                   float(sd) if isinstance(sd, (int, float)) else None, dict(doc.get("settings") or {}), curves)
+
+    def model(self):
+        """The analysis.model.Model the values belong to (rebuilt from the effect ids)."""
+        from analysis.effects import parse_effects
+        from analysis.model import Model
+        return Model(parse_effects(",".join(self.effects) or "none"), self.with_displacement)
+
+    def model_curve(self, name: str, freqs: np.ndarray) -> np.ndarray:
+        """The fitted model of 'impedance' (ohm) or 'displacement' (m/V) at any frequencies."""
+        model = self.model()
+        s = 2j * np.pi * np.asarray(freqs, dtype=float)
+        return model.impedance(s, self.values) if name == "impedance" else model.displacement(s, self.values)
+
+    @property
+    def overall(self) -> str:
+        return str(self.validity.get("overall", "unknown"))
+
+
+def stored_from_recording(path, sd_m2: float | None = None, effects=None):
+    """Analyse a recording file now: (StoredResult, header, calibration), as an archived copy would give."""
+    from datetime import datetime, timezone
+    from pathlib import Path
+
+    from analysis.pipeline import analyze_recording
+    from analysis.recording import read_recording
+    recording = read_recording(path)
+    result = analyze_recording(recording, sd_m2, effects)
+    stored = StoredResult.from_json(results_document(result, recording))
+    try:   # the best date a bare recording carries: when its file was written
+        when = datetime.fromtimestamp(Path(recording.source).stat().st_mtime, timezone.utc)
+        date = when.isoformat(timespec="seconds").replace("+00:00", "Z") + " (file time)"
+    except (OSError, TypeError):
+        date = ""
+    header = {"driver": str((recording.driver or {}).get("name", "")), "measured_at": date,
+              "source": str(recording.source or path)}
+    calibration = {k: recording.extra[k] for k in ("calibration", "capture") if k in (recording.extra or {})}
+    return stored, header, calibration

@@ -1,0 +1,93 @@
+"""The index's SQLite schema: a schema_version table and ordered migrations.
+
+MIGRATIONS[i] takes a database from version i to version i + 1; a new
+database runs them all. Each runs in its own transaction together with the
+version update, so a crash leaves the database at one version or the next,
+never between. Add a migration at the end; never edit one that has shipped.
+
+The index is a cache of the folders (every fact in it is also in a
+measurement.json), so a database that is unreadable, or of a schema this
+program does not know, is set aside and rebuilt rather than repaired.
+"""
+from __future__ import annotations
+
+import sqlite3
+from typing import Callable
+
+# The parameters copied into the index for listing, filtering and comparing.
+KEY_PARAMETERS = ("RE", "LE", "fs", "Bl", "Mms", "Cms", "Rms", "Qms", "Qes", "Qts", "Vas", "SPL_2.83V_1m")
+
+
+def _v1(conn: sqlite3.Connection) -> None:
+    conn.execute("""CREATE TABLE measurements (
+        id TEXT PRIMARY KEY,
+        folder TEXT NOT NULL UNIQUE,
+        measured_at TEXT NOT NULL,
+        stored_at TEXT NOT NULL,
+        driver TEXT NOT NULL,
+        serial TEXT NOT NULL,
+        operator TEXT NOT NULL,
+        station TEXT NOT NULL,
+        validity TEXT NOT NULL)""")
+    conn.execute("""CREATE TABLE parameters (
+        measurement_id TEXT NOT NULL REFERENCES measurements(id) ON DELETE CASCADE,
+        name TEXT NOT NULL,
+        value REAL,
+        std REAL,
+        unit TEXT NOT NULL,
+        PRIMARY KEY (measurement_id, name))""")
+
+
+def _v2(conn: sqlite3.Connection) -> None:
+    # Listing is newest first and filters by driver: index both.
+    conn.execute("ALTER TABLE measurements ADD COLUMN effects TEXT NOT NULL DEFAULT ''")
+    conn.execute("CREATE INDEX measurements_by_date ON measurements(measured_at)")
+    conn.execute("CREATE INDEX measurements_by_driver ON measurements(driver, serial)")
+
+
+MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2)
+CURRENT_VERSION = len(MIGRATIONS)
+# What a database of the current version must have (checked on open).
+EXPECTED_COLUMNS = {
+    "measurements": {"id", "folder", "measured_at", "stored_at", "driver", "serial", "operator", "station",
+                     "validity", "effects"},
+    "parameters": {"measurement_id", "name", "value", "std", "unit"},
+}
+
+
+class SchemaError(Exception):
+    """The database is not a linpar index this program can use."""
+
+
+def version_of(conn: sqlite3.Connection) -> int:
+    tables = {row[0] for row in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    if "schema_version" not in tables:
+        if tables:
+            raise SchemaError(f"tables {sorted(tables)} but no schema_version: not a linpar index")
+        return 0
+    rows = conn.execute("SELECT version FROM schema_version").fetchall()
+    if len(rows) != 1 or not isinstance(rows[0][0], int):
+        raise SchemaError("schema_version must hold exactly one integer")
+    return rows[0][0]
+
+
+def migrate(conn: sqlite3.Connection) -> int:
+    """Bring the database to CURRENT_VERSION; return the version it had."""
+    start = version_of(conn)
+    if start > CURRENT_VERSION:
+        raise SchemaError(f"schema version {start} is newer than this program's {CURRENT_VERSION}")
+    for version in range(start, CURRENT_VERSION):
+        with conn:   # one transaction: the migration and the new version number
+            if version == 0:
+                conn.execute("CREATE TABLE schema_version (version INTEGER NOT NULL)")
+                conn.execute("INSERT INTO schema_version VALUES (0)")
+            MIGRATIONS[version](conn)
+            conn.execute("UPDATE schema_version SET version = ?", (version + 1,))
+    return start
+
+
+def check_columns(conn: sqlite3.Connection) -> None:
+    for table, wanted in EXPECTED_COLUMNS.items():
+        have = {row[1] for row in conn.execute(f"PRAGMA table_info({table})")}
+        if not wanted <= have:
+            raise SchemaError(f"table {table} lacks {sorted(wanted - have)}")

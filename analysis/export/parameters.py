@@ -1,0 +1,57 @@
+"""Parameters as CSV and JSON: SI values with their standard uncertainty, and the customary unit beside.
+
+CSV: one row per parameter, columns
+
+    parameter, value, std, unit, display_value, display_std, display_unit, note
+
+(value and std in SI; display_* = SI x display_scale; an empty value with a
+note says why it is missing). Decimal point '.', comma-separated, UTF-8,
+RFC 4180 quoting.
+
+JSON ("linpar-parameters/1"): the driver header, the parameters keyed by
+name ({value, std, unit, display_unit, display_scale, reason}), the model
+(effects, reduced chi^2 per channel, AIC, BIC) and the overall validity.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+from typing import Mapping
+
+from analysis.archive.results import StoredResult
+
+JSON_FORMAT = "linpar-parameters/1"
+CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note")
+
+
+def _num(x) -> str:
+    return "" if x is None else repr(float(x))
+
+
+def parameters_csv(result: StoredResult) -> str:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for p in result.parameters.values():
+        ok = p.value is not None
+        writer.writerow([p.name, _num(p.value), _num(p.std), p.unit,
+                         _num(p.value * p.display_scale) if ok else "",
+                         _num(p.std * abs(p.display_scale)) if ok and p.std is not None else "",
+                         p.display_unit, p.reason or ""])
+    return buf.getvalue()
+
+
+def parameters_json(result: StoredResult, header: Mapping | None = None) -> str:
+    info = result.model_info
+    doc = {
+        "format": JSON_FORMAT,
+        "driver": {k: v for k, v in dict(header or {}).items() if v},
+        "sd_m2": result.sd_m2,
+        "parameters": {p.name: {"value": p.value, "std": p.std, "unit": p.unit, "display_unit": p.display_unit,
+                                "display_scale": p.display_scale, **({"reason": p.reason} if p.reason else {})}
+                       for p in result.parameters.values()},
+        "model": {k: info.get(k) for k in ("effects", "chi2_red", "aic", "bic", "n_data", "n_parameters", "converged")},
+        "validity": result.overall,
+    }
+    return json.dumps(doc, indent=1, ensure_ascii=False, allow_nan=False) + "\n"

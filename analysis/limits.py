@@ -1,0 +1,239 @@
+"""QA limits: pass or fail per parameter and overall, from a JSON limits file.
+
+    {
+      "format": "linpar-limits/1",
+      "name": "6-inch woofer, production QA",                     (optional)
+      "parameters": {
+        "RE":  {"nominal": 3.0,  "tolerance": "5%",  "unit": "ohm"},
+        "fs":  {"nominal": 70,   "tolerance": 5,     "unit": "Hz"},    absolute tolerance, in "unit"
+        "Mms": {"min": 11, "max": 13, "unit": "g"},                    customary unit...
+        "Cms": {"max": 0.0005, "unit": "m/N"},                         ...or SI, stated per entry
+        "Qts": {"nominal": 0.46, "tolerance": "10%", "unit": "-"}
+      }
+    }
+
+Each entry gives either `nominal` and `tolerance` (a number in `unit`, or a
+string "N%" of the nominal), or `min` and/or `max`. `unit` is required: the
+parameter's SI unit or its customary one (mH or H, g or kg, l or m^3, ...),
+so that a limit can never be read in the wrong unit. A parameter that the
+measurement could not give (Bl without the laser) fails, with the reason.
+
+A limits file that breaks these rules raises LimitsError, whose one-line
+message names the file, the line and key, and what was expected.
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+from analysis.derived import ParameterValue
+
+FORMAT = "linpar-limits/1"
+ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
+# Spellings of units that mean the same thing.
+_ALIASES = {"Ω": "ohm", "ohms": "ohm", "µF": "uF", "μF": "uF", "L": "l", "m3": "m^3", "": "1", "-": "1",
+            "Tm": "T*m", "T·m": "T*m", "N/A": "T*m", "dB SPL": "dB"}
+_PERCENT = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*%\s*$")
+
+
+class LimitsError(ValueError):
+    def __init__(self, message: str):
+        super().__init__(" ".join(str(message).splitlines()))
+
+
+def _unit(text: str) -> str:
+    return _ALIASES.get(text.strip(), text.strip())
+
+
+def parameter_units() -> dict[str, tuple[str, str, float]]:
+    """name -> (SI unit, customary unit, customary = SI x scale) for every parameter linpar can report."""
+    from analysis.derived import DERIVED
+    from analysis.effects import CATALOGUE
+    from analysis.model import BASE_PARAMS, BL_PARAM
+    table = {}
+    for spec in (*BASE_PARAMS, BL_PARAM, *(p for e in CATALOGUE.values() for p in e.params)):
+        table.setdefault(spec.name, (spec.unit, spec.display_unit, spec.display_scale))
+    for d in DERIVED:
+        table.setdefault(d.name, (d.unit, d.display_unit, d.display_scale))
+    return table
+
+
+@dataclass(frozen=True)
+class Limit:
+    name: str
+    unit: str                 # as written in the file
+    to_si: float              # SI = value in `unit` x to_si
+    low: float | None         # SI
+    high: float | None        # SI
+    text: str                 # how the file said it, for the report
+
+    def judge(self, p: ParameterValue | None) -> "Verdict":
+        if p is None or p.value is None:
+            why = p.reason if p is not None else "not in this measurement's results"
+            return Verdict(self, None, False, f"not measured: {why}")
+        ok = (self.low is None or p.value >= self.low) and (self.high is None or p.value <= self.high)
+        return Verdict(self, p.value, ok, "")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    limit: Limit
+    value: float | None       # SI
+    passed: bool
+    note: str
+
+    def as_json(self) -> dict:
+        return {"parameter": self.limit.name, "value": self.value, "low": self.limit.low, "high": self.limit.high,
+                "unit": parameter_units()[self.limit.name][0], "limit": self.limit.text,
+                "pass": self.passed, **({"note": self.note} if self.note else {})}
+
+
+@dataclass(frozen=True)
+class Limits:
+    path: Path
+    name: str
+    limits: tuple[Limit, ...]
+
+    def judge(self, parameters: Mapping[str, ParameterValue]) -> tuple[Verdict, ...]:
+        return tuple(limit.judge(parameters.get(limit.name)) for limit in self.limits)
+
+
+def _line_of(text: str, key: str, after: int = 0) -> int:
+    at = text.find(f'"{key}"', after)
+    return text.count("\n", 0, at) + 1 if at >= 0 else 0
+
+
+def load_limits(path: str | Path) -> Limits:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise LimitsError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError:
+        raise LimitsError(f"{path}: not UTF-8 text: expected a JSON limits file") from None
+    try:
+        doc = json.loads(text, parse_constant=_refuse_constant)
+    except json.JSONDecodeError as exc:
+        raise LimitsError(f"{path}: line {exc.lineno} column {exc.colno}: {exc.msg}: expected JSON") from None
+    except ValueError as exc:
+        raise LimitsError(f"{path}: {exc}") from None
+    return parse_limits(doc, text, path)
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not a number: expected finite numbers")
+
+
+def parse_limits(doc, text: str, path: Path) -> Limits:
+    def fail(line: int, key: str, message: str):
+        where = f"line {line}: " if line else ""
+        raise LimitsError(f"{path}: {where}{key}: {message}")
+
+    if not isinstance(doc, dict):
+        fail(1, "(top level)", "expected a JSON object with \"format\" and \"parameters\"")
+    if doc.get("format") != FORMAT:
+        fail(_line_of(text, "format"), "format", f"found {doc.get('format')!r}, expected {FORMAT!r}")
+    params = doc.get("parameters")
+    if not isinstance(params, dict) or not params:
+        fail(_line_of(text, "parameters"), "parameters", "expected an object of parameter limits, "
+                                                         "e.g. {\"RE\": {\"nominal\": 3.0, \"tolerance\": \"5%\", \"unit\": \"ohm\"}}")
+    units = parameter_units()
+    start = text.find('"parameters"')
+    limits = []
+    for name, entry in params.items():
+        line = _line_of(text, name, max(start, 0))
+        key = f"parameters.{name}"
+        if name not in units:
+            fail(line, key, f"unknown parameter: expected one of {', '.join(units)}")
+        si, customary, scale = units[name]
+        if not isinstance(entry, dict):
+            fail(line, key, "expected an object with nominal/tolerance or min/max, and unit")
+        extra = set(entry) - ENTRY_KEYS
+        if extra:
+            fail(line, f"{key}.{sorted(extra)[0]}", f"unknown key: expected {', '.join(sorted(ENTRY_KEYS))}")
+        unit = entry.get("unit")
+        accepted = {_unit(si): 1.0, _unit(customary): 1.0 / scale}
+        if not isinstance(unit, str) or _unit(unit) not in accepted:
+            fail(line, f"{key}.unit", f"found {unit!r}, expected {si!r} (SI) or {customary!r}")
+        to_si = accepted[_unit(unit)]
+        shown_unit = "" if _unit(unit) == "1" else unit    # dimensionless: no unit in the text
+
+        def number(k):
+            v = entry.get(k)
+            if v is None:
+                return None
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                fail(line, f"{key}.{k}", f"found {v!r}, expected a number in {unit}")
+            return float(v)
+
+        nominal, low, high = number("nominal"), number("min"), number("max")
+        tolerance = entry.get("tolerance")
+        if nominal is not None:
+            if low is not None or high is not None:
+                fail(line, key, "give either nominal and tolerance, or min and/or max, not both")
+            if tolerance is None:
+                fail(line, f"{key}.tolerance", f"missing: expected a number in {unit} or a percentage like \"5%\"")
+            m = _PERCENT.match(tolerance) if isinstance(tolerance, str) else None
+            if m:
+                delta = abs(nominal) * float(m.group(1)) / 100.0
+                said = f"{nominal:g} {shown_unit} ± {m.group(1)} %".replace("  ", " ")
+            elif isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and math.isfinite(tolerance) \
+                    and tolerance >= 0:
+                delta = float(tolerance)
+                said = f"{nominal:g} ± {delta:g} {shown_unit}".rstrip()
+            else:
+                fail(line, f"{key}.tolerance", f"found {tolerance!r}, expected a non-negative number in {unit} "
+                                               "or a percentage like \"5%\"")
+            low, high = nominal - delta, nominal + delta
+        else:
+            if tolerance is not None:
+                fail(line, f"{key}.nominal", "missing: a tolerance needs a nominal value")
+            if low is None and high is None:
+                fail(line, key, "expected nominal and tolerance, or min and/or max")
+            if low is not None and high is not None and low > high:
+                fail(line, key, f"min {low:g} is above max {high:g}")
+            if low is not None and high is not None:
+                said = f"{low:g} .. {high:g} {shown_unit}".rstrip()
+            else:
+                said = (f"≥ {low:g} {shown_unit}" if high is None else f"≤ {high:g} {shown_unit}").rstrip()
+        lo_si = None if low is None else low * to_si
+        hi_si = None if high is None else high * to_si
+        limits.append(Limit(name, unit, to_si, lo_si, hi_si, said))
+    return Limits(path, str(doc.get("name") or path.stem), tuple(limits))
+
+
+def verdict_of(verdicts) -> str:
+    return "pass" if all(v.passed for v in verdicts) else "fail"
+
+
+def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity_overall: str) -> dict:
+    """The QA verdict as JSON: "pass", "fail", or "invalid" when the measurement itself is red.
+
+    A red measurement's parameters are worthless (physics.md section 5):
+    they can neither pass nor fail a driver, the driver must be measured again.
+    """
+    verdicts = limits.judge(parameters)
+    verdict = "invalid" if validity_overall == "red" else verdict_of(verdicts)
+    return {"file": str(limits.path), "name": limits.name, "verdict": verdict,
+            "parameters": [v.as_json() for v in verdicts]}
+
+
+def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity_overall: str) -> str:
+    """A table for the terminal: each limit in its file's unit, the measured value, pass or FAIL."""
+    doc = judge_result(limits, parameters, validity_overall)
+    lines = [f"QA limits: {limits.name} ({limits.path})"]
+    for limit, v in zip(limits.limits, limits.judge(parameters)):
+        unit = "" if _unit(limit.unit) == "1" else limit.unit
+        shown = "n/a" if v.value is None else f"{v.value / limit.to_si:.5g} {unit}".rstrip()
+        mark = "pass" if v.passed else "FAIL"
+        lines.append(f"  {limit.name:<14}{shown:>18}   limit {limit.text:<28} {mark}"
+                     + (f"  ({v.note})" if v.note else ""))
+    if doc["verdict"] == "invalid":
+        lines.append("QA: INVALID: the measurement is not valid (validity red): fix it and measure again")
+    else:
+        lines.append(f"QA: {doc['verdict'].upper()}")
+    return "\n".join(lines)

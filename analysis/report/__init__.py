@@ -1,0 +1,50 @@
+"""Reports of one measurement, as HTML (self-contained) and PDF.
+
+    content = report_content(stored_result, header, settings, calibration)   (or report_for_measurement / report_for_recording)
+    write_report(content, pdf="r.pdf", html="r.html")
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from analysis.archive.atomic import write_atomic
+from analysis.report.content import ReportContent, build_report
+
+
+def render_html(content: ReportContent) -> str:
+    from analysis.report.html import render_html as _render
+    return _render(content)
+
+
+def render_pdf(content: ReportContent) -> bytes:
+    from analysis.report.pdf import render_pdf as _render
+    return _render(content)
+
+
+def report_for_measurement(measurement) -> ReportContent:
+    """The report of an archived measurement (analysis.archive.Measurement), from what is stored."""
+    record = measurement.record
+    header = {k: record.get(k) for k in ("driver", "serial", "measured_at", "operator", "station", "id")}
+    return build_report(measurement.result(), header, measurement.load_json("settings"),
+                        measurement.load_json("calibration"))
+
+
+def report_for_recording(path, sd_m2=None, effects=None, header=None) -> ReportContent:
+    """Analyse a recording now and report it (the same content an archived copy would give)."""
+    from analysis.archive.results import stored_from_recording
+    stored, head, calibration = stored_from_recording(path, sd_m2, effects)
+    head.update({k: v for k, v in (header or {}).items() if v})
+    return build_report(stored, head, None, calibration)
+
+
+def write_report(content: ReportContent, pdf: str | Path | None = None, html: str | Path | None = None) -> list[Path]:
+    written = []
+    if pdf is not None:
+        written.append(write_atomic(pdf, render_pdf(content)))
+    if html is not None:
+        written.append(write_atomic(html, render_html(content)))
+    return written
+
+
+__all__ = ["ReportContent", "build_report", "render_html", "render_pdf", "report_for_measurement",
+           "report_for_recording", "write_report"]

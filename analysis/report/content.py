@@ -1,0 +1,170 @@
+"""What a report says, independent of how it is rendered (HTML or PDF).
+
+A report is built from a StoredResult (analysis.archive.results) and the
+measurement's header (driver, serial, date, operator, station): the same
+content whether the measurement comes from the archive or was analysed on
+the fly. Everything is already formatted for people here (customary units,
+rounded to the uncertainty); the renderers only lay it out.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+from analysis.archive.results import StoredResult
+from analysis.report.numbers import format_number, parameter_cells, pretty_unit
+
+CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
+HEADER_FIELDS = (("driver", "Driver"), ("serial", "Serial number"), ("measured_at", "Date"),
+                 ("operator", "Operator"), ("station", "Station"), ("id", "Measurement id"), ("source", "Source"))
+SETTING_LABELS = {
+    "sample_rate_hz": ("Sample rate", "Hz"), "period_samples": ("Period", "samples"),
+    "periods_analysed": ("Periods analysed", ""), "settle_periods": ("Settle periods", ""),
+    "excited_lines": ("Excited lines", ""), "f_min_hz": ("Lowest line", "Hz"), "f_max_hz": ("Highest line", "Hz"),
+    "duration_s": ("Duration", "s"), "voltage_rms_v": ("Drive voltage", "V rms"), "channels": ("Channels", ""),
+}
+
+
+@dataclass(frozen=True)
+class Finding:
+    channel: str
+    severity: str
+    code: str
+    message: str
+    remedy: str
+
+
+@dataclass(frozen=True)
+class Light:
+    channel: str
+    status: str          # green | yellow | red | absent | unknown
+    findings: tuple[Finding, ...] = ()
+
+
+@dataclass(frozen=True)
+class ParameterRow:
+    name: str
+    value: str
+    std: str
+    unit: str
+    relative: str
+    note: str            # why a value is missing
+    fitted: bool
+
+
+@dataclass(frozen=True)
+class ReportContent:
+    title: str
+    header: tuple[tuple[str, str], ...]
+    overall: str
+    lights: tuple[Light, ...]
+    peak_displacement: str
+    parameters: tuple[ParameterRow, ...]
+    model: tuple[tuple[str, str], ...]
+    settings: tuple[tuple[str, str], ...]
+    calibration: tuple[tuple[str, str], ...]
+    result: StoredResult = field(repr=False)
+    notes: tuple[str, ...] = ()          # e.g. why there is no SPL plot
+
+    @property
+    def has_spl(self) -> bool:
+        return self.result.sd_m2 is not None and "displacement" in self.result.curves
+
+    @property
+    def has_displacement(self) -> bool:
+        return "displacement" in self.result.curves
+
+
+def _lights(validity: Mapping) -> tuple[Light, ...]:
+    lights = []
+    for name, channel in (validity.get("channels") or {}).items():
+        findings = tuple(Finding(name, str(f.get("severity", "")), str(f.get("code", "")),
+                                 str(f.get("message", "")), str(f.get("remedy", "")))
+                         for f in channel.get("findings", []))
+        lights.append(Light(name, str(channel.get("status", "unknown")), findings))
+    return tuple(lights)
+
+
+def _effect_title(effect_id: str) -> str:
+    from analysis.effects import CATALOGUE
+    e = CATALOGUE.get(effect_id)
+    return f"{effect_id} ({e.title})" if e else effect_id
+
+
+def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
+    info = result.model_info
+    effects = ", ".join(_effect_title(e) for e in result.effects) or "none (the textbook lumped model)"
+    chi = info.get("chi2_red") or {}
+    rows = [("Model", "lumped model of physics.md" + (" with Hx (laser)" if result.with_displacement else
+                                                       ", impedance only")),
+            ("Effects", effects)]
+    for channel, value in chi.items():
+        rows.append((f"Reduced χ² ({channel})", format_number(value) if value is not None else "n/a"))
+    for key, label in (("aic", "AIC"), ("bic", "BIC")):
+        value = info.get(key)
+        rows.append((label, f"{value:.1f}" if isinstance(value, (int, float)) else "n/a"))
+    rows.append(("Data, parameters", f"{info.get('n_data', 'n/a')} real data points, "
+                                     f"{info.get('n_parameters', 'n/a')} fitted parameters"))
+    converged = info.get("converged")
+    rows.append(("Converged", "yes" if converged else f"NO: {info.get('message', '')}"))
+    return tuple(rows)
+
+
+def _flatten(prefix: str, value: Any, out: list[tuple[str, str]]) -> None:
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            _flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
+    elif isinstance(value, list) and len(value) > 12:
+        out.append((prefix, f"{len(value)} values"))
+    else:
+        out.append((prefix, value if isinstance(value, str) else json.dumps(value)))
+
+
+def _settings_rows(settings: Mapping) -> tuple[tuple[str, str], ...]:
+    rows = []
+    for key, value in settings.items():
+        label, unit = SETTING_LABELS.get(key, (key, ""))
+        if isinstance(value, float):
+            text = format_number(value)
+        elif isinstance(value, list) and all(isinstance(v, str) for v in value):
+            text = ", ".join(value)
+        elif isinstance(value, (Mapping, list)):
+            flat: list[tuple[str, str]] = []
+            _flatten(key, value, flat)
+            rows += flat
+            continue
+        else:
+            text = str(value)
+        rows.append((label, f"{text} {unit}".strip()))
+    return tuple(rows)
+
+
+def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapping | None = None,
+                 calibration: Mapping | None = None) -> ReportContent:
+    """header: driver, serial, measured_at, operator, station, id, source (any may be missing)."""
+    head = tuple((label, str(header.get(key) or "–")) for key, label in HEADER_FIELDS
+                 if header.get(key) or key in ("driver", "serial", "measured_at", "operator", "station"))
+    params = []
+    for p in result.parameters.values():
+        value, std, unit, rel = parameter_cells(p)
+        params.append(ParameterRow(p.name, value, std, unit, rel, p.reason or "", p.fitted))
+    peak = result.validity.get("peak_displacement_m")
+    peak_text = f"{peak * 1e3:.3g} mm" if isinstance(peak, (int, float)) else "not measured"
+    cal: list[tuple[str, str]] = []
+    _flatten("", dict(calibration or {}), cal)
+    notes = []
+    if "displacement" not in result.curves:
+        notes.append("No displacement channel: Bl, the mechanical parameters, Hx and SPL cannot be shown.")
+    elif result.sd_m2 is None:
+        notes.append("Sd unknown: no SPL prediction (give the effective radiating area).")
+    title = " ".join(x for x in (str(header.get("driver") or ""), str(header.get("serial") or "")) if x)
+    return ReportContent(
+        title=f"Linear parameters: {title}" if title else "Linear parameters",
+        header=head, overall=result.overall, lights=_lights(result.validity), peak_displacement=peak_text,
+        parameters=tuple(params), model=_model_rows(result),
+        settings=_settings_rows({**dict(result.settings), **dict(settings or {})}),
+        calibration=tuple(cal) or (("Calibration", "not recorded"),), result=result, notes=tuple(notes))
+
+
+__all__ = ["Finding", "Light", "ParameterRow", "ReportContent", "build_report", "pretty_unit"]

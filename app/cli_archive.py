@@ -1,0 +1,167 @@
+"""`linpar archive list|show|export|rebuild|store|compare`: the measurement archive from the command line.
+
+Only sqlite3 and json are imported for `list`, `show` and `rebuild`: listing
+a large archive must not wait for numpy and scipy to load.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
+
+
+def add_root_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--root", metavar="DIR",
+                        help="archive folder (default: $LINPAR_ARCHIVE or ~/.local/share/linpar/archive)")
+
+
+def add_commands(sub) -> None:
+    archive = sub.add_parser("archive", help="the measurement archive: list, show, export, rebuild, store, compare")
+    verbs = archive.add_subparsers(dest="archive_command", required=True, parser_class=type(archive))
+
+    ls = verbs.add_parser("list", help="list stored measurements, newest first")
+    for name in ("driver", "serial", "operator", "station"):
+        ls.add_argument(f"--{name}", metavar="TEXT", help=f"only measurements whose {name} contains TEXT")
+    ls.add_argument("--validity", choices=("green", "yellow", "red"))
+    ls.add_argument("--since", metavar="DATE", help="measured on or after DATE (ISO, e.g. 2024-05-01)")
+    ls.add_argument("--until", metavar="DATE", help="measured on or before DATE")
+    ls.add_argument("--limit", type=int, metavar="N")
+
+    show = verbs.add_parser("show", help="one measurement's record and files")
+    show.add_argument("id", help="measurement id (or its first characters)")
+
+    export = verbs.add_parser("export", help="copy a measurement's folder into DIR")
+    export.add_argument("id")
+    export.add_argument("dir")
+
+    verbs.add_parser("rebuild", help="rebuild the index from the measurement folders")
+
+    store = verbs.add_parser("store", help="analyse a recording and store it in the archive")
+    store.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
+    for name in ("driver", "serial", "operator", "station", "notes"):
+        store.add_argument(f"--{name}", metavar="TEXT", default="")
+    store.add_argument("--measured-at", metavar="DATE", help="when it was measured (ISO 8601; default: now)")
+    store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
+    store.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2")
+    store.add_argument("--model", metavar="EFFECTS", help="effect ids separated by commas (default lr2,creep-log)")
+
+    compare = verbs.add_parser("compare", help="up to 8 measurements' parameters side by side")
+    compare.add_argument("ids", nargs="+", metavar="ID")
+
+    for parser in (ls, show, export, store, compare, verbs.choices["rebuild"]):
+        add_root_option(parser)
+        parser.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _archive(args):
+    from analysis.archive import Archive
+    return Archive(Path(args.root).expanduser() if args.root else None)
+
+
+def _notes(archive) -> None:
+    for note in archive.notes:
+        print(f"linpar: note: {note}", file=sys.stderr)
+
+
+def _param(entry, name: str, scale: float) -> str:
+    p = entry.parameters.get(name) or {}
+    v = p.get("value")
+    return "-" if not isinstance(v, (int, float)) else f"{v * scale:.4g}"
+
+
+def run(args: argparse.Namespace) -> int:
+    archive = _archive(args)
+    verb = args.archive_command
+    if verb == "list":
+        from analysis.archive import Filter
+        entries = archive.list(Filter(args.driver, args.serial, args.operator, args.station, args.validity,
+                                      args.since, args.until, args.limit))
+        _notes(archive)
+        if args.json:
+            print(json.dumps([e.as_json() for e in entries], ensure_ascii=False))
+            return 0
+        cols = "  ".join(f"{n + (' [' + u + ']' if u else ''):>10}" for n, u, _ in LIST_PARAMETERS)
+        lines = [f"{'id':<22}  {'date (UTC)':<20}  {'driver':<20}  {'serial':<12}  {'validity':<8}  {cols}"]
+        for e in entries:
+            params = "  ".join(f"{_param(e, n, s):>10}" for n, _, s in LIST_PARAMETERS)
+            lines.append(f"{e.id:<22}  {e.measured_at:<20}  {e.driver[:20]:<20}  {e.serial[:12]:<12}  "
+                         f"{e.validity:<8}  {params}")
+        lines.append(f"{len(entries)} measurement(s) in {archive.root}")
+        sys.stdout.write("\n".join(lines) + "\n")
+        return 0
+    if verb == "show":
+        m = archive.get(args.id)
+        _notes(archive)
+        if args.json:
+            print(json.dumps({**m.record, "path": str(m.folder)}, ensure_ascii=False, indent=1))
+            return 0
+        r = m.record
+        for key in ("id", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity",
+                    "notes"):
+            if r.get(key):
+                print(f"{key:<12} {r[key]}")
+        print(f"{'model':<12} {', '.join(r.get('effects', [])) or 'textbook'}")
+        print(f"{'folder':<12} {m.folder}")
+        for role, name in r.get("files", {}).items():
+            print(f"  {role:<12} {name}")
+        print("parameters (SI):")
+        for name, p in r.get("key_parameters", {}).items():
+            value, std = p.get("value"), p.get("std")
+            text = "n/a" if value is None else f"{value:.6g}" + ("" if std is None else f" ± {std:.2g}")
+            print(f"  {name:<14} {text} {p.get('unit', '')}")
+        return 0
+    if verb == "export":
+        target = archive.export(args.id, args.dir)
+        _notes(archive)
+        print(json.dumps({"exported": str(target)}) if args.json else f"exported to {target}")
+        return 0
+    if verb == "rebuild":
+        report = archive.rebuild()
+        if args.json:
+            print(json.dumps({"indexed": report.indexed, "skipped": report.skipped}))
+        else:
+            print(report.describe())
+        return 0
+    if verb == "store":
+        return _store(archive, args)
+    if verb == "compare":
+        return _compare(archive, args)
+    raise KeyError(f"unknown archive command {verb!r}")
+
+
+def _store(archive, args) -> int:
+    from analysis.effects import parse_effects
+    from analysis.pipeline import analyze_path
+    try:
+        effects = parse_effects(args.model)
+    except KeyError as exc:
+        raise ValueError(f"--model: {exc.args[0]}") from None
+    result = analyze_path(args.path, args.sd, effects)
+    mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
+                                            "station": args.station, "notes": args.notes,
+                                            "measured_at": args.measured_at}, laser_stream=args.laser_stream)
+    _notes(archive)
+    print(json.dumps({"id": mid, "validity": result.validity.get("overall")}) if args.json else
+          f"stored {mid} (validity {result.validity.get('overall')})")
+    return 0
+
+
+def _compare(archive, args) -> int:
+    from analysis.archive import compare
+    from analysis.report.numbers import format_number, pretty_unit
+    c = compare(archive, args.ids)
+    _notes(archive)
+    if args.json:
+        print(json.dumps(c.as_json(), ensure_ascii=False, allow_nan=False))
+        return 0
+    width = 14
+    print(f"{'parameter':<14}{'unit':<8}" + "".join(f"{label[:width - 1]:>{width}}" for label in c.labels)
+          + f"{'spread':>{width}}")
+    for row in c.rows:
+        cells = "".join(f"{format_number(v, s) if v is not None else 'n/a':>{width}}" for v, s in zip(row.values, row.stds))
+        spread = "" if row.spread is None else f"{row.spread:.3g}"
+        print(f"{row.name:<14}{pretty_unit(row.display_unit):<8}{cells}{spread:>{width}}")
+    return 0

@@ -1,0 +1,93 @@
+"""`linpar report` and `linpar export`: a measurement from the archive (ID) or a recording (PATH).
+
+A PATH that names an existing recording is analysed on the fly; anything
+else is looked up in the archive as a measurement id (or its first characters).
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from app.cli_archive import add_root_option
+
+EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
+                  ("zma", "measured impedance (.zma)"), ("zma_model", "modelled impedance (.zma)"),
+                  ("frd", "predicted SPL from the measured Hx (.frd)"), ("frd_model", "modelled SPL (.frd)"),
+                  ("driver", "driver file for WinISD (.wdr)"))
+
+
+def _source_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("source", metavar="ID|PATH", help="archived measurement id, or a recording to analyse")
+    add_root_option(parser)
+    parser.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2 (recordings only)")
+    parser.add_argument("--model", metavar="EFFECTS", help="effect ids for a recording (default lr2,creep-log)")
+
+
+def add_commands(sub) -> None:
+    report = sub.add_parser("report", help="PDF and HTML report of one measurement")
+    _source_arguments(report)
+    report.add_argument("--pdf", metavar="FILE")
+    report.add_argument("--html", metavar="FILE")
+
+    export = sub.add_parser("export", help="parameters, curves and a driver file of one measurement")
+    _source_arguments(export)
+    for kind, what in EXPORT_OPTIONS:
+        export.add_argument(f"--{kind.replace('_', '-')}", dest=kind, metavar="FILE", help=what)
+
+
+def _is_recording(text: str) -> bool:
+    from analysis.recording import recording_paths
+    wav, sidecar = recording_paths(text)
+    return wav.is_file() and sidecar.is_file()
+
+
+def load_source(args):
+    """(StoredResult, header, settings, calibration) of the ID or PATH."""
+    if _is_recording(args.source):
+        from analysis.archive.results import stored_from_recording
+        from analysis.effects import parse_effects
+        try:
+            effects = parse_effects(args.model)
+        except KeyError as exc:
+            raise ValueError(f"--model: {exc.args[0]}") from None
+        stored, header, calibration = stored_from_recording(args.source, args.sd, effects)
+        return stored, header, None, calibration
+    if args.sd is not None or args.model is not None:
+        raise ValueError("--sd and --model apply to recordings; an archived measurement keeps its own")
+    from analysis.archive import Archive
+    archive = Archive(Path(args.root).expanduser() if args.root else None)
+    m = archive.get(args.source)
+    record = m.record
+    header = {k: record.get(k) for k in ("driver", "serial", "measured_at", "operator", "station", "id")}
+    return m.result(), header, m.load_json("settings"), m.load_json("calibration")
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.command == "report":
+        if not args.pdf and not args.html:
+            raise ValueError("report: give --pdf FILE and/or --html FILE")
+        from analysis.report import build_report, write_report
+        stored, header, settings, calibration = load_source(args)
+        written = write_report(build_report(stored, header, settings, calibration), args.pdf, args.html)
+    else:
+        targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
+        if not targets:
+            raise ValueError("export: give at least one of " + ", ".join(
+                f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
+        from analysis.export import write_exports
+        stored, header, _, _ = load_source(args)
+        written = write_exports(stored, targets, header)
+    for path in written:
+        print(f"written: {path}")
+    return 0
+
+
+def user_errors() -> tuple[type[BaseException], ...]:
+    from analysis.archive import ArchiveError
+    from analysis.archive.results import ResultsFormatError
+    from analysis.export import ExportError
+    from analysis.fit import FitError
+    from analysis.recording import RecordingError
+    from analysis.spectra import SpectrumError
+    return (ArchiveError, ResultsFormatError, ExportError, RecordingError, SpectrumError, FitError, ValueError,
+            OSError, KeyError)

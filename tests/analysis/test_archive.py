@@ -1,0 +1,293 @@
+"""The archive: folders + SQLite index; the index survives deletion, garbage, truncation and wrong schemas."""
+import json
+import sqlite3
+
+import pytest
+
+from analysis.archive import Archive, ArchiveError, compare
+from analysis.archive.archive import FOLDERS
+from analysis.archive.index import INDEX_FILE
+from analysis.archive.names import folder_name, inside, safe_suffix, slug
+from analysis.archive.results import StoredResult, results_document
+from analysis.archive.schema import CURRENT_VERSION, MIGRATIONS
+from analysis.pipeline import analyze_recording
+from analysis.recording import read_recording, write_recording
+from tests.builders import TYPICAL_NOISE, recording
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory):
+    """(recording path, results document) of one short synthetic measurement."""
+    path = tmp_path_factory.mktemp("rec") / "paper"
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=3)
+    write_recording(path, rec)
+    return path, results_document(analyze_recording(rec), rec)
+
+
+def fill(root, measured, n=5, **meta):
+    path, doc = measured
+    archive = Archive(root)
+    ids = [archive.store(path, doc, {"serial": f"SN{i}", "operator": "ana", "station": "QA1", **meta})
+           for i in range(n)]
+    return archive, ids
+
+
+def test_store_writes_a_complete_folder_and_the_index_lists_it(tmp_path, measured):
+    archive, (mid,) = fill(tmp_path, measured, 1, driver="woofer 6", measured_at="2024-05-01T12:00:00+02:00")
+    m = archive.get(mid)
+    assert m.folder.parent == tmp_path / FOLDERS
+    assert sorted(p.name for p in m.folder.iterdir()) == ["calibration.json", "measurement.json", "recording.json",
+                                                          "recording.wav", "results.json", "settings.json"]
+    assert m.record["measured_at"] == "2024-05-01T10:00:00Z"
+    assert (m.folder / "recording.wav").read_bytes() == measured[0].with_suffix(".wav").read_bytes()
+    read_recording(m.recording_path())        # the stored recording is a valid recording
+    (entry,) = archive.list()
+    assert (entry.id, entry.driver, entry.serial, entry.operator, entry.station, entry.validity) == \
+           (mid, "woofer 6", "SN0", "ana", "QA1", "green")
+    assert entry.parameters["fs"]["unit"] == "Hz"
+    assert entry.parameters["fs"]["value"] == pytest.approx(70.5, rel=0.01)
+    stored = m.result()
+    assert stored.parameters["Bl"].value == measured[1]["parameters"]["Bl"]["value"]
+    assert archive.notes == []
+
+
+def test_store_takes_a_recording_object_and_an_analysis_result(tmp_path):
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=4)
+    result = analyze_recording(rec)
+    archive = Archive(tmp_path)
+    mid = archive.store(rec, result, {"serial": "X"}, laser_stream=__file__)
+    m = archive.get(mid)
+    assert m.entry.driver == "synthetic"            # from the recording's sidecar
+    assert m.path("laser_stream").name == "laser.py"
+    assert isinstance(m.result(), StoredResult)
+
+
+def test_list_filters_and_limits(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 4)
+    archive.store(measured[0], measured[1], {"driver": "tweeter_x%", "serial": "T1", "operator": "ben"})
+    assert len(archive.list()) == 5
+    assert [e.serial for e in archive.list(driver="TWEETER_X%")] == ["T1"]
+    assert archive.list(driver="%") == archive.list(driver="tweeter_x%")   # '%' is literal, not a wildcard
+    assert len(archive.list(operator="ana")) == 4
+    assert len(archive.list(limit=2)) == 2
+    assert archive.list(validity="red") == []
+    assert len(archive.list(since="2000-01-01", until="2999-12-31")) == 5
+
+
+def test_ids_resolve_by_unique_prefix(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 2)
+    assert archive.get(ids[0][:-1]).id == ids[0] or ids[0][:-1] == ids[1][:-1]
+    with pytest.raises(ArchiveError, match="matches 2"):
+        archive.get(ids[0][:8])      # same day: both match
+    with pytest.raises(ArchiveError, match="no measurement"):
+        archive.get("19990101")
+
+
+@pytest.mark.parametrize("bad", ["../x", "../../etc/passwd", "/etc/passwd", "a\x00b", "..", "", "20240101/../.."])
+def test_ids_that_are_paths_are_refused(tmp_path, measured, bad):
+    archive, _ = fill(tmp_path, measured, 1)
+    with pytest.raises(ArchiveError, match="not a measurement id"):
+        archive.get(bad)
+
+
+@pytest.mark.parametrize("evil", ["../../outside", "/etc/passwd", "a\x00b/../../c", "..", "C:\\Windows\\x",
+                                  "ünïcödé / ≠ \\ : * ? \" < > |", "-" * 300])
+def test_names_from_users_never_place_anything_outside_the_root(tmp_path, measured, evil):
+    root = tmp_path / "archive"
+    archive = Archive(root)
+    mid = archive.store(measured[0], measured[1], {"driver": evil, "serial": evil, "operator": evil,
+                                                   "station": evil}, laser_stream=_evil_file(tmp_path, evil))
+    m = archive.get(mid)
+    assert m.folder.parent == root / FOLDERS
+    assert all(c.isalnum() or c == "-" for c in m.folder.name)
+    assert "\x00" not in m.entry.driver
+    outside = [p for p in tmp_path.rglob("*") if root not in p.parents and p != root and p.name != "evil-src"]
+    assert outside == []
+
+
+def _evil_file(tmp_path, evil):
+    src = tmp_path / "evil-src"
+    src.write_bytes(b"laser bytes")
+    return src
+
+
+def test_inside_refuses_escapes(tmp_path):
+    for bad in ("../x", "/abs", "a/../../b", "x\x00y", ""):
+        with pytest.raises(ArchiveError):
+            inside(tmp_path, bad)
+    assert inside(tmp_path, "a/b") == (tmp_path / "a" / "b").resolve()
+    assert slug("../../Etc/Passwd\x00") == "etc-passwd"
+    assert folder_name("20240101-000000-abcdef", "../..", "") == "20240101-000000-abcdef"
+    assert safe_suffix("x.B!N\x00") == ".bn" and safe_suffix("noext") == ".bin"
+
+
+def _corrupt_garbage(db):
+    db.write_bytes(b"this is not a database\x00" * 50)
+
+
+def _corrupt_truncated(db):
+    data = db.read_bytes()
+    db.write_bytes(data[: len(data) // 3])
+
+
+def _corrupt_header(db):
+    data = bytearray(db.read_bytes())
+    data[100:4096] = b"\xff" * (4096 - 100)   # the first page's b-tree header and cells
+    db.write_bytes(bytes(data))
+
+
+def _corrupt_empty(db):
+    db.write_bytes(b"")
+
+
+def _corrupt_deleted(db):
+    db.unlink()
+
+
+def _wrong_schema(db):
+    db.unlink()
+    conn = sqlite3.connect(db)
+    conn.execute("CREATE TABLE something_else (x INTEGER)")
+    conn.commit()
+    conn.close()
+
+
+def _newer_schema(db):
+    conn = sqlite3.connect(db)
+    conn.execute("UPDATE schema_version SET version = 999")
+    conn.commit()
+    conn.close()
+
+
+def _missing_column(db):
+    conn = sqlite3.connect(db)
+    conn.execute("DROP TABLE parameters")
+    conn.execute("CREATE TABLE parameters (measurement_id TEXT)")
+    conn.commit()
+    conn.close()
+
+
+@pytest.mark.parametrize("damage", [_corrupt_garbage, _corrupt_truncated, _corrupt_header, _corrupt_empty,
+                                    _corrupt_deleted, _wrong_schema, _newer_schema, _missing_column])
+def test_a_damaged_index_is_rebuilt_from_the_folders_without_losing_a_measurement(tmp_path, measured, damage):
+    archive, ids = fill(tmp_path, measured, 6)
+    before = {e.id: e for e in archive.list()}
+    damage(tmp_path / INDEX_FILE)
+    fresh = Archive(tmp_path)
+    after = {e.id: e for e in fresh.list()}
+    assert after == before and set(after) == set(ids)
+    assert any("index rebuilt" in n for n in fresh.notes), fresh.notes
+    assert fresh.get(ids[3]).id == ids[3]
+    conn = sqlite3.connect(tmp_path / INDEX_FILE)
+    assert conn.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
+    assert conn.execute("SELECT version FROM schema_version").fetchone()[0] == CURRENT_VERSION
+
+
+def test_folders_stored_or_removed_behind_the_index_are_noticed(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 3)
+    removed = archive.get(ids[1]).folder
+    # A program that crashed between writing the folder and indexing it: an index without the folder's row.
+    conn = sqlite3.connect(tmp_path / INDEX_FILE)
+    with conn:
+        conn.execute("DELETE FROM measurements WHERE id = ?", (ids[0],))
+    conn.close()
+    for f in removed.iterdir():
+        f.unlink()
+    removed.rmdir()
+    fresh = Archive(tmp_path)
+    assert {e.id for e in fresh.list()} == {ids[0], ids[2]}
+    assert any("1 added, 1 removed" in n for n in fresh.notes), fresh.notes
+
+
+def test_rebuild_skips_an_unreadable_folder_and_keeps_the_others(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 3)
+    broken = archive.get(ids[0]).folder / "measurement.json"
+    broken.write_text("{ not json")
+    report = archive.rebuild()
+    assert report.indexed == 2 and len(report.skipped) == 1 and str(broken) in report.skipped[0]
+    assert broken.exists()                       # never deleted
+    assert {e.id for e in archive.list()} == set(ids[1:])
+
+
+def test_an_index_of_schema_version_1_is_migrated_in_place(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 2)
+    db = tmp_path / INDEX_FILE
+    db.unlink()
+    conn = sqlite3.connect(db)
+    conn.execute("CREATE TABLE schema_version (version INTEGER NOT NULL)")
+    conn.execute("INSERT INTO schema_version VALUES (1)")
+    MIGRATIONS[0](conn)
+    conn.execute("INSERT INTO measurements VALUES (?, ?, '2024-01-01T00:00:00Z', '2024-01-01T00:00:00Z', 'd', 's', "
+                 "'o', 'st', 'green')", ("19990101-000000-abcdef", "a-folder-that-is-gone"))
+    conn.commit()
+    conn.close()
+    fresh = Archive(tmp_path)
+    entries = fresh.list()
+    conn = sqlite3.connect(db)
+    assert conn.execute("SELECT version FROM schema_version").fetchone()[0] == CURRENT_VERSION
+    columns = {row[1] for row in conn.execute("PRAGMA table_info(measurements)")}
+    assert "effects" in columns
+    # Migrated, not rebuilt: the v1 row survived, then the folder sync replaced it by the folders' truth.
+    assert not any("index rebuilt" in n for n in fresh.notes)
+    assert {e.id for e in entries} == set(ids)
+
+
+def test_measurement_json_alone_rebuilds_the_index_entry(tmp_path, measured):
+    archive, (mid,) = fill(tmp_path, measured, 1)
+    record = json.loads((archive.get(mid).folder / "measurement.json").read_text())
+    for key in ("id", "folder", "driver", "serial", "operator", "station", "measured_at", "validity",
+                "key_parameters"):
+        assert key in record
+    (tmp_path / INDEX_FILE).unlink()
+    assert Archive(tmp_path).list()[0].as_json() == archive.list()[0].as_json()
+
+
+def test_export_copies_the_folder(tmp_path, measured):
+    archive, (mid,) = fill(tmp_path / "a", measured, 1)
+    target = archive.export(mid, tmp_path / "out")
+    assert sorted(p.name for p in target.iterdir()) == sorted(p.name for p in archive.get(mid).folder.iterdir())
+    with pytest.raises(ArchiveError, match="already exists"):
+        archive.export(mid, tmp_path / "out")
+
+
+def test_compare_up_to_eight(tmp_path, measured):
+    archive, ids = fill(tmp_path, measured, 3)
+    c = compare(archive, ids)
+    fs = next(r for r in c.rows if r.name == "fs")
+    assert fs.display_unit == "Hz" and len(fs.values) == 3
+    assert fs.deviation_percent == (0.0, 0.0, 0.0) and fs.spread == 0.0
+    mms = next(r for r in c.rows if r.name == "Mms")
+    assert mms.values[0] == pytest.approx(measured[1]["parameters"]["Mms"]["value"] * 1e3)
+    with pytest.raises(ArchiveError, match="1 to 8"):
+        compare(archive, ids * 3)
+    with pytest.raises(ArchiveError, match="twice"):
+        compare(archive, [ids[0], ids[0]])
+
+
+def test_reading_a_missing_archive_creates_nothing(tmp_path):
+    archive = Archive(tmp_path / "none")
+    assert archive.list() == []
+    with pytest.raises(ArchiveError, match="no archive"):
+        archive.get("2024")
+    assert not (tmp_path / "none").exists()
+
+
+def test_meta_is_checked(tmp_path, measured):
+    archive = Archive(tmp_path)
+    with pytest.raises(ArchiveError, match="unknown key"):
+        archive.store(measured[0], measured[1], {"colour": "red"})
+    with pytest.raises(ArchiveError, match="ISO 8601"):
+        archive.store(measured[0], measured[1], {"measured_at": "yesterday"})
+    assert not any((tmp_path / FOLDERS).iterdir())     # nothing half-stored
+
+
+def test_layers_archive_loads_no_numpy_and_report_export_load_no_qt():
+    import subprocess
+    import sys
+    code = ("import sys, analysis.archive, analysis.archive.index;"
+            "assert 'numpy' not in sys.modules, 'numpy';"
+            "import analysis.report.pdf, analysis.report.html, analysis.export, analysis.limits;"
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('PySide6', 'pyqtgraph', 'app', 'instruments')];"
+            "assert not bad, bad;"
+            "import matplotlib; assert 'qt' not in matplotlib.get_backend().lower()")
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -1,0 +1,98 @@
+"""QA limits: parsing with one-line errors naming file, line and key; pass/fail per parameter."""
+import json
+
+import pytest
+
+from analysis.derived import ParameterValue
+from analysis.limits import LimitsError, judge_result, load_limits
+
+
+def write(tmp_path, doc, name="limits.json"):
+    path = tmp_path / name
+    path.write_text(doc if isinstance(doc, str) else json.dumps(doc, indent=2))
+    return path
+
+
+def limits_doc(**parameters):
+    return {"format": "linpar-limits/1", "name": "test", "parameters": parameters}
+
+
+def pv(name, value, unit, display_unit, scale, reason=None):
+    return ParameterValue(name, value, None if value is None else 0.01 * abs(value), unit, display_unit, scale, reason)
+
+
+PARAMS = {"RE": pv("RE", 3.02, "ohm", "ohm", 1.0), "fs": pv("fs", 70.5, "Hz", "Hz", 1.0),
+          "Mms": pv("Mms", 11.87e-3, "kg", "g", 1e3), "Cms": pv("Cms", 0.43e-3, "m/N", "mm/N", 1e3),
+          "LE": pv("LE", 0.132e-3, "H", "mH", 1e3), "Qts": pv("Qts", 0.46, "1", "-", 1.0),
+          "Bl": pv("Bl", None, "T*m", "T*m", 1.0, "not identifiable without displacement")}
+
+
+def verdicts(tmp_path, validity="green", **parameters):
+    doc = judge_result(load_limits(write(tmp_path, limits_doc(**parameters))), PARAMS, validity)
+    return doc["verdict"], {p["parameter"]: p["pass"] for p in doc["parameters"]}
+
+
+def test_nominal_and_percent_or_absolute_tolerance(tmp_path):
+    assert verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "1%", "unit": "ohm"}) == ("pass", {"RE": True})
+    assert verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "0.5%", "unit": "ohm"}) == ("fail", {"RE": False})
+    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.5, "unit": "Hz"})[0] == "pass"
+    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.4, "unit": "Hz"})[0] == "fail"
+
+
+def test_customary_and_si_units_give_the_same_verdict(tmp_path):
+    for unit, lo, hi in (("g", 11.8, 11.9), ("kg", 11.8e-3, 11.9e-3)):
+        assert verdicts(tmp_path, Mms={"min": lo, "max": hi, "unit": unit})[0] == "pass"
+    assert verdicts(tmp_path, LE={"max": 0.13, "unit": "mH"})[0] == "fail"
+    assert verdicts(tmp_path, LE={"max": 0.14e-3, "unit": "H"})[0] == "pass"
+    assert verdicts(tmp_path, Cms={"min": 0.4, "unit": "mm/N"})[0] == "pass"
+    assert verdicts(tmp_path, Qts={"nominal": 0.46, "tolerance": "5%", "unit": "-"})[0] == "pass"
+
+
+def test_overall_fails_when_any_fails_and_missing_parameters_fail(tmp_path):
+    verdict, each = verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+                             Bl={"min": 5, "unit": "T*m"})
+    assert verdict == "fail" and each == {"RE": True, "Bl": False}
+
+
+def test_a_red_measurement_is_invalid_not_pass_or_fail(tmp_path):
+    assert verdicts(tmp_path, "red", RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})[0] == "invalid"
+    assert verdicts(tmp_path, "yellow", RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})[0] == "pass"
+
+
+BAD = [
+    ('{"format": "linpar-limits/1", "parameters": {\n  "RE": {"nominal": 3,}\n}}', r"line 2 column \d+: .*expected JSON"),
+    (limits_doc(), r"parameters: expected an object"),
+    ({"format": "other", "parameters": {}}, r"line 2: format: found 'other', expected 'linpar-limits/1'"),
+    (limits_doc(XYZ={"min": 1, "unit": "ohm"}), r"line \d+: parameters.XYZ: unknown parameter"),
+    (limits_doc(RE={"min": 1}), r"parameters.RE.unit: found None, expected 'ohm'"),
+    (limits_doc(Mms={"min": 1, "unit": "lb"}), r"parameters.Mms.unit: found 'lb', expected 'kg' \(SI\) or 'g'"),
+    (limits_doc(RE={"nominal": 3, "unit": "ohm"}), r"parameters.RE.tolerance: missing"),
+    (limits_doc(RE={"nominal": 3, "tolerance": "five", "unit": "ohm"}), r"parameters.RE.tolerance: found 'five'"),
+    (limits_doc(RE={"nominal": 3, "tolerance": -1, "unit": "ohm"}), r"parameters.RE.tolerance: found -1"),
+    (limits_doc(RE={"nominal": "3", "tolerance": 1, "unit": "ohm"}), r"parameters.RE.nominal: found '3', expected a number"),
+    (limits_doc(RE={"min": 4, "max": 3, "unit": "ohm"}), r"parameters.RE: min 4 is above max 3"),
+    (limits_doc(RE={"unit": "ohm"}), r"parameters.RE: expected nominal and tolerance, or min and/or max"),
+    (limits_doc(RE={"nominal": 3, "tolerance": 1, "min": 2, "unit": "ohm"}), r"not both"),
+    (limits_doc(RE={"min": 2, "unit": "ohm", "tol": 1}), r"parameters.RE.tol: unknown key"),
+    (limits_doc(RE=[1, 2]), r"parameters.RE: expected an object"),
+    ('{"format": "linpar-limits/1", "parameters": {"RE": {"min": NaN, "unit": "ohm"}}}', r"NaN is not a number"),
+    ("[1, 2]", r"\(top level\): expected a JSON object"),
+]
+
+
+@pytest.mark.parametrize("doc, message", BAD)
+def test_a_bad_limits_file_gives_one_line_naming_file_line_and_key(tmp_path, doc, message):
+    path = write(tmp_path, doc)
+    with pytest.raises(LimitsError, match=message) as err:
+        load_limits(path)
+    text = str(err.value)
+    assert text.startswith(str(path)) and "\n" not in text
+
+
+def test_unreadable_file(tmp_path):
+    with pytest.raises(LimitsError, match="cannot be read"):
+        load_limits(tmp_path / "missing.json")
+    path = tmp_path / "latin.json"
+    path.write_bytes(b'{"name": "\xe9"}')
+    with pytest.raises(LimitsError, match="not UTF-8"):
+        load_limits(path)

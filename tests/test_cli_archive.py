@@ -1,0 +1,128 @@
+"""`linpar archive`, `linpar report`, `linpar export` and `linpar analyze --limits`: output and exit codes."""
+import json
+
+import pytest
+
+from analysis.importers import read_curve
+from analysis.recording import write_recording
+from app.cli import main
+from instruments.simulation import faults
+from tests.builders import TYPICAL_NOISE, recording
+
+
+@pytest.fixture(scope="module")
+def rec_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rec") / "paper"
+    write_recording(path, recording(noise=TYPICAL_NOISE, n_periods=3, seed=21))
+    return path
+
+
+@pytest.fixture(scope="module")
+def red_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rec") / "red"
+    write_recording(path, faults.laser_errors())
+    return path
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def root(tmp_path, monkeypatch):
+    monkeypatch.setenv("LINPAR_ARCHIVE", str(tmp_path / "archive"))
+    return tmp_path / "archive"
+
+
+def store(capsys, path, *extra):
+    code, out, err = run(capsys, "archive", "store", path, "--json", *extra)
+    assert code == 0, err
+    return json.loads(out)["id"]
+
+
+def test_store_list_show_rebuild(capsys, root, rec_path):
+    mid = store(capsys, rec_path, "--serial", "SN1", "--operator", "ana", "--driver", "W6")
+    code, out, err = run(capsys, "archive", "list")
+    assert code == 0 and mid in out and "W6" in out and "1 measurement(s)" in out
+    code, out, _ = run(capsys, "archive", "list", "--json", "--serial", "nomatch")
+    assert json.loads(out) == []
+    code, out, _ = run(capsys, "archive", "show", mid[:-2])
+    assert code == 0 and "SN1" in out and "recording.wav" in out
+    (root / "index.sqlite").write_bytes(b"garbage" * 10)
+    code, out, err = run(capsys, "archive", "list", "--json")
+    assert [e["id"] for e in json.loads(out)] == [mid] and "index rebuilt" in err
+    code, out, _ = run(capsys, "archive", "rebuild", "--json")
+    assert json.loads(out) == {"indexed": 1, "skipped": []}
+
+
+def test_root_option_overrides_the_environment(capsys, root, rec_path, tmp_path):
+    other = tmp_path / "other"
+    code, out, err = run(capsys, "archive", "store", rec_path, "--root", other)
+    assert code == 0, err
+    code, out, _ = run(capsys, "archive", "list", "--root", other, "--json")
+    assert len(json.loads(out)) == 1
+    assert not root.exists()
+
+
+def test_export_folder_and_bad_ids(capsys, root, rec_path, tmp_path):
+    mid = store(capsys, rec_path)
+    code, out, _ = run(capsys, "archive", "export", mid, tmp_path / "out")
+    assert code == 0 and (tmp_path / "out").is_dir()
+    for bad in ("../../etc", "/etc/passwd", "nothing-like-an-id"):
+        code, out, err = run(capsys, "archive", "show", bad)
+        assert code == 2 and err.startswith("linpar: error:") and err.count("\n") == 1
+
+
+def test_compare(capsys, root, rec_path):
+    ids = [store(capsys, rec_path, "--serial", f"S{i}") for i in range(2)]
+    code, out, _ = run(capsys, "archive", "compare", *ids, "--json")
+    doc = json.loads(out)
+    assert code == 0 and doc["ids"] == ids and any(r["name"] == "Qts" for r in doc["rows"])
+
+
+def test_report_from_path_and_id(capsys, root, rec_path, tmp_path):
+    code, out, err = run(capsys, "report", rec_path, "--html", tmp_path / "a.html")
+    assert code == 0, err
+    assert "<svg" in (tmp_path / "a.html").read_text()
+    mid = store(capsys, rec_path, "--serial", "SN9")
+    code, out, err = run(capsys, "report", mid, "--pdf", tmp_path / "b.pdf")
+    assert code == 0, err
+    assert (tmp_path / "b.pdf").read_bytes().startswith(b"%PDF")
+    code, out, err = run(capsys, "report", mid)
+    assert code == 2 and "--pdf" in err
+
+
+def test_export_every_kind(capsys, root, rec_path, tmp_path):
+    files = {k: tmp_path / f"x.{k}" for k in ("csv", "json", "zma", "frd", "driver")}
+    args = [a for k, f in files.items() for a in (f"--{k}", f)]
+    code, out, err = run(capsys, "export", rec_path, *args, "--zma-model", tmp_path / "m.zma")
+    assert code == 0, err
+    assert read_curve(files["zma"]).transfer.freqs.size > 10
+    assert files["driver"].read_bytes().startswith(b"[Driver]\r\n")
+    code, out, err = run(capsys, "export", rec_path)
+    assert code == 2 and "--csv" in err
+
+
+def write_limits(tmp_path, **params):
+    path = tmp_path / "limits.json"
+    path.write_text(json.dumps({"format": "linpar-limits/1", "parameters": params}))
+    return path
+
+
+def test_analyze_limits_exit_codes(capsys, rec_path, red_path, tmp_path):
+    ok = write_limits(tmp_path, fs={"nominal": 70.5, "tolerance": "2%", "unit": "Hz"},
+                      Mms={"min": 11, "max": 13, "unit": "g"})
+    code, out, err = run(capsys, "analyze", rec_path, "--limits", ok)
+    assert code == 0 and "QA: PASS" in out
+    bad = write_limits(tmp_path, fs={"nominal": 50, "tolerance": "2%", "unit": "Hz"})
+    code, out, err = run(capsys, "analyze", rec_path, "--limits", bad, "--json")
+    doc = json.loads(out)
+    assert code == 1 and doc["limits"]["verdict"] == "fail" and doc["limits"]["parameters"][0]["pass"] is False
+    code, out, err = run(capsys, "analyze", red_path, "--limits", ok)
+    assert code == 2 and "INVALID" in out
+    broken = write_limits(tmp_path, fs={"nominal": 50, "unit": "Hz"})
+    code, out, err = run(capsys, "analyze", rec_path, "--limits", broken)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and str(broken) in err and "parameters.fs.tolerance" in err and "line " in err
