@@ -63,6 +63,9 @@ def build_parser() -> argparse.ArgumentParser:
     cli_archive.add_commands(sub)
     cli_report.add_commands(sub)
 
+    from app import cli_levels
+    cli_levels.add_commands(sub)
+
     effects = sub.add_parser("effects", help="list the effects catalogue")
     effects.add_argument("--json", action="store_true")
 
@@ -71,18 +74,9 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _archive_parser() -> argparse.ArgumentParser:
-    """`linpar archive` alone: listing must not wait for the other commands' imports (the rig loads scipy)."""
-    from app import cli_archive
-    parser = _Parser(prog="linpar")
-    cli_archive.add_commands(parser.add_subparsers(dest="command", required=True, parser_class=_Parser))
-    return parser
-
-
 def main(argv: Sequence[str] | None = None) -> int:
-    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = (_archive_parser() if argv[:1] == ["archive"] else build_parser()).parse_args(argv)
+        args = build_parser().parse_args(argv)
         return _run(args)
     except CliError as exc:
         print(f"linpar: error: {exc}", file=sys.stderr)
@@ -97,13 +91,19 @@ def _run(args: argparse.Namespace) -> int:
         from app import cli_rig
         try:
             return cli_rig.run(args)
-        except cli_rig.USER_ERRORS as exc:
+        except cli_rig.user_errors() as exc:
             raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
     if args.command in ("archive", "report", "export"):
         from app import cli_archive, cli_report
         try:
             return cli_archive.run(args) if args.command == "archive" else cli_report.run(args)
         except cli_report.user_errors() as exc:
+            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+    if args.command == "levels":
+        from app import cli_levels
+        try:
+            return cli_levels.run(args)
+        except cli_levels.user_errors() as exc:
             raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
     if args.command == "gui":
         from app.main import run_gui

@@ -15,12 +15,20 @@ import argparse
 import json
 from pathlib import Path
 
-from instruments.rig import manager
-from instruments.rig.control import ControlError
 
 EXIT_OK, EXIT_NOT_RUNNING = 0, 1
 # Errors shown to the user as one line (exit 2) by app.cli.
-USER_ERRORS = (manager.RigError, ControlError, ValueError, OSError)
+def _manager():
+    """instruments.rig.manager, imported on use: it loads scipy, which plain `linpar` commands do not need."""
+    from instruments.rig import manager
+    return manager
+
+
+def user_errors() -> tuple[type[BaseException], ...]:
+    """The errors a user must fix; imported here so that building the parser loads no rig code."""
+    from instruments.rig import manager
+    from instruments.rig.control import ControlError
+    return (manager.RigError, ControlError, ValueError, OSError)
 
 
 def add_commands(sub) -> None:
@@ -53,7 +61,7 @@ def add_commands(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run one `linpar rig` action; USER_ERRORS for what the user must fix."""
+    """Run one `linpar rig` action; user_errors() for what the user must fix."""
     if args.rig_action == "start":
         return _start(args)
     if args.rig_action == "status":
@@ -61,26 +69,26 @@ def run(args: argparse.Namespace) -> int:
     if args.rig_action == "fault":
         return _fault(args)
     if args.rig_action == "stop":
-        stopped = manager.stop_rig(args.name, args.runtime_dir)
+        stopped = _manager().stop_rig(args.name, args.runtime_dir)
         print(f"rig {args.name!r} stopped" if stopped else f"rig {args.name!r} is not running")
         return EXIT_OK
     raise KeyError(f"unknown rig action {args.rig_action!r}")
 
 
 def _start(args) -> int:
-    handle = manager.start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir)
+    handle = _manager().start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir)
     if args.json:
         print(handle.state.to_json())
         return EXIT_OK
     if handle.already_running:
         print(f"rig {args.name!r} is already running (pid {handle.pid}); not started again")
-    status = manager.rig_status(args.name, args.runtime_dir)
+    status = _manager().rig_status(args.name, args.runtime_dir)
     print(format_status(status))
     return EXIT_OK
 
 
 def _status(args) -> int:
-    status = manager.rig_status(args.name, args.runtime_dir)
+    status = _manager().rig_status(args.name, args.runtime_dir)
     if args.json:
         print(json.dumps({"running": status is not None, **(status or {})}, indent=1))
     else:
@@ -89,9 +97,9 @@ def _status(args) -> int:
 
 
 def _fault(args) -> int:
-    handle = manager.find_rig(args.name, args.runtime_dir)
+    handle = _manager().find_rig(args.name, args.runtime_dir)
     if handle is None:
-        raise manager.RigError(f"rig {args.name!r} is not running (start it with 'linpar rig start')")
+        raise _manager().RigError(f"rig {args.name!r} is not running (start it with 'linpar rig start')")
     if args.clear or args.specs:
         reply = handle.command("fault", set=list(args.specs), clear=bool(args.clear))
         print(f"faults: {', '.join(reply['faults']) or 'none'}")
