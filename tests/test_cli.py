@@ -1,0 +1,121 @@
+"""The `linpar` command line: output, JSON shape, exit codes, one-line errors."""
+import json
+import subprocess
+import sys
+
+import pytest
+
+from analysis.recording import write_recording
+from app.cli import main
+from tests.builders import PAPER, TYPICAL_NOISE, recording
+
+PARAMETER_NAMES = "RE LE L2 R2 CMES LCES RES fs Mms Rms Cms Kms Bl lambda Qes Qms Qts Vas".split()
+
+
+@pytest.fixture(scope="module")
+def rec_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rec") / "paper"
+    write_recording(path, recording(noise=TYPICAL_NOISE, n_periods=4, seed=11))
+    return path
+
+
+@pytest.fixture(scope="module")
+def z_only_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("rec") / "zonly"
+    write_recording(path, recording(noise=TYPICAL_NOISE, n_periods=4, seed=12, displacement=False))
+    return path
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_analyze_json_has_every_parameter_in_si_with_its_std(capsys, rec_path):
+    code, out, err = run(capsys, "analyze", str(rec_path) + ".wav", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert set(doc) == {"parameters", "model", "validity"}
+    for name in PARAMETER_NAMES:
+        assert doc["parameters"][name]["value"] is not None, name
+        assert doc["parameters"][name]["std"] > 0, name
+    assert doc["parameters"]["RE"]["unit"] == "ohm"
+    assert doc["parameters"]["Bl"]["value"] == pytest.approx(PAPER.parameters["Bl"], rel=1e-3)
+    assert doc["model"]["effects"] == ["lr2", "creep-log"]
+    assert set(doc["model"]["chi2_red"]) == {"impedance", "displacement"}
+    assert doc["model"]["bic"] > doc["model"]["aic"] > 0
+    assert "overall" in doc["validity"]
+
+
+def test_analyze_table_shows_customary_units(capsys, rec_path):
+    code, out, _ = run(capsys, "analyze", str(rec_path), "--model", "lr2,creep-log")
+    assert code == 0
+    mms_line = next(line for line in out.splitlines() if line.startswith("Mms"))
+    assert mms_line.split()[-1] == "g" and float(mms_line.split()[1]) == pytest.approx(11.84, abs=0.05)
+    assert "reduced chi^2" in out
+
+
+def test_without_displacement_mechanical_parameters_are_null_with_a_reason(capsys, z_only_path):
+    code, out, _ = run(capsys, "analyze", str(z_only_path) + ".json", "--json")
+    assert code == 0
+    doc = json.loads(out)
+    for name in ("Bl", "Mms", "Cms"):
+        assert doc["parameters"][name]["value"] is None
+        assert "displacement" in doc["parameters"][name]["reason"]
+    assert doc["parameters"]["Qts"]["value"] is not None
+    assert list(doc["model"]["chi2_red"]) == ["impedance"]
+
+
+def test_textbook_model_on_request(capsys, rec_path):
+    code, out, _ = run(capsys, "analyze", str(rec_path), "--model", "none", "--json")
+    doc = json.loads(out)
+    assert doc["model"]["effects"] == []
+    assert "L2" not in doc["parameters"]
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["analyze", "/nonexistent/rec"], "rec"),
+    (["analyze"], "path"),
+    (["analyze", "REC", "--model", "nonsense"], "nonsense"),
+    (["analyze", "REC", "--sd", "-1"], "positive"),
+    (["frobnicate"], "frobnicate"),
+])
+def test_bad_use_exits_2_with_one_line(capsys, rec_path, argv, words):
+    argv = [str(rec_path) if a == "REC" else a for a in argv]
+    code, out, err = run(capsys, *argv)
+    assert code == 2
+    assert out == ""
+    assert len(err.strip().splitlines()) == 1 and words in err and "Traceback" not in err
+
+
+def test_a_bad_recording_is_refused_with_exit_2(capsys, tmp_path, rec_path):
+    (tmp_path / "bad.wav").write_bytes((rec_path.parent / "paper.wav").read_bytes()[:1000])
+    (tmp_path / "bad.json").write_text((rec_path.parent / "paper.json").read_text())
+    code, _, err = run(capsys, "analyze", str(tmp_path / "bad"))
+    assert code == 2 and "bad.wav" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_installed_command_runs_as_a_process(rec_path):
+    proc = subprocess.run([sys.executable, "-m", "app.cli", "analyze", str(rec_path), "--json"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["parameters"]["fs"]["value"] == pytest.approx(70.56, rel=1e-3)
+
+
+def test_diagnose_json_finds_the_missing_creep(capsys, rec_path):
+    code, out, err = run(capsys, "diagnose", str(rec_path), "--from", "lr2", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["start"]["effects"] == ["lr2"]
+    assert doc["candidates"][0]["category"] == "creep"
+    assert doc["candidates"][0]["delta_bic"] < -10
+    assert doc["final"]["effects"][:1] == ["lr2"] and any("creep" in e for e in doc["final"]["effects"])
+    assert doc["final"]["chi2_red"]["displacement"] < 2
+    assert len(doc["steps"]) >= 2
+
+
+def test_the_effects_catalogue_is_listed(capsys):
+    code, out, _ = run(capsys, "effects", "--json")
+    ids = {e["id"] for e in json.loads(out)}
+    assert {"lr2", "creep-log"} <= ids
