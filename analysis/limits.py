@@ -37,7 +37,9 @@ ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
 # Spellings of units that mean the same thing.
 _ALIASES = {"Ω": "ohm", "ohms": "ohm", "µF": "uF", "μF": "uF", "L": "l", "m3": "m^3", "": "1", "-": "1",
             "Tm": "T*m", "T·m": "T*m", "N/A": "T*m", "dB SPL": "dB"}
-_PERCENT = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*%\s*$")
+# (?:[0-9]*\.)?[0-9]+ rather than [0-9]*\.?[0-9]+: the same numbers, but a long run of digits cannot be
+# split between two quantifiers in n ways, so a refused string costs linear, not quadratic, time.
+_PERCENT = re.compile(r"^\s*((?:[0-9]*\.)?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*%\s*$")
 
 
 class LimitsError(ValueError):
@@ -110,6 +112,8 @@ def _line_of(text: str, key: str, after: int = 0) -> int:
 def load_limits(path: str | Path) -> Limits:
     path = Path(path)
     try:
+        if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
+            raise LimitsError(f"{path}: not a regular file: expected a JSON limits file")
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise LimitsError(f"{path}: cannot be read ({exc.strerror or exc})") from None
@@ -121,7 +125,22 @@ def load_limits(path: str | Path) -> Limits:
         raise LimitsError(f"{path}: line {exc.lineno} column {exc.colno}: {exc.msg}: expected JSON") from None
     except ValueError as exc:
         raise LimitsError(f"{path}: {exc}") from None
+    except RecursionError:
+        raise LimitsError(f"{path}: JSON nested too deeply: expected a JSON limits file") from None
+    try:
+        # Valid JSON may escape half of a UTF-16 pair ("\\ud800"): text that no report or terminal can show.
+        json.dumps(doc, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise LimitsError(f"{path}: a string holds {exc.object[exc.start:exc.end]!r}, half of a UTF-16 "
+                          "surrogate pair: expected Unicode text") from None
     return parse_limits(doc, text, path)
+
+
+def _finite(value: int | float) -> bool:
+    try:
+        return math.isfinite(value)
+    except OverflowError:       # an integer beyond the float range
+        return False
 
 
 def _refuse_constant(name: str):
@@ -166,7 +185,7 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
             v = entry.get(k)
             if v is None:
                 return None
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not _finite(v):
                 fail(line, f"{key}.{k}", f"found {v!r}, expected a number in {unit}")
             return float(v)
 
@@ -181,7 +200,7 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
             if m:
                 delta = abs(nominal) * float(m.group(1)) / 100.0
                 said = f"{nominal:g} {shown_unit} ± {m.group(1)} %".replace("  ", " ")
-            elif isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and math.isfinite(tolerance) \
+            elif isinstance(tolerance, (int, float)) and not isinstance(tolerance, bool) and _finite(tolerance) \
                     and tolerance >= 0:
                 delta = float(tolerance)
                 said = f"{nominal:g} ± {delta:g} {shown_unit}".rstrip()
@@ -202,6 +221,8 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
                 said = (f"≥ {low:g} {shown_unit}" if high is None else f"≤ {high:g} {shown_unit}").rstrip()
         lo_si = None if low is None else low * to_si
         hi_si = None if high is None else high * to_si
+        if not all(math.isfinite(v) for v in (lo_si, hi_si) if v is not None):
+            fail(line, key, f"the limits overflow ({said}): expected finite bounds")
         limits.append(Limit(name, unit, to_si, lo_si, hi_si, said))
     return Limits(path, str(doc.get("name") or path.stem), tuple(limits))
 

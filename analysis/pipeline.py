@@ -10,9 +10,9 @@ from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.fit import FitData, FitResult, fit_model
 from analysis.model import Model
-from analysis.recording import Recording, read_recording
+from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, estimate_spectra
-from analysis.validity import assess
+from analysis.validity import CaptureInfo, CaptureInfoError, assess, capture_of
 
 
 @dataclass(frozen=True)
@@ -43,14 +43,24 @@ def resolve_sd(recording: Recording, sd_m2: float | None) -> float | None:
 def analyze_recording(recording: Recording, sd_m2: float | None = None,
                       effects: Sequence[Effect] | None = None,
                       cancel: threading.Event | None = None) -> AnalysisResult:
+    capture = checked_capture(recording)      # before the fit: a sidecar that cannot be judged is refused at once
     spectra = estimate_spectra(recording)
     data = FitData.from_spectra(spectra)
     model = Model(tuple(default_effects() if effects is None else effects),
                   with_displacement=data.displacement is not None)
     fit = fit_model(data, model, cancel=cancel)
     sd = resolve_sd(recording, sd_m2)
-    validity = assess(recording, spectra).as_json()      # per channel, with the peak excursion
+    validity = assess(recording, spectra, capture).as_json()      # per channel, with the peak excursion
     return AnalysisResult(spectra, fit, parameter_table(fit, sd), sd, recording.source, validity)
+
+
+def checked_capture(recording: Recording) -> CaptureInfo | None:
+    """The sidecar's "capture" object, or RecordingError naming the sidecar and the key."""
+    try:
+        return capture_of(recording)
+    except CaptureInfoError as exc:
+        where = recording_paths(recording.source)[1] if recording.source is not None else IN_MEMORY
+        raise RecordingError(f"{where}: {exc}") from None
 
 
 def analyze_path(path: str | Path, sd_m2: float | None = None,

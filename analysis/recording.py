@@ -148,7 +148,11 @@ def write_recording(path: str | Path, recording: Recording) -> tuple[Path, Path]
         wav_bytes = encode_float32_wav(recording.sample_rate, samples)
     except WavFormatError as err:
         raise RecordingError(f"{wav_path}: {err}") from None
-    json_bytes = _format_sidecar(_sidecar_of(recording)).encode("utf-8")
+    try:
+        json_bytes = _format_sidecar(_sidecar_of(recording)).encode("utf-8")
+    except UnicodeEncodeError as err:
+        raise RecordingError(f"{json_path}: a string holds {err.object[err.start:err.end]!r}, half of a UTF-16 "
+                             f"surrogate pair, expected Unicode text") from None
     _write_atomic(wav_path, wav_bytes)
     _write_atomic(json_path, json_bytes)
     return wav_path, json_path
@@ -357,7 +361,7 @@ def _load_json(path: Path) -> Any:
     except UnicodeDecodeError as err:
         raise RecordingError(f"{path}: not UTF-8 (byte {err.start}), expected a UTF-8 JSON object") from None
     try:
-        return json.loads(text, parse_constant=_refuse_constant)
+        doc = json.loads(text, parse_constant=_refuse_constant)
     except _NotJson as err:
         line = _line_of(text, str(err))
         raise RecordingError(f"{path}: invalid JSON at line {line}: {err} is not a JSON number, "
@@ -367,6 +371,15 @@ def _load_json(path: Path) -> Any:
                              f"expected a JSON object") from None
     except RecursionError:
         raise RecordingError(f"{path}: JSON nested too deeply, expected a JSON object") from None
+    except ValueError as err:   # e.g. an integer of more digits than Python converts
+        raise RecordingError(f"{path}: invalid JSON: {err}, expected a JSON object") from None
+    try:
+        # Valid JSON may escape half of a UTF-16 pair ("\\ud800"): no UTF-8 file could hold it again.
+        json.dumps(doc, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError as err:
+        raise RecordingError(f"{path}: a string holds {err.object[err.start:err.end]!r}, half of a UTF-16 "
+                             f"surrogate pair, expected Unicode text") from None
+    return doc
 
 
 class _NotJson(ValueError):

@@ -38,7 +38,10 @@ OUT_OF_RANGE_CODES = (262077, 262078)
 
 
 class CaptureInfoError(ValueError):
-    """A "capture" object that cannot be read; the message names the key."""
+    """A "capture" object that cannot be read; the message names the key, on one line."""
+
+    def __init__(self, message: str):
+        super().__init__(" ".join(str(message).splitlines()))   # keys copied into it may hold line breaks
 
 
 @dataclass(frozen=True, slots=True)
@@ -151,11 +154,18 @@ def _per_channel(doc: Mapping, key: str, kind: type) -> dict[str, Any]:
 
 
 def _number(value: Any, where: str, kind: type):
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not _finite(value) or value < 0:
         raise CaptureInfoError(f"{where}: found {value!r}, expected a non-negative number")
     if kind is int and value != int(value):
         raise CaptureInfoError(f"{where}: found {value!r}, expected a whole number")
     return kind(value)
+
+
+def _finite(value: int | float) -> bool:
+    try:
+        return math.isfinite(value)
+    except OverflowError:       # an integer beyond the float range
+        return False
 
 
 def _code(key: Any) -> int:

@@ -59,6 +59,9 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_rig
     cli_rig.add_commands(sub)
 
+    from app import cli_measure
+    cli_measure.add_commands(sub)
+
     from app import cli_archive, cli_report
     cli_archive.add_commands(sub)
     cli_report.add_commands(sub)
@@ -104,6 +107,12 @@ def _run(args: argparse.Namespace) -> int:
         try:
             return cli_levels.run(args)
         except cli_levels.user_errors() as exc:
+            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+    if args.command == "measure":
+        from app import cli_measure
+        try:
+            return cli_measure.run(args)
+        except cli_measure.user_errors() as exc:
             raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
     if args.command == "gui":
         from app.main import run_gui

@@ -56,6 +56,7 @@ def run_gui(path: str | None = None) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
     window.show()
+    QTimer.singleShot(0, window.offer_unfinished)     # measurements a crash cut short: keep, analyse, discard
     if path:
         window.open_path(path)
     exit_after = _exit_after_s()

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from PySide6.QtCore import Signal, Slot
+from PySide6.QtCore import QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton,
                                QTabWidget)
@@ -12,13 +12,16 @@ from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QP
 from app import style
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
+from app.qa_view import QAView
+from app.series_page import SeriesPage
 from app.results_view import ResultsView
 from app.settings import Settings
+from app.wizard import MeasureWizard
 from app.workers import AnalysisJob, AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
-PAGE_ORDER = ("Measure", "Results", "Model lab", "QA")
+PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "QA")
 CLOSE_WAIT_MS = 5000        # a cancelled fit stops at its next iteration; this is ample
 
 
@@ -38,6 +41,7 @@ class MainWindow(QMainWindow):
     analysis_shown = Signal(object)          # AnalysisOutcome, after the results page shows it
     analysis_failed = Signal(str)            # the message shown to the user
     analysis_cancelled = Signal()
+    measurement_shown = Signal(object)       # MeasureOutcome, after the Results page shows it
 
     def __init__(self, settings: Settings | None = None, parent=None):
         style.configure_pyqtgraph()
@@ -54,7 +58,15 @@ class MainWindow(QMainWindow):
         # The lab starts from each result the Results page shows; its versions go back there.
         self.results.result_changed.connect(self.model_lab.set_result)
         self.model_lab.model_adopted.connect(self.results.show_outcome)
-        built = {"Results": self.results, "Model lab": self.model_lab}
+        self.wizard = MeasureWizard(self.settings.qsettings)
+        self.qa = QAView(self.settings.qsettings)
+        # A finished measurement goes to the Results page, and from there to the lab and QA.
+        self.wizard.measurement_finished.connect(self.on_measured)
+        self.wizard.open_results_requested.connect(self.on_open_measured)
+        self.results.result_changed.connect(self.qa.set_result)
+        self.series = SeriesPage()
+        built = {"Measure": self.wizard, "Results": self.results, "Model lab": self.model_lab,
+                 "Series": self.series, "QA": self.qa}
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
@@ -199,6 +211,80 @@ class MainWindow(QMainWindow):
         """The message only: tracebacks go to the log, never to the user."""
         QMessageBox.warning(self, title, message)
 
+    # -- measurements of the wizard -----------------------------------------
+    @Slot(object)
+    def on_measured(self, outcome) -> None:
+        """A measurement the wizard finished: shown (it is already analysed), and remembered.
+
+        In the next turn of the event loop: the wizard's own page updates first, so the two do not add
+        up to one long stall of the GUI (the Results page and the Model lab take ~40 ms to show it).
+        """
+        if self.job is not None:            # an opened file still being analysed would replace it: drop that
+            self.job.cancel()
+            self._take(self.job.id)
+        QTimer.singleShot(0, lambda: self._show_measured(outcome))
+
+    def _show_measured(self, outcome) -> None:
+        self.results.show_outcome(outcome.analysis)
+        self.settings.add_recent_file(outcome.path)
+        self._rebuild_recent_menu()
+        self.setWindowTitle(f"linpar — {outcome.path.name}")
+        self.status_label.setText(f"Measured {outcome.path}")
+        self.measurement_shown.emit(outcome)
+
+    @Slot(object)
+    def on_open_measured(self, outcome: AnalysisOutcome) -> None:
+        if self.results.result is None or self.results.result.source != outcome.result.source:
+            self.results.show_outcome(outcome)
+        self.pages.setCurrentWidget(self.results)
+
+    # -- measurements that a crash cut short ----------------------------------
+    def measurement_folder(self) -> Path:
+        """Where the wizard writes its recordings (and where their crash journals are)."""
+        from app.wizard.measure_page import OUT_DIR_KEY, default_out_dir
+        saved = self.settings.qsettings.value(OUT_DIR_KEY, "")
+        return Path(saved) if saved else default_out_dir()
+
+    @Slot()
+    def offer_unfinished(self, directory: Path | None = None) -> list[str]:
+        """Offer each measurement whose process died before writing it: keep it, analyse it, or discard it.
+
+        instruments.measurement.recovery finds them (a journal whose process is gone) and turns one into a
+        recording marked partial. Returns the choices made, in order (for tests and the log).
+        """
+        from instruments.measurement.recovery import discard, find_unfinished, recover
+        choices = []
+        for unfinished in find_unfinished(directory or self.measurement_folder()):
+            choice = self.ask_unfinished(unfinished)
+            choices.append(choice)
+            try:
+                if choice in ("keep", "analyse"):
+                    path = recover(unfinished)
+                    self.status_label.setText(f"Kept the unfinished measurement as {path}")
+                    if choice == "analyse":
+                        self.open_path(path)
+                elif choice == "discard":
+                    discard(unfinished)
+            except (OSError, ValueError) as exc:
+                self.show_error(f"Cannot recover {unfinished.name}", str(exc))
+        return choices
+
+    def ask_unfinished(self, unfinished) -> str:
+        """'analyse', 'keep', 'discard' or 'later' (asked again at the next start)."""
+        box = QMessageBox(QMessageBox.Question, "Unfinished measurement",
+                          "A measurement was cut short (the program stopped before writing it):\n\n"
+                          f"{unfinished.describe()}", parent=self)
+        buttons = {}
+        if not unfinished.problem:
+            buttons[box.addButton("Keep and analyse", QMessageBox.AcceptRole)] = "analyse"
+            buttons[box.addButton("Keep", QMessageBox.ApplyRole)] = "keep"
+        buttons[box.addButton("Discard", QMessageBox.DestructiveRole)] = "discard"
+        later = box.addButton("Later", QMessageBox.RejectRole)
+        buttons[later] = "later"
+        box.setDefaultButton(later)
+        box.exec()
+        return buttons.get(box.clickedButton(), "later")
+
     # -- slots of the menus ------------------------------------------------
     @Slot()
     def on_open(self) -> None:
@@ -239,5 +325,9 @@ class MainWindow(QMainWindow):
     def closeEvent(self, event) -> None:
         self.worker.shutdown(CLOSE_WAIT_MS)
         self.model_lab.shutdown(CLOSE_WAIT_MS)
+        self.wizard.shutdown(CLOSE_WAIT_MS)
+        self.qa.shutdown(CLOSE_WAIT_MS)
+        self.series.worker.cancel()
+        self.series.worker.pool.waitForDone(CLOSE_WAIT_MS)
         self.settings.save_window(self.saveGeometry(), self.saveState())
         super().closeEvent(event)

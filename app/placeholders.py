@@ -9,19 +9,9 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 TEXT_WIDTH = 640
 
-PAGES = {
-    "Measure": (
-        "This page will run a measurement: choose the sound card and the laser (or the virtual rig), set the "
-        "level and the number of periods, watch voltage, current and displacement with their signal and noise "
-        "lines while the periods are averaged, and save the recording.",
-        "Until then, open an existing recording (NAME.wav with its NAME.json) with File ▸ Open recording…",
-    ),
-    "QA": (
-        "This page will check drivers against a reference: tolerance limits on the parameters, the validity "
-        "of each measurement, and a pass/fail report per driver.",
-        "Nothing replaces it yet.",
-    ),
-}
+# Every page of PAGE_ORDER is built now (Measure: app.wizard; QA: app.qa_view); a future page
+# that is not ready yet gets an entry here: name -> (what it will do, what to use until then).
+PAGES: dict[str, tuple[str, str]] = {}
 
 
 class PlaceholderPage(QWidget):

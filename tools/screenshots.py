@@ -5,14 +5,21 @@
 Writes results.png (and one PNG per Results plot tab and per other page) to
 docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
 model-lab-after.png: a recording whose laser lags by 100 us, diagnosed in the
-Model lab, before and after applying the top candidate. Nothing of the user's
-settings is touched: the window gets a QSettings file in the temporary folder.
+Model lab, before and after applying the top candidate; then wizard-1-driver.png
+.. wizard-6-results.png: the measurement wizard run on the in-process
+simulator, live-panels.png: the live panels in the middle of a real-time
+measurement, and qa-measured.png, qa-limits.png, qa-invalid.png: the QA page on
+the measured driver, with limits, and on a recording whose current input was
+disconnected. Nothing of the user's settings is touched: the window gets a
+QSettings file in the temporary folder.
 """
 from __future__ import annotations
 
+import json
 import os
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -85,6 +92,122 @@ def model_lab_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     return written
 
 
+def measure_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """Every step of the measurement wizard on the in-process simulator, the live panels mid-measurement, QA."""
+    wizard = window.wizard
+    wizard.state.settings.setValue("measure/out_dir", str(folder / "measurements"))
+    window.pages.setCurrentWidget(wizard)
+    written = []
+
+    def shot(name: str) -> None:
+        settle(app)
+        path = out / f"{name}.png"
+        window.grab().save(str(path))
+        written.append(path)
+
+    def run(button, jobs, name: str) -> bool:
+        with_result = wait_for_click(button, jobs.busy_changed)
+        if not with_result:
+            print(f"screenshots: {name} did not finish in time", file=sys.stderr)
+        return with_result
+
+    page = wizard.driver_page
+    page.name_edit.setText("W18-PAPER")
+    page.serial_edit.setText("0042")
+    page.sd_value.setValue(133.0)
+    page.impedance.setValue(4.0)
+    shot("wizard-1-driver")
+    wizard.next_button.click()
+    hardware = wizard.hardware_page
+    hardware.simulator_radio.setChecked(True)
+    hardware.realtime_check.setChecked(False)
+    run(hardware.test_audio_button, hardware.audio_jobs, "the sound-card test")
+    shot("wizard-2-hardware")
+    wizard.next_button.click()
+    calibration = wizard.calibration_page
+    run(calibration.measure_button, calibration.jobs, "the calibration")
+    shot("wizard-3-calibration")
+    wizard.next_button.click()
+    level = wizard.level_page
+    run(level.run_button, level.jobs, "the level check")
+    shot("wizard-4-level")
+    wizard.next_button.click()
+    measure = wizard.measure_page
+    run(measure.start_button, measure.jobs, "the measurement")
+    shot("wizard-5-measure")
+    wizard.next_button.click()
+    shot("wizard-6-results")
+
+    # The live panels in the middle of a measurement in real time.
+    for _ in range(4):
+        wizard.back_button.click()
+    hardware.realtime_check.setChecked(True)
+    for _ in range(3):
+        wizard.next_button.click()
+    measure.start_button.click()
+    deadline = time.monotonic() + ANALYSIS_TIMEOUT_S
+    halfway = max(2, measure.request().template.n_periods // 2)
+    while (measure.panels.frame is None or measure.panels.frame.n_periods < halfway) and time.monotonic() < deadline:
+        wait_for(measure.panels.repainted, 5)
+    shot("live-panels")
+    wait_for_click(measure.jobs.cancel_button, measure.jobs.busy_changed)
+
+    window.pages.setCurrentWidget(window.qa)
+    shot("qa-measured")
+    limits = folder / "w18-limits.json"
+    limits.write_text(json.dumps({"format": "linpar-limits/1", "name": "W18 production QA", "parameters": {
+        "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+        "fs": {"nominal": 70, "tolerance": 7, "unit": "Hz"},
+        "Qts": {"min": 0.3, "max": 0.5, "unit": "1"},
+        "Mms": {"nominal": 12, "tolerance": "10%", "unit": "g"},
+        "Bl": {"min": 5.5, "unit": "T*m"}}}, indent=1))
+    if window.qa.load_button.isEnabled():
+        window.qa.load_limits(limits)
+        shot("qa-limits")
+    from instruments.simulation import faults
+    bad, _ = write_recording(folder / "current-disconnected", faults.current_disconnected())
+    window.open_path(bad)
+    if wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        window.pages.setCurrentWidget(window.qa)
+        shot("qa-invalid")
+    return written
+
+
+def series_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Series page with a level series of the simulated nonlinear driver analysed."""
+    from instruments.simulation.level_series import write_level_series
+
+    paths = write_level_series(folder / "levels", levels_v=(0.3, 3.0, 6.0, 10.0, 14.0))
+    window.pages.setCurrentWidget(window.series)
+    window.series.setCurrentIndex(1)
+    window.series.analyse("levels", paths)
+    if not wait_for(window.series.worker.finished, 4 * ANALYSIS_TIMEOUT_S):
+        print("screenshots: the level series did not finish", file=sys.stderr)
+        return []
+    settle(app)
+    path = out / "series-levels.png"
+    window.grab().save(str(path))
+    return [path]
+
+
+def wait_for_click(button, busy_changed, timeout_s: float = ANALYSIS_TIMEOUT_S) -> bool:
+    """Click `button` and wait until the job it starts is over (busy_changed(False))."""
+    loop = QEventLoop()
+    ended = []
+
+    def on_busy(busy: bool) -> None:
+        if not busy:
+            ended.append(True)
+            loop.quit()
+    busy_changed.connect(on_busy)
+    button.click()
+    if not ended:
+        QTimer.singleShot(int(timeout_s * 1000), loop.quit)
+        loop.exec()
+    busy_changed.disconnect(on_busy)
+    return bool(ended)
+
+
 def wait_for(signal, timeout_s: float) -> bool:
     loop = QEventLoop()
     fired = []
@@ -147,6 +270,8 @@ def main(argv: list[str]) -> int:
             window.grab().save(str(path))
             written.append(path)
         written += model_lab_screenshots(app, window, folder, out)
+        written += measure_screenshots(app, window, folder, out)
+        written += series_screenshots(app, window, folder, out)
         window.close()
     for path in written:
         print(path)

@@ -91,9 +91,13 @@ class Measurement:
         if path is None:
             return {}
         try:
+            if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
+                raise ArchiveError(f"{path}: not a regular file")
             return json.loads(path.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, ValueError) as exc:
             raise ArchiveError(f"{path}: not readable JSON ({exc})") from None
+        except RecursionError:
+            raise ArchiveError(f"{path}: not readable JSON (nested too deeply)") from None
 
     def result(self):
         """The analysis as stored (analysis.archive.results.StoredResult)."""

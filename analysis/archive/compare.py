@@ -42,6 +42,11 @@ class Comparison:
         return {"ids": list(self.ids), "labels": list(self.labels), "rows": [r.as_json() for r in self.rows]}
 
 
+def _finite(x: float) -> float | None:
+    # A stored value times its display scale can overflow; the statistics module fails on infinities.
+    return x if math.isfinite(x) else None
+
+
 def compare(archive, ids) -> Comparison:
     ids = list(ids)
     if not 1 <= len(ids) <= MAX_COMPARED:
@@ -60,8 +65,8 @@ def compare(archive, ids) -> Comparison:
         values, stds = [], []
         for p in ps:
             ok = p is not None and p.value is not None
-            values.append(p.value * p.display_scale if ok else None)
-            stds.append(p.std * abs(p.display_scale) if ok and p.std is not None else None)
+            values.append(_finite(p.value * p.display_scale) if ok else None)
+            stds.append(_finite(p.std * abs(p.display_scale)) if ok and p.std is not None else None)
         present = [v for v in values if v is not None]
         mean = statistics.fmean(present) if present else None
         spread = statistics.stdev(present) if len(present) >= 2 else None

@@ -97,6 +97,8 @@ class Index:
         """Why the database file cannot be used as it is, or None."""
         if not self.path.exists():
             return MISSING
+        if not self.path.is_file():     # a FIFO would block the read below forever, a folder cannot be opened
+            return "the database file is not a regular file"
         try:
             with open(self.path, "rb") as f:
                 head = f.read(len(SQLITE_MAGIC))
@@ -177,13 +179,15 @@ class Index:
 
     def _set_aside(self) -> None:
         """Keep a damaged database for a look, and never let its journal touch the new one."""
-        if not self.path.exists():
-            return
-        if self._problem_is_damage():
-            stamp = time.strftime("%Y%m%d-%H%M%S")
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        if self.path.exists() and self._problem_is_damage():
             os.replace(self.path, self.path.with_name(f"{INDEX_FILE}.broken-{stamp}"))
         for suffix in ("-journal", "-wal", "-shm"):
-            Path(str(self.path) + suffix).unlink(missing_ok=True)
+            side = Path(str(self.path) + suffix)
+            if side.is_dir() and not side.is_symlink():     # not SQLite's: kept for a look, out of its way
+                os.replace(side, side.with_name(f"{side.name}.broken-{stamp}"))
+            else:
+                side.unlink(missing_ok=True)
 
     def _problem_is_damage(self) -> bool:
         # A sound database that is merely being rebuilt on request is simply replaced.
@@ -259,7 +263,15 @@ def _insert(conn: sqlite3.Connection, record: dict) -> None:
         p = e.parameters.get(name)
         if p is None:
             continue
-        value, std = p.get("value"), p.get("std")
         conn.execute("INSERT INTO parameters VALUES (?, ?, ?, ?, ?)",
-                     (e.id, name, value if isinstance(value, (int, float)) else None,
-                      std if isinstance(std, (int, float)) else None, str(p.get("unit", ""))))
+                     (e.id, name, _real(p.get("value")), _real(p.get("std")), str(p.get("unit", ""))))
+
+
+def _real(value) -> float | None:
+    """A number as the REAL column takes it; None for anything else (an integer beyond the float range too)."""
+    if not isinstance(value, (int, float)):
+        return None
+    try:
+        return float(value)
+    except OverflowError:
+        return None

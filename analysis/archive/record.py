@@ -50,15 +50,35 @@ def entry_of(record: dict) -> Entry:
                  dict(record.get("key_parameters", {})))
 
 
+def _number_or_null(value) -> bool:
+    if value is None:
+        return True
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    try:
+        float(value)
+    except OverflowError:       # an integer beyond the float range
+        return False
+    return True
+
+
 def read_record(folder: Path) -> dict:
     """The checked measurement.json of a folder; ArchiveError naming the file and key otherwise."""
     path = folder / RECORD_FILE
     try:
+        if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
+            raise ArchiveError(f"{path}: not a regular file")
         doc = json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ArchiveError(f"{path}: missing") from None
     except (OSError, UnicodeDecodeError, ValueError) as exc:
         raise ArchiveError(f"{path}: not readable JSON ({exc})") from None
+    except RecursionError:
+        raise ArchiveError(f"{path}: not readable JSON (nested too deeply)") from None
+    try:
+        json.dumps(doc, ensure_ascii=False).encode("utf-8")
+    except UnicodeEncodeError:
+        raise ArchiveError(f"{path}: a string holds half of a UTF-16 surrogate pair, expected Unicode text") from None
     if not isinstance(doc, dict) or doc.get("format") != RECORD_FORMAT:
         raise ArchiveError(f"{path}: format: expected {RECORD_FORMAT!r}")
     for key in ("id", "folder", "measured_at", "stored_at", "validity", *TEXT_FIELDS):
@@ -73,6 +93,13 @@ def read_record(folder: Path) -> dict:
     params = doc.get("key_parameters", {})
     if not isinstance(params, dict) or not all(isinstance(p, dict) for p in params.values()):
         raise ArchiveError(f"{path}: key_parameters: expected an object of objects")
+    for name, p in params.items():
+        for key in ("value", "std"):
+            if not _number_or_null(p.get(key)):
+                raise ArchiveError(f"{path}: key_parameters.{name}.{key}: expected a number or null")
     if not isinstance(doc.get("files", {}), dict):
         raise ArchiveError(f"{path}: files: expected an object")
+    effects = doc.get("effects", [])
+    if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+        raise ArchiveError(f"{path}: effects: expected a list of effect ids (strings)")
     return doc

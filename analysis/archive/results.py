@@ -127,8 +127,29 @@ def _array(values, where: str) -> np.ndarray:
         raise ResultsFormatError(f"{where}: expected a list of numbers")
     try:
         return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ResultsFormatError(f"{where}: expected a list of numbers") from None
+
+
+def _number(value, where: str) -> float | None:
+    """A JSON number or null as float or None (None for a non-finite one, as _num writes it); else an error."""
+    if value is None:
+        return None
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        try:
+            return _num(value)
+        except OverflowError:      # an integer beyond the float range
+            return None
+    raise ResultsFormatError(f"{where}: expected a number or null")
+
+
+def _object(doc: Mapping, key: str, where: str) -> dict:
+    value = doc.get(key)
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise ResultsFormatError(f"{where}{key}: expected a JSON object")
+    return dict(value)
 
 
 @dataclass(frozen=True)
@@ -150,13 +171,21 @@ class StoredResult:
         parameters = {}
         for name, p in _get(doc, "parameters", dict, "").items():
             where = f"parameters.{name}."
-            parameters[name] = ParameterValue(name, p.get("value"), p.get("std"), _get(p, "unit", str, where),
-                                              _get(p, "display_unit", str, where),
-                                              float(_get(p, "display_scale", (int, float), where)),
-                                              p.get("reason"), bool(p.get("fitted", False)))
+            if not isinstance(p, Mapping):
+                raise ResultsFormatError(f"parameters.{name}: expected a JSON object")
+            scale = _number(_get(p, "display_scale", (int, float), where), where + "display_scale")
+            if scale is None:
+                raise ResultsFormatError(f"{where}display_scale: expected a finite number")
+            reason = p.get("reason")
+            parameters[name] = ParameterValue(name, _number(p.get("value"), where + "value"),
+                                              _number(p.get("std"), where + "std"), _get(p, "unit", str, where),
+                                              _get(p, "display_unit", str, where), scale,
+                                              None if reason is None else str(reason), bool(p.get("fitted", False)))
         model = _get(doc, "model", dict, "")
         effects = tuple(str(e) for e in _get(model, "effects", list, "model."))
-        values = {k: float(v) for k, v in _get(model, "values", dict, "model.").items() if v is not None}
+        values = {k: _number(v, f"model.values.{k}") for k, v in _get(model, "values", dict, "model.").items()
+                  if v is not None}
+        values = {k: math.nan if v is None else v for k, v in values.items()}   # non-finite, as float() read it
         curves = {}
         for name, c in _get(doc, "curves", dict, "").items():
             if name not in CHANNELS:
@@ -171,8 +200,9 @@ class StoredResult:
                                  arr["model_re"] + 1j * arr["model_im"], bool(c.get("has_phase", True)))
         sd = doc.get("sd_m2")
         return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
-                   dict(model), dict(doc.get("validity") or {"overall": "unknown"}),
-                   float(sd) if isinstance(sd, (int, float)) else None, dict(doc.get("settings") or {}), curves)
+                   dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
+                   _number(sd, "sd_m2") if type(sd) in (int, float) else None, _object(doc, "settings", ""),
+                   curves)
 
     def model(self):
         """The analysis.model.Model the values belong to (rebuilt from the effect ids)."""

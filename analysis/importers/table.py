@@ -12,6 +12,7 @@ number. A silently skipped line would be a silently wrong curve.
 from __future__ import annotations
 
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +23,9 @@ from analysis.importers.errors import ImportFormatError
 COMMENT_MARKERS = ("*", "#", "%", "'", "//", "!")
 # Bigger than any curve export (the 0.5 Hz-step Dayton files are 0.7 MB).
 MAX_FILE_BYTES = 200 * 1024 * 1024
-_NUMBER = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+# [0-9]+(?:\.[0-9]*)? rather than [0-9]+\.?[0-9]*: the same numbers, but a long run of digits cannot be split
+# between two quantifiers in n ways, so refusing a field costs linear, not quadratic, time.
+_NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _NOT_FINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
 _LINE_BREAK = re.compile(r"\r\n|\r|\n")
 _BLANKS = re.compile(r"[ \t]+")
@@ -65,7 +68,10 @@ class Table:
 def read_text(path: str | Path) -> str:
     path = Path(path)
     try:
-        size = path.stat().st_size
+        status = path.stat()
+        if not stat.S_ISREG(status.st_mode):    # a FIFO or a device would block the read forever
+            raise ImportFormatError(path, None, "not a regular file: expected a text file")
+        size = status.st_size
         if size > MAX_FILE_BYTES:
             raise ImportFormatError(path, None, f"{size} bytes: too large for a curve export")
         raw = path.read_bytes()

@@ -22,8 +22,9 @@ from typing import Any, Sequence
 
 from instruments.rig.control import ControlServer
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP, RigEngine, RigFaults, RigNoise, default_driver
-from instruments.rig.jack_rig import DEFAULT_CLIENT_PATTERN, JackRig
+from instruments.rig.jack_rig import DEFAULT_CLIENT_PATTERN, PLAYED_CHANNEL, JackRig
 from instruments.rig.jackd import JackServer
+from instruments.rig.laser_feed import DisplacementFeed, RigLaser
 from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, write_atomic
 
 EXIT_OK, EXIT_FAILED, EXIT_SERVER_DIED = 0, 1, 3
@@ -43,7 +44,32 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--client-pattern", default=DEFAULT_CLIENT_PATTERN,
                    help="regular expression of the JACK client names wired to the rig (default %(default)s)")
     p.add_argument("--seed", type=int, help="noise seed (default: random)")
+    p.add_argument("--model", choices=("linear", "nonlinear"), default="linear",
+                   help="the driver's simulation: linear FIRs, or Bl(x), Kms(x), Le(x) in the time domain "
+                        "(~2 ms of a 21 ms cycle)")
+    p.add_argument("--no-laser", action="store_true", help="no serial laser emulator on a pty")
+    p.add_argument("--laser-ppm", type=float, default=37.0, help="the serial laser's clock error (ppm)")
+    p.add_argument("--laser-latency", type=float, default=0.02,
+                   help="seconds from the laser's output switched on to its first measurement")
+    p.add_argument("--laser-noise", type=float, default=0.0, help="the serial laser's noise, m rms")
     return p
+
+
+class OrderedJackRig(JackRig):
+    """JackRig that wires a workstation only once its played channel exists.
+
+    PortAudio registers its capture ports before its playback ports; wired as
+    they appear, the links rig -> workstation could be made before workstation
+    -> rig. JACK makes the link that closes a loop its "feedback" link, so the
+    order decides whether the rig runs before or after the workstation in a
+    cycle: one period (21 ms) of difference in when a displacement reaches the
+    workstation, which the serial laser's time base (laser_feed.py) must know.
+    Played channel first, always: the rig runs after the workstation.
+    """
+
+    def _workstation_ports(self):
+        return {name: ports for name, ports in super()._workstation_ports().items()
+                if len(ports[1]) > PLAYED_CHANNEL}
 
 
 class RigProcess:
@@ -56,6 +82,7 @@ class RigProcess:
         self.jackd: JackServer | None = None
         self.rig: JackRig | None = None
         self.control: ControlServer | None = None
+        self.laser: RigLaser | None = None
         self._state_lock = threading.Lock()
 
     def run(self) -> int:
@@ -66,12 +93,25 @@ class RigProcess:
             faults = RigFaults.parse(args.fault)
             noise = RigNoise.parse(args.noise) if args.noise else RigNoise()
             driver, definition = default_driver(args.driver, args.sample_rate, args.effects)
+            if args.model == "nonlinear":
+                from instruments.simulation.nonlinear_driver import NonlinearBlockDriver
+                driver = NonlinearBlockDriver(dict(definition.parameters), args.sample_rate)
             engine = RigEngine(driver, RIG_CALIBRATION, noise, faults, seed=args.seed)
+            feed = DisplacementFeed(args.sample_rate)
+            if not args.no_laser:
+                engine.displacement_sinks.append(feed.sink)
             # jackd first, from the main thread: its parent-death signal follows this thread.
             self.jackd = JackServer(args.name, args.sample_rate, args.period, log=sys.stdout)
             self.jackd.start()
-            self.rig = JackRig(engine, args.name, args.client_pattern, on_shutdown=self._server_gone)
+            self.rig = OrderedJackRig(engine, args.name, args.client_pattern, on_shutdown=self._server_gone)
+            client = self.rig.client
+            # The cycle's start, not the moment the sink runs (after the driver's FIRs): see laser_feed.
+            feed.cycle_clock = lambda: time.monotonic() - client.frames_since_cycle_start / args.sample_rate
             self.rig.activate()
+            laser_pty = None
+            if not args.no_laser:
+                self.laser = RigLaser(feed, args.laser_ppm, args.laser_latency, args.laser_noise)
+                laser_pty = self.laser.plug()
             self.control = ControlServer(paths.control_socket, self.handle)
             self.control.start()
             self.state = RigState(
@@ -80,8 +120,9 @@ class RigProcess:
                 effects=tuple(driver.model.effect_ids), fir_length=driver.fir_length,
                 faults=tuple(faults.describe()), noise=asdict(noise), calibration=RIG_CALIBRATION.to_dict(),
                 channel_map=RIG_CHANNEL_MAP.to_dict(), ports=self.rig.port_names,
-                client_pattern=args.client_pattern, extra={"driver_name": definition.name,
-                                                           "sd_m2": definition.sd_m2})
+                client_pattern=args.client_pattern, laser_pty=laser_pty,
+                extra={"driver_name": definition.name, "sd_m2": definition.sd_m2, "model": args.model,
+                       "laser": None if self.laser is None else self.laser.settings})
             self._write_state()
             print(f"rig {args.name!r} ready: driver {definition.name}, JACK server {args.name!r}", flush=True)
             while not self.stop_requested.wait(0.5):
@@ -137,10 +178,24 @@ class RigProcess:
         if cmd == "laser-pty":
             self._update_state(laser_pty=request.get("path"))
             return {}
+        if cmd == "laser":
+            return self._laser_command(request)
         if cmd == "stop":
             self.stop_requested.set()
             return {}
         raise ValueError(f"unknown command {cmd!r}")
+
+    def _laser_command(self, request: dict[str, Any]) -> dict[str, Any]:
+        """{"cmd": "laser", "set": {"clock_ppm": .., "start_latency_s": .., "noise_m": ..}} | "unplug" | "plug"."""
+        if self.laser is None:
+            raise ValueError("this rig has no serial laser (started with --no-laser)")
+        settings = self.laser.configure(**request.get("set", {}))
+        if request.get("unplug"):
+            self.laser.unplug()
+        if request.get("plug"):
+            self.laser.plug()
+        self._update_state(laser_pty=self.laser.port_path, extra={**self.state.extra, "laser": settings})
+        return {"laser_pty": self.laser.port_path, "laser": settings, "time_base": self.laser.feed.time_base()}
 
     def status(self) -> dict[str, Any]:
         rig = self.rig
@@ -156,6 +211,8 @@ class RigProcess:
         self.paths.state_file.unlink(missing_ok=True)   # first: nobody may start using a dying rig
         if self.control is not None:
             self.control.close()
+        if self.laser is not None:
+            self.laser.close()
         if self.rig is not None:
             self.rig.close()
         if self.jackd is not None:

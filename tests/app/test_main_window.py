@@ -5,7 +5,6 @@ import threading
 
 from PySide6.QtCore import QMimeData, QPoint, Qt, QUrl
 from PySide6.QtGui import QDropEvent
-from PySide6.QtWidgets import QAbstractButton
 
 import app.workers
 from analysis.fit import FitCancelled
@@ -17,19 +16,16 @@ from app.settings import MAX_RECENT
 from .conftest import ANALYSIS_TIMEOUT_MS, open_and_wait
 
 
-def test_pages_and_placeholders_say_they_do_not_work_yet(window):
+def test_pages_are_built_and_none_is_a_placeholder(window):
     names = [window.pages.tabText(i) for i in range(window.pages.count())]
-    assert names == ["Measure", "Results", "Model lab", "QA"]
+    assert names == ["Measure", "Results", "Model lab", "Series", "QA"]
     assert window.pages.currentWidget() is window.results
+    assert window.pages.widget(0) is window.wizard
     assert window.pages.widget(2) is window.model_lab
-    for i, name in enumerate(names):
-        page = window.pages.widget(i)
-        if name in ("Results", "Model lab"):
-            continue
-        assert isinstance(page, PlaceholderPage)
-        assert "not available yet" in page.label.text()
-        assert page.findChildren(QAbstractButton) == []      # nothing that pretends to work
-    assert set(PAGES) == {"Measure", "QA"}
+    assert window.pages.widget(3) is window.series
+    assert window.pages.widget(4) is window.qa
+    assert window.findChildren(PlaceholderPage) == []
+    assert PAGES == {}
 
 
 def test_analysis_runs_in_a_worker_thread(qtbot, window, recordings, monkeypatch):

@@ -1,0 +1,187 @@
+"""`linpar measure`: play, record, write the recording, then analyse it.
+
+    linpar measure --out DIR [--rig virtual|soundcard] [--device NAME] [--calibration FILE]
+                   [--laser URL|analog|none] [--template woofer|midrange|tweeter|microspeaker]
+                   [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
+                   [--json]
+
+With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
+used, started first if it is not running and stopped at the end if this
+command started it; the displacement comes from the rig's serial laser
+emulator (its pty) unless ``--laser`` says otherwise (``analog``: the rig's
+laser input on the sound card; ``none``: no displacement). With ``--rig
+soundcard``, ``--device`` names the sound card and ``--calibration`` a JSON
+file {"calibration": {...}, "channel_map": {...}} (instruments.audio.config).
+
+The recording (NAME.wav + NAME.json, and NAME.laser.npz with the serial
+laser) is written before anything is analysed. stdout gets what `linpar
+analyze` prints (the same JSON with --json, validity included); progress and
+the files written go to stderr. A measurement that a device ends (or Ctrl-C)
+keeps what was recorded and exits with 2 and a message that says what
+happened and where the data are.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import sys
+import threading
+from contextlib import ExitStack
+from pathlib import Path
+
+from instruments.measurement import TEMPLATES, MeasurementError, MeasurementPlan, MeasurementProgress
+
+LASER_ANALOG, LASER_NONE = "analog", "none"
+
+
+def add_commands(sub) -> None:
+    m = sub.add_parser("measure", help="measure a driver: play, record, write the recording, analyse it")
+    m.add_argument("--out", required=True, type=Path, metavar="DIR", help="folder for the recording")
+    m.add_argument("--name", help="file name of the recording (default: measurement-DATE-TIME)")
+    m.add_argument("--rig", choices=("virtual", "soundcard"), default="virtual",
+                   help="the virtual rig (default), or a real sound card")
+    m.add_argument("--rig-name", default="linpar", help="name of the virtual rig (default %(default)s)")
+    m.add_argument("--runtime-dir", type=Path, help=argparse.SUPPRESS)
+    m.add_argument("--device", metavar="NAME", help="sound card name (with --rig soundcard)")
+    m.add_argument("--calibration", type=Path, metavar="FILE",
+                   help='JSON {"calibration": {...}, "channel_map": {...}} of the sound card (--rig soundcard)')
+    m.add_argument("--laser", metavar="URL", help="serial laser port or pyserial URL; 'analog': the laser's "
+                                                  "analog output on the sound card; 'none': no displacement")
+    m.add_argument("--template", choices=tuple(TEMPLATES), default="woofer", help="driver class (default woofer)")
+    m.add_argument("--level", type=float, metavar="VOLT", help="excitation level, V RMS at the terminals")
+    m.add_argument("--periods", type=int, metavar="N", help="periods averaged")
+    m.add_argument("--period", type=int, metavar="SAMPLES", help="period length, a power of two")
+    m.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2")
+    m.add_argument("--model", metavar="EFFECTS",
+                   help="effect ids (default lr2,creep-log; with the serial laser also delay-x)")
+    m.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def user_errors() -> tuple[type[BaseException], ...]:
+    from analysis.fit import FitError
+    from analysis.model import ModelError
+    from analysis.recording import RecordingError
+    from analysis.spectra import SpectrumError
+    from instruments.audio.errors import AudioError
+    from instruments.laser.sensor import LaserError
+    from instruments.rig.control import ControlError
+    from instruments.rig.manager import RigError
+    return (MeasurementError, AudioError, LaserError, RigError, ControlError, RecordingError, SpectrumError,
+            FitError, ModelError, ValueError, OSError)
+
+
+def run(args: argparse.Namespace) -> int:
+    from app.cli_commands import _effects, format_result
+    from analysis.pipeline import result_json
+    from instruments.measurement.recovery import find_unfinished, run_journaled
+
+    effects = _effects(args.model) if args.model else None
+    for unfinished in find_unfinished(args.out):
+        _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal}")
+    # The plan first: a plan that cannot work must not start a rig.
+    plan = MeasurementPlan.from_template(args.template, level_v_rms=args.level, n_periods=args.periods,
+                                         period_samples=args.period)
+    with ExitStack() as stack:
+        audio, laser, driver = _devices(args, stack)
+        if args.sd is not None:
+            driver = {**driver, "sd_m2": args.sd}
+        plan = dataclasses.replace(plan, driver={k: v for k, v in driver.items() if v is not None})
+        cancel = threading.Event()
+        _say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
+             f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"
+             f" of sound) on {audio.describe()}" + (f", laser {laser!r}" if laser is not None else ""))
+        try:
+            outcome = run_journaled(plan, audio, _laser_sensor(laser), args.out, name=args.name,
+                                      cancel=cancel, progress=_Progress(), effects=effects)
+        except KeyboardInterrupt:
+            cancel.set()
+            raise
+    for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
+        if path is not None:
+            _say(f"wrote {path}")
+    result = outcome.result
+    if args.json:
+        print(json.dumps(result_json(result), allow_nan=False, default=lambda value: None))
+    else:
+        print(format_result(result))
+    return 0
+
+
+def _devices(args: argparse.Namespace, stack: ExitStack):
+    """(audio, laser port or None, driver info); what is started here is stopped by ``stack``."""
+    if args.rig == "soundcard":
+        return _sound_card(args), _laser_choice(args.laser, None), {}
+    from instruments.audio import portaudio
+    from instruments.rig import manager
+    from instruments.rig.workstation import rig_audio
+
+    handle = manager.find_rig(args.rig_name, args.runtime_dir)
+    if handle is None:
+        _say(f"starting the virtual rig {args.rig_name!r}")
+        handle = manager.start_rig(args.rig_name, runtime_dir=args.runtime_dir)
+        stack.callback(lambda: (_say(f"stopping the virtual rig {args.rig_name!r}"),
+                                manager.stop_rig(args.rig_name, args.runtime_dir)))
+    audio = rig_audio(handle)
+    stack.callback(portaudio.release)      # PortAudio lets go of the rig's JACK server before it may stop
+    laser = _laser_choice(args.laser, handle.state.laser_pty)
+    if args.laser is None and laser is None:
+        raise MeasurementError(f"the rig {args.rig_name!r} has no serial laser (started with --no-laser): "
+                               f"use --laser analog or --laser none")
+    if laser is not None or args.laser == LASER_NONE:
+        audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
+    state = handle.state
+    return audio, laser, {"name": state.extra.get("driver_name", state.driver), "sd_m2": state.extra.get("sd_m2")}
+
+
+def _laser_choice(option: str | None, rig_pty: str | None) -> str | None:
+    if option in (LASER_ANALOG, LASER_NONE):
+        return None
+    return option or rig_pty
+
+
+def _laser_sensor(port: str | None):
+    if port is None:
+        return None
+    from instruments.laser import ILD1420
+    return ILD1420(port)
+
+
+def _sound_card(args: argparse.Namespace):
+    from instruments.audio import Calibration, ChannelMap, SoundDeviceAudio, list_devices
+    if args.calibration is None:
+        raise MeasurementError("--rig soundcard needs --calibration FILE (the sound card's calibration and "
+                               "channel map)")
+    doc = json.loads(args.calibration.read_text(encoding="utf-8"))
+    calibration = Calibration.from_dict(doc.get("calibration", {}))
+    channel_map = ChannelMap.from_dict(doc.get("channel_map", {}))
+    if args.laser != LASER_ANALOG:
+        channel_map = dataclasses.replace(channel_map, laser_analog=None)
+    elif channel_map.laser_analog is None:
+        raise MeasurementError(f"--laser analog: the channel map in {args.calibration} has no laser_analog input")
+    devices = [d for d in list_devices() if d.full_duplex and (args.device is None or d.name == args.device)]
+    if len(devices) != 1:
+        names = ", ".join(str(d.choice) for d in list_devices() if d.full_duplex) or "none"
+        what = f"no full-duplex sound card named {args.device!r}" if not devices else \
+            f"{len(devices)} sound cards match; name one with --device"
+        raise MeasurementError(f"{what}; full-duplex cards: {names}")
+    return SoundDeviceAudio(devices[0].choice, calibration, int(doc.get("sample_rate", 48000)), channel_map)
+
+
+class _Progress:
+    """One stderr line per stage and per kept period."""
+
+    def __init__(self):
+        self._last = None
+
+    def __call__(self, p: MeasurementProgress) -> None:
+        key = (p.stage, p.periods_kept)
+        if key == self._last:
+            return
+        self._last = key
+        periods = f" {p.periods_kept}/{p.periods_wanted} periods" if p.stage in ("averaging", "settling") else ""
+        _say(f"[{p.elapsed_s:5.1f} s] {p.stage}{periods}{': ' + p.message if p.message else ''}")
+
+
+def _say(text: str) -> None:
+    print(f"linpar measure: {text}", file=sys.stderr, flush=True)

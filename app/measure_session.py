@@ -1,0 +1,216 @@
+"""The Qt bridge to the measurement: device tests, calibration, level check and measurement off the GUI thread.
+
+Built like app.workers: one long-lived MeasureSession (a QObject of the GUI
+thread) owns a QThreadPool and the signals; each job is a plain callable run
+by the pool and every signal carries the job's id, so a page drops what a job
+it has replaced still says. The pool has ONE thread: the jobs share the
+hardware (one sound card stream, one PortAudio initialisation, one serial
+port), so they run one after the other, never side by side.
+
+What crosses to the GUI thread is frozen: LiveFrames (analysis.live), the
+level decision, the resistor check, the finished measurement (a
+MeasureOutcome holding an app.workers.AnalysisOutcome, ready for the Results
+page and the Model lab), or one line of text.
+
+The measurement itself is instruments.measurement's run_measurement when
+that is installed, else app.wizard.tasks' fallback (capture + live frames +
+write_recording + analyze_recording); `runner_name()` says which.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from PySide6.QtCore import QObject, QThreadPool, Signal
+
+from analysis.fit import FitCancelled
+from app.result_curves import result_curves
+from app.workers import USER_ERRORS, AnalysisOutcome, one_line
+
+log = logging.getLogger(__name__)
+
+PROGRESS_STEP = 0.005       # a progress bar 200 pixels wide does not move for less
+FALLBACK_NAME = "app.wizard.tasks (capture, live frames, write_recording, analyze_recording)"
+
+
+def runner_name() -> str:
+    from app.wizard.plans import find_runner
+    return "instruments.measurement.run_measurement" if find_runner() is not None else FALLBACK_NAME
+
+
+def _device_errors() -> tuple[type[BaseException], ...]:
+    """Errors of the devices, whose message is for the user. Imported late: PortAudio loads on demand."""
+    from instruments.audio.errors import AudioError
+    from instruments.laser.sensor import LaserError
+    from instruments.rig.manager import RigError
+    errors = (AudioError, LaserError, RigError)
+    try:
+        from instruments.measurement import MeasurementError
+    except ImportError:
+        return errors
+    return errors + (MeasurementError,)
+
+
+def _cancel_errors() -> tuple[type[BaseException], ...]:
+    from instruments.audio.errors import CaptureCancelled
+    try:
+        from instruments.measurement import MeasurementCancelled
+    except ImportError:
+        return CaptureCancelled, FitCancelled
+    return CaptureCancelled, FitCancelled, MeasurementCancelled
+
+
+@dataclass(frozen=True, slots=True)
+class MeasureOutcome:
+    """A finished measurement: where it was written, its analysis, and what it was asked to do."""
+
+    analysis: AnalysisOutcome
+    request: object                 # app.wizard.tasks.MeasurementRequest
+
+    @property
+    def path(self) -> Path:
+        return self.analysis.path
+
+
+class SessionJob:
+    """One job in the pool thread: `work(job)` returns what `finished` carries."""
+
+    def __init__(self, job: int, kind: str, work: Callable[["SessionJob"], object], session: "MeasureSession"):
+        self.id = job
+        self.kind = kind
+        self._work = work
+        self._session = session
+        # NB: set by the GUI thread, read by the capture loop and the fit in the pool thread.
+        self.cancel_event = threading.Event()
+        self._last_progress = (-1.0, "")
+
+    def cancel(self) -> None:
+        self.cancel_event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self.cancel_event.is_set()
+
+    def frame(self, frame) -> None:
+        self._session.frame_ready.emit(self.id, frame)
+
+    def progress(self, fraction: float, text: str) -> None:
+        """Forwarded when it says something new: the runner reports every audio block."""
+        last_fraction, last_text = self._last_progress
+        if text != last_text or abs(fraction - last_fraction) >= PROGRESS_STEP:
+            self._last_progress = (fraction, text)
+            self._session.progress.emit(self.id, float(fraction), text)
+
+    def __call__(self) -> None:
+        session = self._session
+        try:
+            result = self._work(self)
+        except _cancel_errors():
+            session.cancelled.emit(self.id)
+        except USER_ERRORS + _device_errors() as exc:
+            if self.cancel_event.is_set():
+                session.cancelled.emit(self.id)
+            else:
+                session.failed.emit(self.id, one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
+            log.exception("measurement %s failed", self.kind)
+            session.failed.emit(self.id, f"internal error in the {self.kind} ({type(exc).__name__}: "
+                                         f"{one_line(exc)}); the details are in the log")
+        else:
+            if self.cancel_event.is_set():
+                session.cancelled.emit(self.id)
+            else:
+                session.finished.emit(self.id, result)
+
+
+class MeasureSession(QObject):
+    frame_ready = Signal(int, object)       # job id, analysis.live.LiveFrame
+    progress = Signal(int, float, str)      # job id, fraction 0..1, what is being done
+    finished = Signal(int, object)          # job id, the job's result
+    failed = Signal(int, str)               # job id, a one-line message for the user
+    cancelled = Signal(int)                 # job id
+
+    def __init__(self, parent: QObject | None = None):
+        super().__init__(parent)
+        self.pool = QThreadPool(self)
+        self.pool.setMaxThreadCount(1)
+        self._ids = itertools.count(1)
+        self._jobs: dict[int, SessionJob] = {}
+        for signal in (self.finished, self.failed, self.cancelled):
+            signal.connect(self._forget)
+
+    @property
+    def busy(self) -> bool:
+        return bool(self._jobs)
+
+    # -- jobs ----------------------------------------------------------------
+    # Each job imports what it needs in the pool thread: a first import of the measurement's modules takes
+    # ~70 ms, which on the GUI thread would be a visible stall.
+    def list_sound_cards(self) -> SessionJob:
+        def work(job):
+            from app.wizard.hardware import list_sound_cards
+            return list_sound_cards()
+        return self._start("device list", work)
+
+    def test_audio(self, config) -> SessionJob:
+        def work(job):
+            from app.wizard.hardware import test_audio
+            job.progress(0.0, "playing a quiet test signal")
+            return test_audio(config, job.cancel_event,
+                              lambda kept, wanted: job.progress(kept / wanted, f"{kept} of {wanted} periods"))
+        return self._start("sound card test", work)
+
+    def test_laser(self, config) -> SessionJob:
+        def work(job):
+            from app.wizard.hardware import test_laser
+            return test_laser(config)
+        return self._start("laser test", work)
+
+    def calibrate(self, config, r_ohm: float, level_v: float) -> SessionJob:
+        def work(job):
+            from app.wizard.calibration import measure_resistor
+            return measure_resistor(config, r_ohm, level_v, job.cancel_event,
+                                    lambda kept, wanted: job.progress(kept / wanted,
+                                                                      f"measuring the resistor: {kept} of {wanted} "
+                                                                      f"periods"))
+        return self._start("calibration", work)
+
+    def check_level(self, config, template, corrections, v_min: float, v_max: float, x_limit_m: float) -> SessionJob:
+        def work(job):
+            from app.wizard.tasks import run_level_check
+            job.progress(0.0, "designing the multitone")
+            return run_level_check(config, template, corrections, v_min, v_max, x_limit_m, job.frame,
+                                   job.cancel_event, job.progress)
+        return self._start("level check", work)
+
+    def measure(self, request) -> SessionJob:
+        def work(job):
+            from app.wizard.tasks import run_measurement
+            job.progress(0.0, "designing the multitone")
+            wav, result = run_measurement(request, job.frame, job.cancel_event, job.progress)
+            job.progress(0.99, "preparing the plots")
+            return MeasureOutcome(AnalysisOutcome(job.id, wav, result, result_curves(result)), request)
+        return self._start("measurement", work)
+
+    # -- bookkeeping -----------------------------------------------------------
+    def _start(self, kind: str, work: Callable[[SessionJob], object]) -> SessionJob:
+        job = SessionJob(next(self._ids), kind, work, self)
+        self._jobs[job.id] = job
+        self.pool.start(job)
+        return job
+
+    def cancel_all(self) -> None:
+        for job in list(self._jobs.values()):
+            job.cancel()
+
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel every job and wait for the pool; True when all stopped in time."""
+        self.cancel_all()
+        return self.pool.waitForDone(wait_ms)
+
+    def _forget(self, job: int, *_args) -> None:
+        self._jobs.pop(job, None)

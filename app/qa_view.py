@@ -1,0 +1,370 @@
+"""The QA page: is this driver good, and can the measurement be trusted?
+
+One large light for the measurement's validity, the channel lights with
+their findings and remedies, pass/fail of the parameters against a limits
+file (analysis.limits), and the report export (analysis.report). Both come
+from other packages: when one is not installed its button stays disabled and
+says why, rather than pretending.
+
+The verdict keeps the two questions apart: a red measurement is not a failed
+driver, it is a driver not judged (measure it again).
+"""
+from __future__ import annotations
+
+import html
+import importlib.util
+import logging
+import threading
+from pathlib import Path
+
+from PySide6.QtCore import QObject, QSettings, Qt, QThreadPool, Signal
+from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxLayout, QHeaderView, QLabel,
+                               QProgressBar, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+
+from analysis.pipeline import AnalysisResult
+from app.traffic_light import CHANNELS, ChannelLight, TrafficLight
+from app.workers import USER_ERRORS, one_line
+
+log = logging.getLogger(__name__)
+
+LIMITS_MODULE, REPORT_MODULE = "analysis.limits", "analysis.report"
+NO_LIMITS = "QA limits need analysis/limits.py, which this installation does not have."
+NO_REPORT = "Reports need the analysis.report package, which this installation does not have."
+LIMITS_KEY = "qa/limits_file"
+VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"),
+                   "not judged": ("#fff1c9", "#7a5300"), "none": ("#e6e6e6", "#404040")}
+COLUMNS = ("Parameter", "Measured", "Limit", "Result")
+
+
+def available(module: str) -> bool:
+    try:
+        return importlib.util.find_spec(module) is not None
+    except ModuleNotFoundError:
+        return False
+
+
+def display(value: float | None, parameter) -> str:
+    if value is None:
+        return "–"
+    if parameter is None:
+        return f"{value:.4g}"
+    unit = "" if parameter.display_unit in ("-", "1", "") else f" {parameter.display_unit}"
+    return f"{value * parameter.display_scale:.4g}{unit}"
+
+
+def qa_verdict(validity_overall: str, limits_verdict: str | None) -> tuple[str, str]:
+    """(verdict, why): the measurement's validity first, then the limits."""
+    if validity_overall == "red":
+        return "not judged", "the measurement is invalid (see the red channels): measure this driver again"
+    if limits_verdict is None:
+        return "none", "no limits loaded: only the measurement's validity is judged"
+    if limits_verdict == "fail":
+        return "fail", "a parameter is outside its limits"
+    doubt = " (the measurement is doubtful: read the yellow findings)" if validity_overall == "yellow" else ""
+    return "pass", "every parameter within its limits" + doubt
+
+
+class ReportWorker(QObject):
+    """Renders and writes one report at a time in a pool thread (matplotlib takes a second or two)."""
+
+    finished = Signal(int, str)         # job id, what was written
+    failed = Signal(int, str)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.pool = QThreadPool(self)
+        self.pool.setMaxThreadCount(1)
+        self._next = 0
+
+    def start(self, result: AnalysisResult, path: Path, cancel: threading.Event) -> int:
+        self._next += 1
+        job = self._next
+        self.pool.start(lambda: self._run(job, result, path, cancel))
+        return job
+
+    def _run(self, job: int, result: AnalysisResult, path: Path, cancel: threading.Event) -> None:
+        try:
+            from analysis.archive.results import StoredResult, results_document
+            from analysis.recording import read_recording
+            from analysis.report import build_report, write_report
+            recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
+            stored = StoredResult.from_json(results_document(result, recording))
+            driver = dict(recording.driver) if recording is not None else {}
+            header = {"driver": driver.get("name", ""), "serial": driver.get("serial", ""),
+                      "source": str(result.source or "")}
+            extra = dict(recording.extra) if recording is not None else {}
+            calibration = {k: extra[k] for k in ("calibration", "capture") if k in extra}
+            content = build_report(stored, header, None, calibration)
+            if cancel.is_set():
+                return
+            kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
+            written = write_report(content, **kind)
+            self.finished.emit(job, ", ".join(str(p) for p in written))
+        except USER_ERRORS + (ImportError, KeyError) as exc:
+            self.failed.emit(job, one_line(exc))
+        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
+            log.exception("report export failed")
+            self.failed.emit(job, f"internal error while writing the report ({type(exc).__name__}: "
+                                  f"{one_line(exc)}); the details are in the log")
+
+
+class QAView(QWidget):
+    verdict_changed = Signal(str)       # "pass" | "fail" | "not judged" | "none"
+    report_written = Signal(str)
+
+    def __init__(self, settings: QSettings | None = None, parent=None):
+        super().__init__(parent)
+        self.settings = settings
+        self.result: AnalysisResult | None = None
+        self.limits = None
+        self.verdicts: tuple = ()
+        self.verdict = "none"
+        self._job: int | None = None
+        self._cancel = threading.Event()
+        self.worker = ReportWorker(self)
+        self.worker.finished.connect(self.on_report_written)
+        self.worker.failed.connect(self.on_report_failed)
+
+        self.source = QLabel("No result yet: measure a driver, or open a recording.")
+        self.source.setWordWrap(True)
+        self.overall_light = TrafficLight(96)
+        self.overall_text = QLabel()
+        self.overall_text.setTextFormat(Qt.RichText)
+        self.overall_text.setWordWrap(True)
+        self.verdict_label = QLabel()
+        self.verdict_label.setTextFormat(Qt.RichText)
+        self.verdict_label.setWordWrap(True)
+        self.verdict_label.setMargin(10)
+        self.channels = {name: ChannelLight(name, 20) for name in CHANNELS}
+
+        self.load_button = QPushButton("Load limits…")
+        self.limits_label = QLabel()
+        self.limits_label.setWordWrap(True)
+        self.limits_label.setTextFormat(Qt.RichText)
+        self.table = QTableWidget(0, len(COLUMNS))
+        self.table.setHorizontalHeaderLabels(COLUMNS)
+        self.table.verticalHeader().setVisible(False)
+        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
+        header = self.table.horizontalHeader()
+        header.setSectionResizeMode(QHeaderView.ResizeToContents)
+        header.setSectionResizeMode(2, QHeaderView.Stretch)
+        self.export_button = QPushButton("Export report…")
+        self.export_label = QLabel()
+        self.export_label.setWordWrap(True)
+        self.export_progress = QProgressBar()
+        self.export_progress.setRange(0, 0)
+        self.export_progress.setMaximumWidth(160)
+        self.export_cancel = QPushButton("Cancel")
+        self._build_layout()
+
+        self.load_button.clicked.connect(self.on_load_limits)
+        self.export_button.clicked.connect(self.on_export)
+        self.export_cancel.clicked.connect(self.on_cancel_export)
+        self._set_exporting(False)
+        self._restore_limits()
+        self.refresh()
+
+    def _build_layout(self) -> None:
+        light_row = QHBoxLayout()
+        light_row.addWidget(self.overall_light, 0, Qt.AlignTop)
+        light_row.addWidget(self.overall_text, 1)
+        left = QVBoxLayout()
+        left.addWidget(self.source)
+        left.addLayout(light_row)
+        left.addWidget(self.verdict_label)
+        channel_box = QGroupBox("Channels")
+        channel_layout = QVBoxLayout(channel_box)
+        for light in self.channels.values():
+            channel_layout.addWidget(light)
+        left.addWidget(channel_box)
+        left.addStretch(1)
+
+        limits_box = QGroupBox("Limits")
+        limits_layout = QVBoxLayout(limits_box)
+        row = QHBoxLayout()
+        row.addWidget(self.load_button)
+        row.addWidget(self.limits_label, 1)
+        limits_layout.addLayout(row)
+        limits_layout.addWidget(self.table, 1)
+        report_box = QGroupBox("Report")
+        report_layout = QHBoxLayout(report_box)
+        report_layout.addWidget(self.export_button)
+        report_layout.addWidget(self.export_progress)
+        report_layout.addWidget(self.export_cancel)
+        report_layout.addWidget(self.export_label, 1)
+        right = QVBoxLayout()
+        right.addWidget(limits_box, 1)
+        right.addWidget(report_box)
+        layout = QHBoxLayout(self)
+        layout.addLayout(left, 1)
+        layout.addLayout(right, 1)
+
+    # -- input -------------------------------------------------------------------
+    def set_result(self, result: AnalysisResult | None) -> None:
+        self.result = result
+        if self._job is None:
+            self.export_label.setText("")          # "Written ..." was about the previous result
+        self.refresh()
+
+    def load_limits(self, path: str | Path) -> bool:
+        """Load a limits file; False (and the reason on the page) when it cannot be used."""
+        from analysis.limits import LimitsError, load_limits
+        try:
+            self.limits = load_limits(path)
+        except LimitsError as exc:
+            self.limits = None
+            self.limits_label.setText(f"<span style='color:#8e1b1b'>{html.escape(str(exc))}</span>")
+            self.refresh(keep_limits_text=True)
+            return False
+        if self.settings is not None:
+            self.settings.setValue(LIMITS_KEY, str(path))
+        self.refresh()
+        return True
+
+    def _restore_limits(self) -> None:
+        if not available(LIMITS_MODULE):
+            return
+        saved = self.settings.value(LIMITS_KEY, "") if self.settings is not None else ""
+        if saved and Path(saved).exists():
+            self.load_limits(saved)
+
+    # -- showing -----------------------------------------------------------------
+    def refresh(self, keep_limits_text: bool = False) -> None:
+        result = self.result
+        validity = result.validity if result is not None else {"overall": "unknown"}
+        overall = str(validity.get("overall", "unknown"))
+        self.overall_light.set_status(overall)
+        from app.style import VALIDITY_TEXT
+        from app.traffic_light import STATE_WORDS
+        self.overall_text.setText(f"<h2>Measurement {html.escape(STATE_WORDS.get(overall, overall))}</h2>"
+                                  f"{html.escape(VALIDITY_TEXT.get(overall, ''))}")
+        channels = validity.get("channels") or {}
+        for name, light in self.channels.items():
+            entry = channels.get(name) or {}
+            light.set_state(str(entry.get("status", "unknown" if result is None else "absent")),
+                            entry.get("findings") or ())
+        if result is not None:
+            self.source.setText(f"Result of {result.source.name if result.source else 'an unsaved measurement'}"
+                                f" — model {result.fit.model.describe()}")
+        self._show_limits(keep_limits_text)
+        self._show_verdict(overall)
+        self._update_export()
+
+    def _show_limits(self, keep_text: bool) -> None:
+        self.table.setRowCount(0)
+        self.verdicts = ()
+        if not available(LIMITS_MODULE):
+            self.load_button.setEnabled(False)
+            self.load_button.setToolTip(NO_LIMITS)
+            self.limits_label.setText(html.escape(NO_LIMITS))
+            return
+        self.load_button.setEnabled(True)
+        if self.limits is None:
+            if not keep_text:
+                self.limits_label.setText("No limits loaded: load a limits file (linpar-limits/1 JSON) to judge "
+                                          "the parameters.")
+            return
+        self.limits_label.setText(f"<b>{html.escape(self.limits.name)}</b> ({html.escape(str(self.limits.path))})")
+        if self.result is None:
+            return
+        self.verdicts = self.limits.judge(self.result.parameters)
+        # Parameters of an invalid measurement are worthless (physics.md section 5): not a pass, not a fail.
+        invalid = self.result.validity.get("overall") == "red"
+        self.table.setRowCount(len(self.verdicts))
+        for row, v in enumerate(self.verdicts):
+            parameter = self.result.parameters.get(v.limit.name)
+            measured = display(v.value, parameter) if v.value is not None else v.note
+            outcome = "not judged" if invalid else ("pass" if v.passed else "FAIL")
+            cells = (v.limit.name, measured, v.limit.text, outcome)
+            for col, text in enumerate(cells):
+                item = QTableWidgetItem(text)
+                if invalid:
+                    item.setForeground(Qt.gray)
+                elif col == 3:
+                    item.setForeground(Qt.darkGreen if v.passed else Qt.darkRed)
+                self.table.setItem(row, col, item)
+
+    def _show_verdict(self, overall: str) -> None:
+        limits_verdict = None
+        if self.verdicts:
+            from analysis.limits import verdict_of
+            limits_verdict = verdict_of(self.verdicts)
+        if self.result is None:
+            verdict, why = "none", "nothing to judge yet"
+        else:
+            verdict, why = qa_verdict(overall, limits_verdict)
+        background, text = VERDICT_COLOURS[verdict]
+        title = {"pass": "PASS", "fail": "FAIL", "not judged": "NOT JUDGED", "none": "NO VERDICT"}[verdict]
+        self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "
+                                         f"border: 1px solid {text}; border-radius: 4px; }}")
+        self.verdict_label.setText(f"<span style='font-size:20pt'><b>{title}</b></span><br>{html.escape(why)}")
+        if verdict != self.verdict:
+            self.verdict = verdict
+            self.verdict_changed.emit(verdict)
+
+    # -- export ------------------------------------------------------------------
+    def _update_export(self) -> None:
+        if not available(REPORT_MODULE):
+            self.export_button.setEnabled(False)
+            self.export_button.setToolTip(NO_REPORT)
+            self.export_label.setText(NO_REPORT)
+            return
+        exporting = self._job is not None
+        self.export_button.setEnabled(self.result is not None and not exporting)
+        if exporting:
+            return
+        if self.result is None:
+            self.export_label.setText("Nothing to report yet.")
+        elif not self.export_label.text().startswith(("Written", "Could not", "Export cancelled")):
+            self.export_label.setText("A PDF or HTML report of this result: parameters, validity, plots.")
+
+    def _set_exporting(self, exporting: bool) -> None:
+        self.export_progress.setVisible(exporting)
+        self.export_cancel.setVisible(exporting)
+        self._update_export()
+
+    def on_load_limits(self) -> None:
+        start = str(Path(self.settings.value(LIMITS_KEY, "")).parent) if self.settings is not None else ""
+        path, _ = QFileDialog.getOpenFileName(self, "Load QA limits", start, "Limits (*.json);;All files (*)")
+        if path:
+            self.load_limits(path)
+
+    def on_export(self) -> None:
+        if self.result is None:
+            return
+        stem = self.result.source.with_suffix("").name if self.result.source else "report"
+        start = str(self.result.source.with_name(stem + "-report.pdf")) if self.result.source else "report.pdf"
+        path, _ = QFileDialog.getSaveFileName(self, "Export report", start, "PDF (*.pdf);;HTML (*.html)")
+        if path:
+            self.export_to(Path(path))
+
+    def export_to(self, path: Path) -> None:
+        self._cancel = threading.Event()
+        self._job = self.worker.start(self.result, path, self._cancel)
+        self.export_label.setText(f"Writing {path.name}…")
+        self._set_exporting(True)
+
+    def on_cancel_export(self) -> None:
+        self._cancel.set()
+        self._job = None
+        self.export_label.setText("Export cancelled: nothing written.")
+        self._set_exporting(False)
+
+    def on_report_written(self, job: int, written: str) -> None:
+        if job != self._job:
+            return
+        self._job = None
+        self._set_exporting(False)
+        self.export_label.setText(f"Written: {written}")
+        self.report_written.emit(written)
+
+    def on_report_failed(self, job: int, message: str) -> None:
+        if job != self._job:
+            return
+        self._job = None
+        self._set_exporting(False)
+        self.export_label.setText(f"Could not write the report: {message}")
+
+    def shutdown(self, wait_ms: int) -> bool:
+        self._cancel.set()
+        return self.worker.pool.waitForDone(wait_ms)

@@ -1,0 +1,101 @@
+"""Step 1: which driver is measured: name, serial number, Sd, nominal impedance and its class."""
+from __future__ import annotations
+
+from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout, QLineEdit, QVBoxLayout
+
+from app.wizard.base import WizardPage, rich_label
+from app.wizard.plans import TEMPLATES, DriverInfo, sd_from_diameter
+
+SD_AREA, SD_DIAMETER = 0, 1
+TEMPLATE_KEY = "measure/template"
+
+
+class DriverPage(WizardPage):
+    title = "Driver"
+    subtitle = "What is measured: the recording and the report are named after it."
+
+    def __init__(self, state, session, parent=None):
+        super().__init__(state, session, parent)
+        self.name_edit = QLineEdit()
+        self.name_edit.setPlaceholderText("required, e.g. W18-PAPER")
+        self.serial_edit = QLineEdit()
+        self.serial_edit.setPlaceholderText("optional, e.g. 0042")
+        self.sd_mode = QComboBox()
+        self.sd_mode.addItems(["Sd (cm²)", "effective diameter (cm)"])
+        self.sd_value = QDoubleSpinBox()
+        self.sd_value.setDecimals(2)
+        self.sd_value.setRange(0.0, 5000.0)
+        self.sd_value.setSpecialValueText("unknown")
+        self.sd_value.setToolTip("The effective radiating area: needed for Vas, the efficiency and the SPL")
+        sd_row = QHBoxLayout()
+        sd_row.addWidget(self.sd_mode)
+        sd_row.addWidget(self.sd_value, 1)
+        self.sd_note = rich_label()
+        self.impedance = QDoubleSpinBox()
+        self.impedance.setRange(0.0, 100.0)
+        self.impedance.setDecimals(1)
+        self.impedance.setSuffix(" Ω")
+        self.impedance.setSpecialValueText("unknown")
+        self.impedance.setToolTip("The nominal impedance printed on the driver; it suggests the reference "
+                                  "resistor of the calibration")
+        self.template = QComboBox()
+        for key, template in TEMPLATES.items():
+            self.template.addItem(template.title, key)
+        saved = state.settings.value(TEMPLATE_KEY, "woofer")
+        self.template.setCurrentIndex(max(0, self.template.findData(saved)))
+        self.template_note = rich_label()
+
+        form = QFormLayout()
+        form.addRow("Name", self.name_edit)
+        form.addRow("Serial number", self.serial_edit)
+        form.addRow("Radiating area", sd_row)
+        form.addRow("", self.sd_note)
+        form.addRow("Nominal impedance", self.impedance)
+        form.addRow("Class (template)", self.template)
+        form.addRow("", self.template_note)
+        # A form as wide as the window reads badly: keep it to a column, left.
+        row = QHBoxLayout()
+        row.addLayout(form, 3)
+        row.addStretch(2)
+        layout = QVBoxLayout(self)
+        layout.addLayout(row)
+        layout.addStretch(1)
+
+        self.name_edit.textChanged.connect(self.changed)
+        for signal in (self.sd_mode.currentIndexChanged, self.sd_value.valueChanged,
+                       self.template.currentIndexChanged):
+            signal.connect(self.on_edited)
+        self.on_edited()
+
+    def sd_m2(self) -> float | None:
+        value = self.sd_value.value()
+        if value <= 0:
+            return None
+        if self.sd_mode.currentIndex() == SD_DIAMETER:
+            return sd_from_diameter(value / 100.0)
+        return value * 1e-4
+
+    def on_edited(self, *_args) -> None:
+        self.sd_value.setRange(0.0, 5000.0 if self.sd_mode.currentIndex() == SD_AREA else 80.0)
+        sd = self.sd_m2()
+        if sd is None:
+            self.sd_note.setText("Sd unknown: Vas, the efficiency and the SPL will not be reported "
+                                 "(it can be entered later on the Results page).")
+        elif self.sd_mode.currentIndex() == SD_DIAMETER:
+            self.sd_note.setText(f"Sd = {sd * 1e4:.1f} cm² (a piston of that diameter)")
+        else:
+            self.sd_note.setText("")
+        template = TEMPLATES[self.template.currentData()]
+        self.template_note.setText(template.describe())
+        self.changed.emit()
+
+    def missing(self) -> str | None:
+        if not self.name_edit.text().strip():
+            return "Give the driver's name: it names the recording and the report."
+        return None
+
+    def commit(self) -> None:
+        key = self.template.currentData()
+        self.state.settings.setValue(TEMPLATE_KEY, key)
+        self.state.driver = DriverInfo(self.name_edit.text().strip(), self.serial_edit.text().strip(),
+                                       self.sd_m2(), self.impedance.value() or None, key)

@@ -1,0 +1,129 @@
+"""Step 5: the measurement: what will be done, progress, the live panels, cancel."""
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+from PySide6.QtCore import QStandardPaths, Signal
+from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QPushButton, QVBoxLayout
+
+from app.live_panels import LivePanels
+from app.measure_session import runner_name
+from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
+from app.wizard.plans import TEMPLATES
+from app.wizard.tasks import MeasurementRequest
+
+OUT_DIR_KEY = "measure/out_dir"
+
+
+def default_out_dir() -> Path:
+    documents = QStandardPaths.writableLocation(QStandardPaths.DocumentsLocation) or str(Path.home())
+    return Path(documents) / "linpar"
+
+
+def _table(left: list[tuple[str, str]], right: list[tuple[str, str]]) -> str:
+    """Two columns of name: value rows, so the summary leaves the height to the live panels."""
+    def cells(rows, i):
+        if i >= len(rows):
+            return "<td></td><td></td>"
+        name, value = rows[i]
+        return f"<td><b>{html.escape(name)}</b>&nbsp;</td><td>{html.escape(value)}&nbsp;&nbsp;&nbsp;</td>"
+    body = "".join(f"<tr>{cells(left, i)}{cells(right, i)}</tr>" for i in range(max(len(left), len(right))))
+    return f"<table>{body}</table>"
+
+
+class MeasurePage(WizardPage):
+    title = "Measure"
+    subtitle = "The recording is written first, then analysed; the spectra show each period as it is averaged."
+    measured = Signal(object)           # MeasureOutcome
+
+    def __init__(self, state, session, parent=None):
+        super().__init__(state, session, parent)
+        self.summary = rich_label(selectable=True)
+        self.folder_button = QPushButton("Folder…")
+        self.folder_button.setToolTip("Where the recording (NAME.wav and NAME.json) is written")
+        self.start_button = QPushButton("Start the measurement")
+        self.jobs = JobControls(session)
+        self.result = rich_label(selectable=True)
+        self.panels = LivePanels()
+        top = QHBoxLayout()
+        top.addWidget(self.summary, 1)
+        top.addWidget(self.folder_button)
+        run = QHBoxLayout()
+        run.addWidget(self.start_button)
+        run.addWidget(self.jobs, 1)
+        layout = QVBoxLayout(self)
+        layout.addLayout(top)
+        layout.addLayout(run)
+        layout.addWidget(self.result)
+        layout.addWidget(self.panels, 1)
+        self.start_button.clicked.connect(self.on_start)
+        self.folder_button.clicked.connect(self.on_folder)
+        self.jobs.busy_changed.connect(self.on_busy_changed)
+
+    def out_dir(self) -> Path:
+        saved = self.state.settings.value(OUT_DIR_KEY, "")
+        return Path(saved) if saved else default_out_dir()
+
+    def request(self) -> MeasurementRequest:
+        s = self.state
+        return MeasurementRequest(s.driver, s.hardware, TEMPLATES[s.driver.template], s.corrections, s.level_v,
+                                  s.level_reason, self.out_dir())
+
+    def enter(self) -> None:
+        s = self.state
+        if s.driver is None or s.level_v is None or s.corrections is None:
+            self.summary.setText("")
+            return
+        if s.outcome is not None and s.outcome.request != self.request():
+            s.outcome = None            # the steps before changed: that measurement is not this one
+            self.result.setText("")
+        t = TEMPLATES[s.driver.template]
+        serial = f", serial {s.driver.serial}" if s.driver.serial else ""
+        left = [("Driver", f"{s.driver.name}{serial} ({t.key})"), ("Hardware", s.hardware.describe()),
+                ("Corrections", s.corrections.describe())]
+        right = [("Level", f"{s.level_v:.4g} V rms ({s.level_words})"), ("Excitation", t.describe().split(";")[0]),
+                 ("Recording to", str(self.out_dir()))]
+        self.summary.setText(_table(left, right))
+        self.summary.setToolTip(f"Level: {s.level_reason}\nMeasured by {runner_name()}")
+        self.changed.emit()
+
+    def missing(self) -> str | None:
+        if self.jobs.busy:
+            return "Wait for the measurement to finish, or cancel it."
+        if self.state.outcome is None:
+            return "Start the measurement."
+        return None
+
+    @property
+    def busy(self) -> bool:
+        return self.jobs.busy
+
+    def on_folder(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self, "Folder for the recordings", str(self.out_dir()))
+        if folder:
+            self.state.settings.setValue(OUT_DIR_KEY, folder)
+            self.enter()
+
+    def on_start(self) -> None:
+        self.state.outcome = None
+        self.result.setText("")
+        self.panels.clear(band_hz=self.request().template.band_hz)
+        self.jobs.run(self.session.measure(self.request()), "Starting…", self.on_measured,
+                      lambda message: self.result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
+                      lambda: self.result.setText("Measurement cancelled: nothing analysed."),
+                      frame=self.panels.set_frame)
+        self.changed.emit()
+
+    def on_measured(self, outcome) -> None:
+        self.state.outcome = outcome
+        overall = outcome.analysis.result.validity.get("overall", "unknown")
+        self.result.setText(coloured(f"Written {outcome.path} and analysed (validity {overall}). ", OK_COLOUR)
+                            + "Next shows the parameters.")
+        self.measured.emit(outcome)
+        self.changed.emit()
+
+    def on_busy_changed(self, busy: bool) -> None:
+        self.start_button.setEnabled(not busy)
+        self.folder_button.setEnabled(not busy)
+        self.changed.emit()

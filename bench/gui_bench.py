@@ -1,0 +1,288 @@
+"""The GUI while it works: live-panel repaints and event-loop stalls, measuring and diagnosing.
+
+A MainWindow (1400 x 900, offscreen) measures with its wizard on the JACK
+virtual rig (the in-process simulator in real time when jackd is missing),
+the Measure step's live panels in view. A QTimer at 5 ms notes the gaps
+between its ticks: the longest, less the 5 ms, is how long the event loop
+stalled. A period of the woofer template lasts 1.37 s, so the measurement
+itself offers under one frame a second; to see whether the panels keep up
+with a fast frame source while the measurement loads the machine, frames of
+the same excitation are also offered at OFFERED_HZ (60 a second), and the
+repaints per second are counted. Rows also say how many frames the
+measurement delivered, whether the audio stream dropped out while the GUI
+painted (xruns, restarts of the averaging: every repaint holds the GIL, which
+the audio callback needs), and the longest time a 1 ms Python thread waited
+to run (the GIL held by the GUI or the measurement).
+
+Then a diagnosis in the Model lab of a recording whose laser lags by 100 us
+(every candidate refitted in worker processes, the table filled at the end):
+the longest stall from the click until the candidates are shown.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from bench.common import Row, at_most
+
+TICK_MS = 5
+OFFERED_HZ = int(os.environ.get("GUI_BENCH_OFFERED_HZ", "60"))
+STALL_LIMIT_MS = 50.0
+REPAINT_TARGET = 25.0
+TIMEOUT_S = 180.0
+
+
+def run(workdir: Path) -> list[Row]:
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    from PySide6.QtCore import QSettings
+    from PySide6.QtWidgets import QApplication
+
+    app = QApplication.instance() or QApplication(["gui-bench"])
+    from app.main_window import MainWindow
+    from app.settings import Settings
+
+    folder = Path(tempfile.mkdtemp(prefix="gui-bench-", dir=workdir))
+    settings = Settings(QSettings(str(folder / "settings.ini"), QSettings.IniFormat))
+    settings.qsettings.setValue("measure/out_dir", str(folder / "measurements"))
+    rig = _start_rig(folder) if shutil.which("jackd") else None
+    try:
+        window = MainWindow(settings)
+        if rig is not None:
+            # The wizard looks for the bench's own rig, not the user's.
+            window.wizard.hardware_page.rig_name = rig.name
+            window.wizard.hardware_page.rig_runtime_dir = str(rig.paths.directory.parent)
+        window.resize(1400, 900)
+        window.show()
+        rows = _measuring(app, window, rig)
+        rows += _diagnosing(app, window, folder)
+        window.close()
+    finally:
+        if rig is not None:
+            from instruments.audio import portaudio
+            from instruments.rig.manager import stop_rig
+            portaudio.release()
+            stop_rig(rig.name, runtime_dir=rig.paths.directory.parent)
+    return rows
+
+
+def _start_rig(folder: Path):
+    from instruments.rig.manager import start_rig
+    return start_rig(f"linpar-gui-bench-{os.getpid()}", runtime_dir=folder / "rig", seed=3)
+
+
+class StallMeter:
+    """Gaps between the ticks of a TICK_MS QTimer, and between the wake-ups of a 1 ms Python thread."""
+
+    def __init__(self):
+        from PySide6.QtCore import QTimer
+        self.timer = QTimer()
+        self.timer.setTimerType(self.timer.timerType().PreciseTimer)
+        self.timer.setInterval(TICK_MS)
+        self.timer.timeout.connect(self._tick)
+        self.gaps: list[float] = []
+        self.thread_gaps: list[float] = []
+        self._last = 0.0
+        self._stop = threading.Event()
+
+    def _tick(self) -> None:
+        now = time.perf_counter()
+        self.gaps.append(now - self._last)
+        self._last = now
+
+    def _spin(self) -> None:
+        last = time.perf_counter()
+        while not self._stop.is_set():
+            time.sleep(0.001)
+            now = time.perf_counter()
+            self.thread_gaps.append(now - last)
+            last = now
+
+    def __enter__(self) -> "StallMeter":
+        self._last = time.perf_counter()
+        self.timer.start()
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.timer.stop()
+        self._stop.set()
+        self._thread.join()
+
+    @property
+    def stall_ms(self) -> float:
+        return self.stall_between(0, len(self.gaps))
+
+    def stall_between(self, first: int, last: int) -> float:
+        """The longest stall among the ticks first..last-1 (indices into gaps)."""
+        return max(0.0, 1e3 * max(self.gaps[first:last], default=0.0) - TICK_MS)
+
+    @property
+    def thread_wait_ms(self) -> float:
+        return 1e3 * max(self.thread_gaps, default=0.0)
+
+
+def _wait(app, condition, timeout_s: float = TIMEOUT_S) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        app.processEvents()
+        time.sleep(0.002)
+    return True
+
+
+def _offered_frames(template, level: float):
+    """Frames of the measurement's own excitation, to offer the panels faster than periods come."""
+    from analysis.drivers import load_driver
+    from analysis.live import LiveAccumulator
+    from analysis.synthesis import ChannelNoise, synthesize_recording
+    from app.wizard.plans import multitone_for
+
+    driver = load_driver("paper")
+    mt = multitone_for(template).scaled(rms=level)
+    rec = synthesize_recording(driver.model(), driver.parameters, mt.waveform, mt.excited_bins, mt.sample_rate, 6, 0,
+                               ChannelNoise(1e-4, 1e-5, 1e-8), seed=2)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, mt.excited_bins)
+    signals = ("voltage", "current", "displacement")
+    return [acc.add_period({s: rec.periods(s)[k] for s in signals}) for k in range(6)][1:]
+
+
+def _measuring(app, window, rig) -> list[Row]:
+    """Two measurements: the panels fed by the measurement alone, then with frames offered at OFFERED_HZ too."""
+    from app.wizard.calibration import Corrections
+    from app.wizard.hardware import RIG, SIMULATOR, HardwareConfig
+    from app.wizard.plans import TEMPLATES, DriverInfo
+
+    wizard = window.wizard
+    template = TEMPLATES["woofer"]
+    level = 1.0
+    where = "the JACK virtual rig" if rig is not None else "the in-process simulator (real time; no jackd)"
+    if rig is not None:
+        hardware = HardwareConfig(kind=RIG, rig_name=rig.name, rig_runtime_dir=str(rig.paths.directory.parent),
+                                  sample_rate=rig.state.sample_rate, channel_map=rig.state.workstation_channel_map,
+                                  calibration=rig.state.workstation_calibration)
+    else:
+        hardware = HardwareConfig(kind=SIMULATOR, realtime=True)
+    state = wizard.state
+    state.driver = DriverInfo("bench", "1", 0.0133, 4.0, template.key)
+    state.hardware = hardware
+    state.corrections = Corrections(source="exact" if rig is not None else "none")
+    state.level_v, state.level_reason, state.level_words = level, "the bench's level", "bench"
+    window.pages.setCurrentWidget(wizard)
+    wizard.go_to(4)
+    page = wizard.measure_page
+    alone = _measure_once(app, wizard, page, template, [], 0)
+    offered = _measure_once(app, wizard, page, template, _offered_frames(template, level), OFFERED_HZ)
+    for run_ in (alone, offered):
+        if "failed" in run_:
+            return [Row(f"gui: the measurement on {where} failed: {run_['failed']}", 0.0, "", "", False)]
+    return [
+        Row(f"gui: measuring on {where}, {template.n_periods} periods of {template.period_samples}",
+            alone["averaging"], "s", "", None),
+        Row("gui: frames the measurement delivered per second", alone["frames"], "/s", "", None),
+        at_most("gui: longest event-loop stall while averaging", alone["stall"], "ms", STALL_LIMIT_MS),
+        at_most("gui: longest stall from the last period to the result shown", alone["handoff"], "ms",
+                STALL_LIMIT_MS),
+        Row("gui: longest wait of a 1 ms Python thread while measuring (GIL)", alone["thread"], "ms", "", None),
+        at_most("gui: xruns and restarts of the averaging", alone["xruns"], "", 0),
+        Row(f"gui: live-panel repaints per second, frames also offered at {OFFERED_HZ}/s", offered["paints"], "/s",
+            f">= {REPAINT_TARGET:g}", offered["paints"] >= REPAINT_TARGET),
+        at_most(f"gui: longest event-loop stall while averaging, {OFFERED_HZ}/s offered", offered["stall"], "ms",
+                STALL_LIMIT_MS),
+        Row(f"gui: longest wait of a 1 ms Python thread, {OFFERED_HZ}/s offered (GIL)", offered["thread"], "ms",
+            "", None),
+        at_most(f"gui: xruns and restarts of the averaging, {OFFERED_HZ}/s offered", offered["xruns"], "", 0),
+    ]
+
+
+def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -> dict:
+    from PySide6.QtCore import QTimer
+
+    sent = [0]
+    feeder = QTimer()
+    feeder.setInterval(round(1000 / max(offered_hz, 1)))
+    feeder.timeout.connect(lambda: (page.panels.set_frame(offered[sent[0] % len(offered)]),
+                                    sent.__setitem__(0, sent[0] + 1)))
+    finished, failed = [], []
+    on_finished = finished.append
+    on_failed = lambda job, message: failed.append(message)      # noqa: E731
+    wizard.measurement_finished.connect(on_finished)
+    page.jobs.session.failed.connect(on_failed)
+    paints_before, frames_before = len(page.panels.paint_times), page.panels.frames_received
+    with StallMeter() as meter:
+        page.start_button.click()
+        started = time.monotonic()
+        if offered:
+            feeder.start()
+        _wait(app, lambda: page.panels.frames_received - frames_before - sent[0] >= template.n_periods
+              or finished or failed)
+        feeder.stop()
+        averaging = time.monotonic() - started
+        averaged_ticks = len(meter.gaps)
+        ok = _wait(app, lambda: finished or failed)
+        _wait(app, lambda: False, 0.3)          # the hand-off to the Results page, the Model lab and QA
+    wizard.measurement_finished.disconnect(on_finished)
+    page.jobs.session.failed.disconnect(on_failed)
+    if not ok or failed:
+        return {"failed": failed[0] if failed else "timed out"}
+    frames = page.panels.frames_received - frames_before - sent[0]
+    return {"averaging": averaging, "frames": frames / averaging,
+            "paints": (len(page.panels.paint_times) - paints_before) / averaging,
+            "stall": meter.stall_between(0, averaged_ticks),
+            "handoff": meter.stall_between(averaged_ticks, len(meter.gaps)),
+            "thread": meter.thread_wait_ms, "xruns": _audio_stats(finished[0].path)}
+
+
+def _audio_stats(wav: Path) -> float:
+    from analysis.recording import read_recording
+    capture = read_recording(wav).extra.get("audio_capture", {})
+    return float(sum(capture.get(k, 0) for k in ("input_overflows", "input_underflows", "output_underflows",
+                                                 "output_overflows", "restarts")))
+
+
+def _diagnosing(app, window, folder: Path) -> list[Row]:
+    from analysis.drivers import load_driver
+    from analysis.effects import get_effect
+    from analysis.multitone import design_multitone
+    from analysis.recording import write_recording
+    from analysis.synthesis import ChannelNoise, synthesize_recording
+
+    driver = load_driver("paper")
+    model = driver.model()
+    model = model.with_effects(model.effects + (get_effect("delay-x"),))
+    mt = design_multitone(48000, 16384, 5.0, 10000.0, rms=1.0)
+    rec = synthesize_recording(model, {**driver.parameters, "tau_x": 100e-6}, mt.waveform, mt.excited_bins, 48000,
+                               8, 1, ChannelNoise(1e-4, 1e-4, 1e-8), seed=3,
+                               driver={"name": "laser 100 us late", "sd_m2": driver.sd_m2})
+    wav, _ = write_recording(folder / "laser-late", rec)
+    shown = []
+    window.analysis_shown.connect(shown.append)
+    window.open_path(wav)
+    if not _wait(app, lambda: shown):
+        return [Row("gui: the recording for the diagnosis was not analysed in time", 0.0, "", "", False)]
+    lab = window.model_lab
+    window.pages.setCurrentWidget(lab)
+    done = []
+    lab.diagnosis_shown.connect(done.append)
+    with StallMeter() as meter:
+        started = time.monotonic()
+        lab.candidates.diagnose_button.click()
+        ok = _wait(app, lambda: done)
+        took = time.monotonic() - started
+        _wait(app, lambda: False, 0.3)          # what the GUI does right after showing the table counts too
+    if not ok:
+        return [Row("gui: the diagnosis did not finish in time", 0.0, "", "", False)]
+    return [Row("gui: diagnosis in the Model lab, click to candidates shown", took, "s", "", None),
+            at_most("gui: longest event-loop stall during the diagnosis", meter.stall_ms, "ms", STALL_LIMIT_MS)]
+
+
+if __name__ == "__main__":
+    with tempfile.TemporaryDirectory() as tmp:
+        for row in run(Path(tmp)):
+            ok = "" if row.ok is None else ("yes" if row.ok else "NO")
+            print(f"{row.name:<72}{row.value:>10.3f} {row.unit:<4}{row.target:>8}  {ok}")

@@ -1,0 +1,126 @@
+"""What a measurement plays and keeps: templates per driver class, and the plan made from one.
+
+A template is a sensible start for a class of drivers (band, period, level,
+periods); a MeasurementPlan is a template with the user's changes, frozen,
+so a measurement thread can hold it. Levels are RMS volts at the terminals.
+
+Periods are powers of two. The bin spacing is sample_rate / period: 65,536
+samples at 48 kHz (0.73 Hz, 1.37 s) resolve a woofer's resonance and creep
+below it; 16,384 (2.9 Hz, 0.34 s) suit drivers resonating above ~100 Hz.
+The virtual rig's driver is a 65,536-tap FIR, whose steady state is exact
+only for periods that divide 65,536 (every power of two up to it).
+
+Settling: capture() discards ``settle_periods`` whole periods after the
+fade-in and the first sound. They must outlast the driver's memory: a real
+driver's decays in well under a second, the rig's FIR lasts exactly 65,536
+samples, so the default asks for SETTLE_SAMPLES (the FIR plus a margin for
+the audio round trip) rounded up to whole periods.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any, Mapping
+
+SETTLE_SAMPLES = 65536 + 8192
+ON_XRUN = ("end", "restart")
+
+
+@dataclass(frozen=True, slots=True)
+class MeasurementTemplate:
+    name: str
+    description: str
+    f_min_hz: float
+    f_max_hz: float
+    period_samples: int
+    level_v_rms: float
+    n_periods: int
+    lines_per_octave: float = 12.0
+
+
+TEMPLATES: Mapping[str, MeasurementTemplate] = {t.name: t for t in (
+    MeasurementTemplate("woofer", "bass and bass-midrange drivers, fs 15 - 100 Hz", 2.0, 10000.0, 65536, 1.0, 8),
+    MeasurementTemplate("midrange", "midrange drivers, fs 100 - 500 Hz", 10.0, 20000.0, 16384, 1.0, 16),
+    MeasurementTemplate("tweeter", "tweeters, fs above 500 Hz: nothing below 200 Hz", 200.0, 20000.0, 16384,
+                        0.5, 16),
+    MeasurementTemplate("microspeaker", "micro speakers and receivers, fs 300 Hz - 1.5 kHz", 50.0, 20000.0,
+                        16384, 0.3, 16),
+)}
+
+
+@dataclass(frozen=True, slots=True)
+class MeasurementPlan:
+    """Everything run_measurement needs to know besides the devices. SI units."""
+
+    template: str = "woofer"
+    f_min_hz: float = 2.0
+    f_max_hz: float = 10000.0
+    period_samples: int = 65536
+    level_v_rms: float = 1.0
+    n_periods: int = 8
+    settle_periods: int | None = None     # None: SETTLE_SAMPLES in whole periods
+    lines_per_octave: float = 12.0
+    laser_rate_hz: float = 4000.0
+    laser_sign: float = -1.0              # -1: the laser looks at the cone's front (outward = closer)
+    laser_latency_s: float = 0.0          # a known latency of the serial laser's link, subtracted
+    on_xrun: str | None = None            # "end" | "restart" (while periods are kept; see runner.py);
+                                          # None: end with a serial laser, else restart
+    driver: Mapping[str, Any] = field(default_factory=dict)     # {"name": ..., "sd_m2": ...}
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        p = self.period_samples
+        if not (isinstance(p, int) and p >= 1024 and p & (p - 1) == 0):
+            raise ValueError(f"period_samples must be a power of two >= 1024, got {p!r}")
+        if not self.level_v_rms > 0:
+            raise ValueError(f"the level must be > 0 V RMS, got {self.level_v_rms!r}")
+        if not (isinstance(self.n_periods, int) and self.n_periods >= 2):
+            raise ValueError(f"at least 2 periods are needed to estimate the noise, got {self.n_periods!r}")
+        if self.settle_periods is not None and self.settle_periods < 0:
+            raise ValueError(f"settle_periods must be >= 0, got {self.settle_periods!r}")
+        if not 0 < self.f_min_hz < self.f_max_hz:
+            raise ValueError(f"the band must be 0 < f_min < f_max, got {self.f_min_hz} - {self.f_max_hz} Hz")
+        if self.on_xrun not in (None, *ON_XRUN):
+            raise ValueError(f"on_xrun must be one of {ON_XRUN}, got {self.on_xrun!r}")
+        if self.laser_sign not in (-1.0, 1.0):
+            raise ValueError(f"laser_sign must be +1 or -1, got {self.laser_sign!r}")
+
+    @classmethod
+    def from_template(cls, name: str = "woofer", **changes: Any) -> MeasurementPlan:
+        try:
+            t = TEMPLATES[name]
+        except KeyError:
+            raise ValueError(f"unknown template {name!r}; known: {', '.join(TEMPLATES)}") from None
+        base = cls(template=t.name, f_min_hz=t.f_min_hz, f_max_hz=t.f_max_hz, period_samples=t.period_samples,
+                   level_v_rms=t.level_v_rms, n_periods=t.n_periods, lines_per_octave=t.lines_per_octave)
+        return replace(base, **{k: v for k, v in changes.items() if v is not None})
+
+    @property
+    def settle(self) -> int:
+        """Periods discarded after the fade-in."""
+        if self.settle_periods is not None:
+            return self.settle_periods
+        return math.ceil(SETTLE_SAMPLES / self.period_samples)
+
+    def end_on_xrun(self, serial_laser: bool) -> bool:
+        if self.on_xrun == "restart" and serial_laser:
+            raise ValueError("on_xrun='restart' cannot be used with a serial laser: an xrun moves the audio's "
+                             "sample clock against the laser's")
+        return self.on_xrun == "end" or (self.on_xrun is None and serial_laser)
+
+    def excitation(self, sample_rate: int):
+        """The multitone (analysis.multitone.Multitone) at this plan's band, period and level."""
+        from analysis.multitone import design_multitone
+        f_max = min(self.f_max_hz, 0.45 * sample_rate)
+        return design_multitone(sample_rate, self.period_samples, self.f_min_hz, f_max,
+                                lines_per_octave=self.lines_per_octave, rms=self.level_v_rms, seed=self.seed)
+
+    def duration_s(self, sample_rate: int) -> float:
+        """Nominal time at the sound card: settle and averaged periods."""
+        return (self.settle + self.n_periods) * self.period_samples / sample_rate
+
+    def as_json(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["driver"] = dict(self.driver)
+        d["settle_periods"] = self.settle
+        return d

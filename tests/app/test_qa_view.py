@@ -1,0 +1,114 @@
+"""The QA page: the lights with their findings, pass/fail against limits, the report export."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import app.qa_view as qa_view
+from analysis.recording import write_recording
+from app.qa_view import NO_LIMITS, NO_REPORT, QAView
+from instruments.simulation import faults
+
+from .conftest import open_and_wait
+from .test_wizard_helpers import plain
+
+LIMITS = {"format": "linpar-limits/1", "name": "paper QA", "parameters": {
+    "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+    "fs": {"nominal": 70, "tolerance": 7, "unit": "Hz"},
+    "Bl": {"min": 5.5, "unit": "T*m"}}}
+
+
+@pytest.fixture(scope="module")
+def faulty(tmp_path_factory):
+    wav, _ = write_recording(tmp_path_factory.mktemp("faults") / "current-disconnected", faults.current_disconnected())
+    return wav
+
+
+@pytest.fixture
+def limits_file(tmp_path):
+    path = tmp_path / "limits.json"
+    path.write_text(json.dumps(LIMITS), encoding="utf-8")
+    return path
+
+
+def test_a_faulty_recording_shows_a_red_light_and_its_message(qtbot, window, faulty):
+    outcome, = open_and_wait(qtbot, window, faulty)
+    window.pages.setCurrentWidget(window.qa)
+    qa = window.qa
+    assert qa.overall_light.status == "red"
+    current = qa.channels["current"]
+    assert current.light.status == "red"
+    finding = outcome.result.validity["channels"]["current"]["findings"][0]
+    shown = plain(current.details)
+    assert finding["message"] in shown and finding["remedy"] in shown
+    assert current.details.isVisible() and current.details.width() > 100
+    assert qa.channels["voltage"].light.status == "green"
+    assert qa.verdict == "not judged"            # an invalid measurement fails no driver
+    assert "measure this driver again" in plain(qa.verdict_label)
+
+
+def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limits_file):
+    if not qa_view.available(qa_view.LIMITS_MODULE):
+        pytest.skip("analysis/limits.py is not in this installation")
+    open_and_wait(qtbot, window, recordings["paper"])
+    qa = window.qa
+    assert qa.load_button.isEnabled()
+    assert qa.load_limits(limits_file)
+    rows = {qa.table.item(r, 0).text(): qa.table.item(r, 3).text() for r in range(qa.table.rowCount())}
+    assert rows == {"RE": "pass", "fs": "pass", "Bl": "FAIL"}          # the paper's Bl is 5.23 T*m
+    assert qa.verdict == "fail"
+    assert window.settings.qsettings.value("qa/limits_file") == str(limits_file)
+    LIMITS["parameters"]["Bl"] = {"min": 5.0, "unit": "T*m"}
+    limits_file.write_text(json.dumps(LIMITS), encoding="utf-8")
+    assert qa.load_limits(limits_file)
+    assert qa.verdict == "pass"
+
+
+def test_a_broken_limits_file_says_why_and_judges_nothing(qtbot, settings, tmp_path):
+    if not qa_view.available(qa_view.LIMITS_MODULE):
+        pytest.skip("analysis/limits.py is not in this installation")
+    qa = QAView(settings.qsettings)
+    qtbot.addWidget(qa)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "linpar-limits/1", "parameters": {"RE": {"nominal": 3}}}', encoding="utf-8")
+    assert not qa.load_limits(bad)
+    assert "unit" in plain(qa.limits_label) and qa.table.rowCount() == 0
+
+
+def test_without_the_limits_and_report_packages_the_buttons_say_why(qtbot, settings, monkeypatch):
+    monkeypatch.setattr(qa_view, "available", lambda module: False)
+    qa = QAView(settings.qsettings)
+    qtbot.addWidget(qa)
+    assert not qa.load_button.isEnabled() and qa.load_button.toolTip() == NO_LIMITS
+    assert NO_LIMITS in plain(qa.limits_label)
+    assert not qa.export_button.isEnabled() and qa.export_label.text() == NO_REPORT
+
+
+def test_the_report_is_written_off_the_gui_thread(qtbot, window, recordings, tmp_path):
+    if not qa_view.available(qa_view.REPORT_MODULE):
+        pytest.skip("analysis/report is not in this installation")
+    open_and_wait(qtbot, window, recordings["paper"])
+    qa = window.qa
+    assert qa.export_button.isEnabled()
+    target = tmp_path / "paper-report.html"
+    with qtbot.waitSignal(qa.report_written, timeout=60_000) as written:
+        qa.export_to(target)
+        assert not qa.export_progress.isHidden() and not qa.export_cancel.isHidden()
+    assert str(target) in written.args[0]
+    assert target.exists() and "paper" in target.read_text(encoding="utf-8").lower()
+    assert qa.export_progress.isHidden()
+    assert "Written" in qa.export_label.text()
+
+
+def test_a_cancelled_export_writes_nothing(qtbot, window, recordings, tmp_path):
+    if not qa_view.available(qa_view.REPORT_MODULE):
+        pytest.skip("analysis/report is not in this installation")
+    open_and_wait(qtbot, window, recordings["paper"])
+    qa = window.qa
+    target = tmp_path / "cancelled.pdf"
+    qa.export_to(target)
+    qa.export_cancel.click()
+    assert "cancelled" in qa.export_label.text()
+    qa.worker.pool.waitForDone(60_000)
+    assert not target.exists()

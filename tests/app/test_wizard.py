@@ -1,0 +1,150 @@
+"""The measurement wizard on the in-process simulator: a whole run, what blocks Next, cancel, the hand-off."""
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from app.wizard import MeasureWizard
+from app.wizard.calibration_page import settings_key
+
+from .test_wizard_helpers import (
+    JOB_TIMEOUT_MS, choose_simulator, fill_driver, parameter_errors, plain, run_job, skip_to_measure, to_hardware)
+
+
+@pytest.fixture
+def wizard(qtbot, settings, tmp_path):
+    settings.qsettings.setValue("measure/out_dir", str(tmp_path / "measurements"))
+    w = MeasureWizard(settings.qsettings, rig_name="linpar-not-running-in-tests")
+    qtbot.addWidget(w)
+    w.resize(1300, 850)
+    w.show()
+    yield w
+    w.shutdown(10_000)
+
+
+def test_a_whole_run_ends_in_the_simulated_drivers_parameters(qtbot, window, settings, tmp_path):
+    settings.qsettings.setValue("measure/out_dir", str(tmp_path / "measurements"))
+    wizard = window.wizard
+    window.pages.setCurrentWidget(wizard)
+    to_hardware(wizard)
+    choose_simulator(wizard, realtime=False)
+    hardware = wizard.hardware_page
+    run_job(qtbot, hardware.test_audio_button, hardware.audio_jobs)
+    assert "Found:" in hardware.audio_result.text() and "current" in hardware.audio_result.text()
+    wizard.next_button.click()
+
+    calibration = wizard.calibration_page
+    assert not wizard.next_button.isEnabled()                 # nothing stored for the simulator yet
+    run_job(qtbot, calibration.measure_button, calibration.jobs)
+    assert "Resistor OK" in calibration.result.text()
+    assert settings.qsettings.value(settings_key("simulator"))      # stored
+    assert wizard.next_button.isEnabled()
+    wizard.next_button.click()
+
+    level = wizard.level_page
+    run_job(qtbot, level.run_button, level.jobs)
+    assert level.decision is not None and level.decision.level is not None
+    assert "Chosen:" in level.decision_label.text() and "Why:" in level.decision_label.text()
+    assert level.probes.rowCount() == len(level.decision.probes) >= 1
+    assert level.panels.frames_received >= 2
+    wizard.next_button.click()
+
+    measure = wizard.measure_page
+    with qtbot.waitSignal(window.measurement_shown, timeout=JOB_TIMEOUT_MS) as finished:
+        measure.start_button.click()
+    outcome = finished.args[0]
+    assert outcome.path.exists() and outcome.path.with_suffix(".json").exists()
+    assert measure.panels.frames_received >= 2
+    wizard.next_button.click()
+
+    results = wizard.results_page
+    assert wizard.current is results
+    errors = parameter_errors(results.table)
+    assert all(abs(e) < 0.01 for e in errors.values()), errors
+    assert results.validity.overall_light.status == "green"
+    # The measurement went to the Results page, and from there to the Model lab and QA.
+    assert window.results.result.source == outcome.path
+    assert window.model_lab.base is window.results.result
+    assert window.qa.result is window.results.result
+    assert window.settings.recent_files()[0] == str(outcome.path.resolve())
+    results.open_button.click()
+    assert window.pages.currentWidget() is window.results
+
+
+def test_next_is_disabled_with_a_reason_until_the_name_is_given(qtbot, wizard):
+    assert wizard.current is wizard.driver_page
+    assert not wizard.next_button.isEnabled()
+    assert "name" in wizard.reason.text() and wizard.reason.isVisible()
+    fill_driver(wizard)
+    assert wizard.next_button.isEnabled() and wizard.reason.text() == ""
+    wizard.driver_page.name_edit.clear()
+    assert not wizard.next_button.isEnabled() and "name" in wizard.reason.text()
+
+
+def test_a_rig_that_is_not_running_blocks_next_and_says_how_to_start_it(qtbot, wizard):
+    to_hardware(wizard)
+    page = wizard.hardware_page
+    assert page.simulator_radio.isChecked()          # nothing else there: the in-process simulator
+    assert wizard.next_button.isEnabled()
+    page.rig_radio.setChecked(True)
+    assert not wizard.next_button.isEnabled()
+    assert "linpar rig start" in wizard.reason.text()
+    assert not page.test_audio_button.isEnabled()
+
+
+def test_a_channel_map_with_two_signals_on_one_input_blocks_next(qtbot, wizard, monkeypatch):
+    to_hardware(wizard)
+    page = wizard.hardware_page
+    page.devices = ["a card"]                 # no PortAudio in this test: the list is not asked for
+    page.device_message = "offline"
+    page.soundcard_radio.setChecked(True)
+    page.channel_form.spins["current"].setValue(0)       # voltage is on 0 too
+    assert not wizard.next_button.isEnabled()
+    assert wizard.reason.text()
+
+
+def test_cancel_stops_the_measurement_and_nothing_is_shown(qtbot, wizard):
+    skip_to_measure(qtbot, wizard, realtime=True, template="midrange")     # short periods: a frame comes soon
+    measure = wizard.measure_page
+    with qtbot.waitSignal(measure.panels.repainted, timeout=JOB_TIMEOUT_MS):
+        measure.start_button.click()
+    assert measure.jobs.cancel_button.isVisible() and not wizard.next_button.isEnabled()
+    assert not wizard.back_button.isEnabled()
+    assert "Wait for the measurement" in wizard.reason.text()
+    with qtbot.waitSignal(wizard.session.cancelled, timeout=10_000):
+        measure.jobs.cancel_button.click()
+    assert "cancelled" in measure.result.text().lower()
+    assert wizard.state.outcome is None
+    assert not wizard.next_button.isEnabled() and wizard.back_button.isEnabled()
+    assert measure.start_button.isEnabled()
+
+
+def test_the_measurement_runs_off_the_gui_thread(qtbot, wizard, monkeypatch):
+    import app.wizard.tasks as tasks
+    threads = []
+    real = tasks.run_measurement
+
+    def spy(*args, **kwargs):
+        threads.append(threading.current_thread())
+        return real(*args, **kwargs)
+    monkeypatch.setattr(tasks, "run_measurement", spy)
+    skip_to_measure(qtbot, wizard, realtime=False)
+    with qtbot.waitSignal(wizard.measurement_finished, timeout=JOB_TIMEOUT_MS):
+        wizard.measure_page.start_button.click()
+    assert threads and threads[0] is not threading.main_thread()
+
+
+def test_a_failing_device_is_a_message_not_a_crash(qtbot, wizard, monkeypatch):
+    from instruments.audio.errors import AudioError
+    import app.wizard.hardware as hardware
+
+    def broken(config, calibration=None):
+        raise AudioError("sound card 'X' not found")
+    monkeypatch.setattr(hardware, "open_audio", broken)
+    to_hardware(wizard)
+    choose_simulator(wizard, realtime=False)
+    page = wizard.hardware_page
+    run_job(qtbot, page.test_audio_button, page.audio_jobs)
+    assert "Failed: sound card 'X' not found" in plain(page.audio_result)
+    assert wizard.next_button.isEnabled()          # a test is advice; the user may go on

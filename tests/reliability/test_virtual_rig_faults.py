@@ -1,0 +1,110 @@
+"""Faults on the virtual rig (JACK, the laser emulator on the rig's pty): the workstation stays usable.
+
+tests/instruments/test_measure_rig.py shows that an xrun, a closed laser pty
+and a killed JACK client each end a measurement within 2 s keeping its
+periods. Here: after an xrun and after a closed pty, the next measurement in
+the same process completes; and with the JACK server killed under `linpar
+measure` (which PortAudio does not survive, so in a process of its own) the
+command says in one line what happened and where the periods it kept are.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from analysis.recording import read_recording
+from instruments.laser import ILD1420
+from instruments.measurement import MeasurementFailed, MeasurementPlan
+from instruments.measurement.recovery import find_unfinished, run_journaled
+from instruments.rig.workstation import rig_audio
+from tests.builders import PAPER, REPO_ROOT
+
+pytestmark = [pytest.mark.rig, pytest.mark.timeout(120)]
+DEFAULT_LASER = {"clock_ppm": 37.0, "start_latency_s": 0.02}
+
+
+def plan(**changes) -> MeasurementPlan:
+    """Periods of 8,192 samples, one to settle: these measurements must end as they should, not be exact."""
+    base = dict(period_samples=8192, n_periods=2, settle_periods=1, f_min_hz=5.0,
+                driver={"name": PAPER.name, "sd_m2": PAPER.sd_m2})
+    return MeasurementPlan.from_template("woofer", **{**base, **changes})
+
+
+@pytest.fixture
+def rig(virtual_rig):
+    yield virtual_rig
+    virtual_rig.command("laser", set=DEFAULT_LASER, plug=virtual_rig.command("laser")["laser_pty"] is None)
+
+
+def devices(rig):
+    audio = rig_audio(rig)
+    audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
+    return audio, ILD1420(rig.command("laser")["laser_pty"])
+
+
+def break_after(periods: int, action):
+    def progress(p):
+        if p.periods_kept >= periods and not progress.done:
+            progress.done = True
+            action()
+    progress.done = False
+    return progress
+
+
+def test_after_an_xrun_and_after_a_closed_laser_pty_the_next_measurement_completes(rig, tmp_path):
+    audio, laser = devices(rig)
+    with pytest.raises(MeasurementFailed, match="xrun") as info:
+        run_journaled(plan(n_periods=40), audio, laser, tmp_path, name="xrun",
+                      progress=break_after(2, lambda: rig.command("xrun", seconds=0.1)))
+    assert read_recording(info.value.outcome.recording_path).n_periods >= 2
+
+    audio, laser = devices(rig)
+    with pytest.raises(MeasurementFailed, match="laser link lost") as info:
+        run_journaled(plan(n_periods=40), audio, laser, tmp_path, name="pty",
+                      progress=break_after(4, lambda: rig.command("laser", unplug=True)))
+    assert read_recording(info.value.outcome.recording_path).n_periods >= 2
+    rig.command("laser", plug=True)                     # a new pty: what a person plugging it back gets
+
+    audio, laser = devices(rig)
+    outcome = run_journaled(plan(), audio, laser, tmp_path, name="again", analyse=False)
+    assert outcome.ended_by == "complete" and outcome.periods == 2
+    assert "displacement" in {c.signal for c in read_recording(outcome.recording_path).channels}
+    assert find_unfinished(tmp_path) == []
+
+
+def test_linpar_measure_with_the_jack_server_killed_says_so_in_one_line_and_keeps_the_periods(tmp_path,
+                                                                                             virtual_rig):
+    from instruments.rig.manager import find_rig, start_rig, stop_rig
+    name, runtime = f"linpar-jackd-{os.getpid()}", tmp_path / "rig"
+    handle = start_rig(name, runtime_dir=runtime, seed=4)
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "app.cli", "measure", "--out", str(tmp_path / "out"), "--name", "m",
+             "--rig-name", name, "--runtime-dir", str(runtime), "--period", "8192", "--periods", "60"],
+            cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        lines = []
+        for line in proc.stderr:
+            lines.append(line)
+            if "averaging 2/" in line:
+                os.kill(handle.state.jackd_pid, signal.SIGKILL)
+                break
+        out, err = proc.communicate(timeout=30)
+        lines += err.splitlines(keepends=True)
+    finally:
+        if find_rig(name, runtime) is not None:
+            stop_rig(name, runtime)
+    assert proc.returncode == 2, "".join(lines)
+    errors = [line for line in lines if line.startswith("linpar: error: ")]
+    assert len(errors) == 1 and "Traceback" not in "".join(lines)
+    # The rig's process dies with its server and takes the laser's pty along: either may be noticed first.
+    assert "sound card" in errors[0] or "laser link lost" in errors[0]
+    assert "marked partial" in errors[0] and str(tmp_path / "out" / "m.wav") in errors[0]
+    rec = read_recording(tmp_path / "out" / "m.wav")
+    assert rec.n_periods >= 2 and json.loads((tmp_path / "out" / "m.json").read_text())["measurement"]["partial"]
