@@ -3,7 +3,7 @@
     linpar measure --out DIR [--rig virtual|soundcard] [--device NAME] [--calibration FILE]
                    [--laser URL|analog|none] [--template woofer|midrange|tweeter|microspeaker]
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
-                   [--json]
+                   [--on-xrun end|restart] [--json]
 
 With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
 used, started first if it is not running and stopped at the end if this
@@ -53,6 +53,9 @@ def add_commands(sub) -> None:
     m.add_argument("--periods", type=int, metavar="N", help="periods averaged")
     m.add_argument("--period", type=int, metavar="SAMPLES", help="period length, a power of two")
     m.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2")
+    m.add_argument("--on-xrun", choices=("end", "restart"),
+                   help="an xrun while periods are kept: end the measurement, keeping them (the default with the "
+                        "serial laser), or average again")
     m.add_argument("--model", metavar="EFFECTS",
                    help="effect ids (default lr2,creep-log; with the serial laser also delay-x)")
     m.add_argument("--json", action="store_true", help="print one JSON object")
@@ -81,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
         _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal}")
     # The plan first: a plan that cannot work must not start a rig.
     plan = MeasurementPlan.from_template(args.template, level_v_rms=args.level, n_periods=args.periods,
-                                         period_samples=args.period)
+                                         period_samples=args.period, on_xrun=args.on_xrun)
     with ExitStack() as stack:
         audio, laser, driver = _devices(args, stack)
         if args.sd is not None:

@@ -134,12 +134,15 @@ class AlignedDisplacement:
 def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: np.ndarray,
                 period_starts: Sequence[int], period_samples: int, audio_rate: float, nominal_rate: float,
                 excited_bins: np.ndarray, *, sign: float = -1.0, latency_s: float = 0.0,
-                refine: bool = True) -> AlignedDisplacement:
+                refine: bool = True, quick: bool = False) -> AlignedDisplacement:
     """The displacement at the audio samples of the given periods (contiguous, in order).
 
     ``sign``: -1 when the laser looks at the front of the cone (outward motion
     shortens the distance). Periods at the end that the laser's stream does not
     cover are left out (``periods`` says how many are in); ValueError if none is.
+    ``quick`` (the live view): interpolated on every D-th audio sample only and
+    brought to the full rate period by period through the FFT, D times less
+    work, the same lines; the recording gets the full interpolation.
     """
     laser_line = lower_envelope(stream.block_last, stream.block_host_time)
     audio_line = lower_envelope(audio_stops, audio_host_times)
@@ -175,7 +178,12 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
         clock = moved
         if abs(drift) < _CONVERGED:
             break
-    x = interpolate(filled, clock.laser_index(grid))
+    if quick:
+        coarse_x = interpolate(filled, clock.laser_index(coarse)).reshape(n_periods, -1)
+        spectra = np.fft.rfft(coarse_x, axis=1) * step          # the same lines at the full rate
+        x = np.fft.irfft(spectra, period_samples, axis=1).ravel()
+    else:
+        x = interpolate(filled, clock.laser_index(grid))
     x = _band_limited(sign * (x - np.mean(x)), n_periods, period_samples, max_hz / audio_rate)
     return AlignedDisplacement(x, n_periods, clock, host_clock, laser_line, audio_line, counts, float(max_hz),
                                lines, passes)

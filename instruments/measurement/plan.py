@@ -103,9 +103,9 @@ class MeasurementPlan:
         return math.ceil(SETTLE_SAMPLES / self.period_samples)
 
     def end_on_xrun(self, serial_laser: bool) -> bool:
-        if self.on_xrun == "restart" and serial_laser:
-            raise ValueError("on_xrun='restart' cannot be used with a serial laser: an xrun moves the audio's "
-                             "sample clock against the laser's")
+        """Whether an xrun while periods are kept ends the measurement ("end"), or capture() discards them and
+        averages again ("restart"; with the serial laser the audio's time line is then taken from the blocks
+        after the xrun, since an xrun moves the audio's sample counter against the host clock)."""
         return self.on_xrun == "end" or (self.on_xrun is None and serial_laser)
 
     def excitation(self, sample_rate: int):

@@ -32,7 +32,9 @@ The analysis uses the default model, plus `delay-x` with the serial laser
 from __future__ import annotations
 
 import dataclasses
+import gc
 import re
+import sys
 import threading
 import time
 from dataclasses import dataclass
@@ -64,6 +66,7 @@ from instruments.measurement.timed_audio import TimedAudio
 # so the name is taken through the package, and whichever of the two it is, the function comes out.
 capture = getattr(_capture_name, "capture", _capture_name)
 _CAPTURE_KEPT = re.compile(r"; kept \d+ of \d+ periods$")
+GIL_SWITCH_S = 0.001
 SILENT_SHARE = 0.01      # a period with this share of exact zeros on every input is not the driver's
 STAGES = ("laser", "settling", "averaging", "aligning", "writing", "analysing", "done")
 
@@ -151,6 +154,14 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
         live.on_progress(kept)
         report("averaging" if kept else "settling", kept)
 
+    # NB: process-wide while it runs. The audio callback is Python and must get the GIL within one cycle of
+    # the audio server (21 ms on the rig); with the pump, the laser's readers and the live view also asking
+    # for it, the default interval (5 ms per holder) let it wait longer: xruns. 1 ms keeps it well inside.
+    # Likewise the cyclic garbage collector: a full collection holds the GIL for tens of ms. The capture makes
+    # no reference cycles; what it leaves is collected after.
+    switch_interval, collecting = sys.getswitchinterval(), gc.isenabled()
+    sys.setswitchinterval(min(switch_interval, GIL_SWITCH_S))
+    gc.disable()
     try:
         captured, failure = _capture(timed, multitone, plan, on_capture)
         if captured is None:          # the stream never started: nothing was recorded
@@ -164,6 +175,10 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
         if reader is not None:
             reader.close()
         raise
+    finally:
+        sys.setswitchinterval(switch_interval)
+        if collecting:
+            gc.enable()
     aligned, laser_info, raw_path = None, None, None
     if reader is not None:
         report("aligning", captured.n_periods)
@@ -328,7 +343,7 @@ def _provisional_displacement(plan: MeasurementPlan, timed: TimedAudio, reader: 
         try:
             aligned = align_laser(stream_of_blocks(blocks), stop, arrived, [start], plan.period_samples,
                                   timed.sample_rate, plan.laser_rate_hz, excited_bins, sign=plan.laser_sign,
-                                  latency_s=plan.laser_latency_s, refine=False)
+                                  latency_s=plan.laser_latency_s, refine=False, quick=True)
         except ValueError:
             return None
         return aligned.displacement

@@ -16,8 +16,9 @@ capture() watches as its cancel), when:
   samples, so the audio's sample counter no longer runs with the host clock
   the laser is aligned by, and the periods on either side of it do not line
   up with the laser's stream the same way. An xrun while the driver still
-  settles is passed on: capture() settles again after it, and the audio's
-  time line is taken from the blocks after it (``arrivals(since_xrun=True)``).
+  settles (or with ``end_on_xrun`` False) is passed on: capture() settles,
+  or averages, again after it, and the audio's time line is taken from the
+  blocks after it (``arrivals(since_xrun=True)``).
 """
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ class TimedAudio:
         # NB: appended by the pump thread, read (copied) by the measurement thread.
         self._log: list[tuple[int, int, float]] = []
         self.xrun_at: int | None = None           # input index of the block whose xrun ended the capture
-        self.settling_xruns: list[int] = []       # input index of the blocks with an xrun passed on
+        self.passed_xruns: list[int] = []         # input index of the blocks with an xrun passed on
         self.keeping = False                      # NB: set by the measurement thread once a period is kept
         self.handed_out_until = 0                 # stop index of the last block given to capture()
         self._keep = max(int(keep_samples), 0)
@@ -105,8 +106,8 @@ class TimedAudio:
         """(start, stop, host arrival time) of every block taken from the stream so far; with
         ``since_xrun``, of those after the last xrun passed on (one time line: no samples lost between)."""
         log = list(self._log)
-        if since_xrun and self.settling_xruns:
-            after = self.settling_xruns[-1]
+        if since_xrun and self.passed_xruns:
+            after = self.passed_xruns[-1]
             log = [entry for entry in log if entry[0] > after]
         if not log:
             return np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0)
@@ -141,7 +142,7 @@ class TimedAudio:
                         self.xrun_at = block.start
                         self.stop_event.set()
                         continue
-                    self.settling_xruns.append(block.start)
+                    self.passed_xruns.append(block.start)
                 self._remember(block)
                 try:
                     self._queue.put_nowait(block)

@@ -11,6 +11,7 @@ which detaches it into its own process group.
 from __future__ import annotations
 
 import argparse
+import gc
 import os
 import signal
 import sys
@@ -123,6 +124,10 @@ class RigProcess:
                 client_pattern=args.client_pattern, laser_pty=laser_pty,
                 extra={"driver_name": definition.name, "sd_m2": definition.sd_m2, "model": args.model,
                        "laser": None if self.laser is None else self.laser.settings})
+            # What start-up made lives as long as the rig: out of the cyclic collector's way, or its first full
+            # collection (~10 ms of held GIL, more under load) makes the JACK callback miss a cycle.
+            gc.collect()
+            gc.freeze()
             self._write_state()
             print(f"rig {args.name!r} ready: driver {definition.name}, JACK server {args.name!r}", flush=True)
             while not self.stop_requested.wait(0.5):
@@ -231,6 +236,9 @@ def json_state(state: RigState | None) -> dict[str, Any] | None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    # The JACK callback is Python: it must get the GIL within a cycle while the laser emulator's threads run
+    # (the default 5 ms per holder let it miss cycles).
+    sys.setswitchinterval(0.001)
     process = RigProcess(args)
     for sig in (signal.SIGTERM, signal.SIGINT, signal.SIGHUP):
         signal.signal(sig, lambda *_: process.stop_requested.set())

@@ -152,6 +152,22 @@ def test_an_xrun_ends_the_measurement_keeping_the_periods_before_it(tmp_path):
     assert json.loads(outcome.sidecar_path.read_text())["capture"]["xruns"] == 0     # none inside the periods
 
 
+def test_with_on_xrun_restart_the_serial_laser_measurement_averages_again_after_an_xrun(tmp_path):
+    audio, laser = simulated(ppm=90.0)
+    injected = {}
+
+    def progress(p):
+        if p.periods_kept >= 2 and not injected:
+            injected["at"] = p.periods_kept
+            audio.inject_xrun()
+
+    outcome = run_measurement(plan(on_xrun="restart"), audio, laser, tmp_path, name="m", progress=progress)
+    stats = json.loads(outcome.sidecar_path.read_text())["audio_capture"]
+    assert injected and stats["restarts"] >= 1 and outcome.periods == 4
+    assert outcome.alignment["clock_ppm"] == pytest.approx(90.0, abs=0.5)
+    assert_recovers(outcome.result)
+
+
 def test_cancel_keeps_what_was_captured(tmp_path):
     audio, laser = simulated()
     cancel = threading.Event()
@@ -194,7 +210,7 @@ def test_plans_come_from_templates_and_refuse_what_cannot_work():
             MeasurementPlan.from_template("woofer", **bad)
     with pytest.raises(ValueError, match="unknown template"):
         MeasurementPlan.from_template("subwoofer")
-    with pytest.raises(ValueError, match="serial laser"):
-        MeasurementPlan(on_xrun="restart").end_on_xrun(serial_laser=True)
+    assert MeasurementPlan().end_on_xrun(serial_laser=True) and not MeasurementPlan().end_on_xrun(False)
+    assert not MeasurementPlan(on_xrun="restart").end_on_xrun(serial_laser=True)
     excitation = plan().excitation(48000)
     assert excitation.rms == pytest.approx(1.0) and excitation.period_samples == PERIOD

@@ -40,7 +40,8 @@ def test_start_status_fault_stop_and_nothing_left_behind(rig_name):
     assert f"rig '{name}' running" in started.stdout and "JACK_DEFAULT_SERVER=" + name in started.stdout
     assert "clip=5" in started.stdout
     state = json.loads(Path(runtime, name, "state.json").read_text())
-    assert state["jack_server"] == name and state["sample_rate"] == 48000 and state["laser_pty"] is None
+    assert state["jack_server"] == name and state["sample_rate"] == 48000
+    assert state["laser_pty"].startswith("/dev/pts/") and Path(state["laser_pty"]).exists()   # the serial laser
     assert set(state["ports"]) == {"amplifier", "voltage-sense", "current-sense", "laser-analog"}
     assert len(processes_mentioning(f"jackd -n {name} ")) == 1
     # The rig is detached (its own session, not the CLI's) and jackd is its child.
