@@ -30,7 +30,8 @@ import threading
 from contextlib import ExitStack
 from pathlib import Path
 
-from instruments.measurement import TEMPLATES, MeasurementError, MeasurementPlan, MeasurementProgress
+from instruments.measurement.errors import MeasurementError
+from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
 LASER_ANALOG, LASER_NONE = "analog", "none"
 

@@ -4,11 +4,27 @@ No Qt: the GUI runs ``run_measurement`` in a worker thread and forwards its
 progress and LiveFrames. See runner.py for the flow, alignment.py and
 clocks.py for how the laser's clock is put on the audio's, raw_stream.py
 for the raw laser file beside each recording.
-"""
-from instruments.measurement.plan import TEMPLATES, MeasurementPlan, MeasurementTemplate
-from instruments.measurement.runner import (
-    MeasurementCancelled, MeasurementError, MeasurementFailed, MeasurementOutcome, MeasurementProgress,
-    run_measurement)
 
-__all__ = ["TEMPLATES", "MeasurementCancelled", "MeasurementError", "MeasurementFailed", "MeasurementOutcome",
-           "MeasurementPlan", "MeasurementProgress", "MeasurementTemplate", "run_measurement"]
+Names are loaded on first use (PEP 562), as in instruments.audio: the CLI
+builds its parser from TEMPLATES without loading the runner (and lmfit).
+"""
+from importlib import import_module
+
+_EXPORTS = {
+    "TEMPLATES": "plan", "MeasurementPlan": "plan", "MeasurementTemplate": "plan",
+    "MeasurementCancelled": "runner", "MeasurementError": "errors", "MeasurementFailed": "runner",
+    "MeasurementOutcome": "runner", "MeasurementProgress": "runner", "run_measurement": "runner",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'instruments.measurement' has no attribute {name!r}")
+    value = getattr(import_module(f"instruments.measurement.{_EXPORTS[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__

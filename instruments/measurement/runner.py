@@ -60,6 +60,7 @@ from instruments.measurement.plan import MeasurementPlan
 from instruments.measurement.raw_stream import raw_capture_path, write_raw_capture
 from instruments.measurement.resample import HALF_TAPS
 from instruments.measurement.timed_audio import TimedAudio
+from instruments.measurement.errors import MeasurementError  # noqa: F401  (re-exported)
 
 # NB: "capture" is both a submodule of instruments.audio and the function the package exports lazily.
 # Importing the submodule by its path binds the package's name to the module, for every later importer;
@@ -69,13 +70,6 @@ _CAPTURE_KEPT = re.compile(r"; kept \d+ of \d+ periods$")
 GIL_SWITCH_S = 0.001
 SILENT_SHARE = 0.01      # a period with this share of exact zeros on every input is not the driver's
 STAGES = ("laser", "settling", "averaging", "aligning", "writing", "analysing", "done")
-
-
-class MeasurementError(RuntimeError):
-    """The measurement could not start (a device missing, a plan the devices cannot do); nothing was recorded."""
-
-    def __init__(self, message: str):
-        super().__init__(" ".join(str(message).splitlines()))
 
 
 class MeasurementFailed(MeasurementError):
