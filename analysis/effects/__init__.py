@@ -16,10 +16,12 @@ _ALL: tuple[Effect, ...] = (
     creep.creep_fractional,
     creep.creep_rs,
     channels.delay_current,
+    channels.lowpass_current,
     channels.delay_x,
     channels.lowpass_x,
     channels.lowpass2_x,
     breakup.breakup,
+    breakup.breakup_spot,
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}

@@ -103,3 +103,45 @@ breakup = Breakup(
            "7*fs carrying much of the mass (mu2 > 0.2) are hard to reach even then. The laser sees the coil's motion (the cone's centre); a laser spot "
            "on the outer cone would see m2 instead."),
 )
+
+
+@dataclass(frozen=True)
+class SpotMode(Effect):
+    """Hx_measured(s) = Hx(s) * (s*w2/Q2 + w2^2) / (s^2 + s*w2/Q2 + w2^2),  w2 = 2*pi*f2x.
+
+    The laser spot sits on a part of the cone that rides on the coil through
+    the cone's own bending stiffness: a base-excited oscillator whose
+    transmissibility is 1 far below f2x, peaks at f2x and falls above. Its
+    mass is small against Mms, so the impedance does not see it.
+    """
+
+    def response(self, s, p):
+        w2 = 2.0 * np.pi * p["f2x"]
+        damping = s * w2 / p["Q2x"]
+        return (damping + w2 * w2) / (s * s + damping + w2 * w2)
+
+    def guess(self, ctx):
+        return {"f2x": min(DEFAULT_F2_OVER_FS * ctx.fs, 0.5 * ctx.f_max), "Q2x": START_Q2}
+
+    def starts(self, ctx) -> list[dict[str, float]]:
+        """f2x stepped across the band like Breakup.starts: a narrow mode is found only from nearby."""
+        return [{"f2x": start["f2"], "Q2x": START_Q2} for start in breakup.starts(ctx)]
+
+
+breakup_spot = SpotMode(
+    id="breakup-spot",
+    category=CATEGORY,
+    title="Cone breakup seen at the laser spot only",
+    site=Site.DISPLACEMENT,
+    params=(ParamSpec("f2x", "Hz", "Hz", 1.0, 10.0, 1e5, 2000.0, "resonance of the cone area under the laser spot"),
+            ParamSpec("Q2x", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of that local mode")),
+    physics=("The laser measures one spot of the cone, not the coil. When the cone bends, that spot moves "
+             "more than the coil near its local resonance and less above it, while the coil, and so the "
+             "impedance, hardly notices: the mode's mass is small."),
+    signature=("A peak followed by a fall in |Hx| (and a phase swing) at one frequency well above fs, with no "
+               "matching wiggle in Z."),
+    typical="f2x 1 to 8 kHz for woofer cones, Q2x 2 to 20",
+    reference="W. Klippel, 'Loudspeaker cone vibration and radiation' (Klippel GmbH): scanning vibrometry",
+    notes=("An alternative to `breakup` in its category: choose it when Z shows no trace of the mode. Aim the "
+           "laser at the dust cap or close to the coil to avoid it."),
+)

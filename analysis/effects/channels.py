@@ -67,6 +67,41 @@ delay_current = CurrentDelay(
 
 
 @dataclass(frozen=True)
+class CurrentLowPass(Effect):
+    """Z_measured(s) = Z(s) * (1 + s/wc),  wc = 2*pi*fc_i.
+
+    The current sense (shunt amplifier, its anti-alias filter) rolls off
+    before the voltage sense: I_measured = I / (1 + s/wc), so U/I_measured =
+    Z*(1 + s/wc). Well below fc_i it looks like a delay of 1/wc; near fc_i
+    |Z| rises too, which a delay cannot do.
+    """
+
+    def response(self, s, p):
+        return 1.0 + s / (2.0 * np.pi * p["fc_i"])
+
+    def guess(self, ctx):
+        return {"fc_i": max(4.0 * ctx.f_max, 1e3)}
+
+
+lowpass_current = CurrentLowPass(
+    id="lowpass-current",
+    category=CURRENT_CATEGORY,
+    title="Bandwidth of the current sense (first-order low-pass)",
+    site=Site.CURRENT,
+    params=(ParamSpec("fc_i", "Hz", "kHz", 1e-3, 100.0, 1e7, 50e3,
+                      "corner frequency of the current channel relative to the voltage channel"),),
+    physics=("The current is sensed by a small shunt and an amplifier whose bandwidth, or an extra filter, "
+             "is lower than the voltage path's: the measured current falls and lags at the top of the band, "
+             "so the measured |Z| rises and its phase leads."),
+    signature=("Impedance residual growing with frequency in the phase (like a delay) and, near the corner, "
+               "in |Z| too: measured |Z| above the model at the top lines."),
+    typical="fc_i 20 kHz to 1 MHz for a good sense amplifier; a few kHz for a slow one",
+    reference="Any first-order amplifier response; AES2-2012 on measuring the impedance of drivers",
+    notes=_CURRENT_GAIN_NOTE,
+)
+
+
+@dataclass(frozen=True)
 class DisplacementDelay(Effect):
     """Hx_measured(s) = Hx(s) * exp(-s*tau_x).
 

@@ -32,12 +32,16 @@ CASES = [
     ("creep", BASE, {"lambda": 0.376}, "lr2"),
     ("electrical-channel", BASE + ",delay-current", {"tau_i": 20e-6}, BASE),
     ("electrical-channel", BASE + ",delay-current", {"tau_i": -50e-6}, BASE),
+    ("electrical-channel", BASE + ",lowpass-current", {"fc_i": 20e3}, BASE),
+    ("electrical-channel", BASE + ",lowpass-current", {"fc_i": 5e3}, BASE),
     ("displacement-sensor", BASE + ",delay-x", {"tau_x": 100e-6}, BASE),
     ("displacement-sensor", BASE + ",delay-x", {"tau_x": 400e-6}, BASE),
     ("displacement-sensor", BASE + ",lowpass-x", {"fc_x": 2000.0}, BASE),
     ("displacement-sensor", BASE + ",lowpass-x", {"fc_x": 600.0}, BASE),
     ("breakup", BASE + ",breakup", {"f2": 700.0, "Q2": 5.0, "mu2": 0.1}, BASE),
     ("breakup", BASE + ",breakup", {"f2": 2500.0, "Q2": 10.0, "mu2": 0.05}, BASE),
+    ("breakup", BASE + ",breakup-spot", {"f2x": 1500.0, "Q2x": 5.0}, BASE),
+    ("breakup", BASE + ",breakup-spot", {"f2x": 4000.0, "Q2x": 10.0}, BASE),
 ]
 
 # The stages of LR-3 are interchangeable: compare them as a set.

@@ -27,14 +27,16 @@ CASES = {
     "creep-fractional": {"beta": 0.1},
     "creep-rs": {"lambda": 0.3},
     "delay-current": {"tau_i": 10e-6},
+    "lowpass-current": {"fc_i": 20e3},
     "delay-x": {"tau_x": 40e-6},
     "lowpass-x": {"fc_x": 2000.0},
     "lowpass2-x": {"fc_x": 3000.0, "Q_x": 0.8},
     "breakup": {"f2": 1000.0, "Q2": 5.0, "mu2": 0.2},
+    "breakup-spot": {"f2x": 2000.0, "Q2x": 5.0},
 }
 # What Z alone must identify: everything that acts on the impedance directly.
 # (breakup too: its parameterisation is meant to be identifiable from Z alone.)
-IMPEDANCE_ONLY = ("lr2", "lr3", "leach", "wright", "delay-current", "breakup")
+IMPEDANCE_ONLY = ("lr2", "lr3", "leach", "wright", "delay-current", "lowpass-current", "breakup")
 SEED = 7
 MAX_Z = 4.0
 MAX_CHI2_RED = 1.5
