@@ -165,6 +165,16 @@ def _transfer(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.n
     return TransferFunction(name, unit, bins * bin_width, bins, value, np.sqrt(var))
 
 
+def _displacement_max_hz(recording: Recording) -> float | None:
+    value = recording.extra.get("displacement_max_hz") if recording.extra else None
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
+        raise SpectrumError(f"sidecar key displacement_max_hz: found {value!r}, expected a positive number "
+                            "in Hz (the top of the laser's band)")
+    return float(value)
+
+
 def estimate_spectra(recording: Recording) -> Spectra:
     """Per-period spectra after the settle periods, averaged, with noise and transfer functions."""
     for required in ("voltage", "current"):
@@ -197,7 +207,12 @@ def estimate_spectra(recording: Recording) -> Spectra:
     impedance = _transfer("impedance", "ohm", u, i, excited, bin_width)
     displacement = None
     if "displacement" in per_period:
-        x = per_period["displacement"][:, excited]
-        displacement = _transfer("displacement", "m/V", x, u, excited, bin_width)
+        # A serial laser samples slower than the sound card: the sidecar's
+        # displacement_max_hz marks where its band ends; lines above carry no displacement.
+        max_hz = _displacement_max_hz(recording)
+        x_lines = excited if max_hz is None else excited[excited * bin_width <= max_hz]
+        in_band = np.isin(excited, x_lines)
+        displacement = _transfer("displacement", "m/V", per_period["displacement"][:, x_lines],
+                                 u[:, in_band], x_lines, bin_width)
     return Spectra(recording.sample_rate, n, recording.n_periods, excited, unexcited,
                    channels, impedance, displacement)
