@@ -24,6 +24,13 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
+# NB: `capture` is both a submodule and the function the package exports. Bound
+# here, eagerly: otherwise the first `import instruments.audio.capture` anywhere
+# rebinds the package's attribute to the module for everyone. (capture.py itself
+# loads only numpy and this package's light modules, not PortAudio.)
+from instruments.audio.capture import CapturedSignals, CaptureStats, capture  # noqa: E402
+
+
 def __getattr__(name: str):
     if name not in _EXPORTS:
         raise AttributeError(f"module 'instruments.audio' has no attribute {name!r}")
