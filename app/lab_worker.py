@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
-import itertools
 import logging
 import threading
 from dataclasses import dataclass
 from typing import Callable
 
-from PySide6.QtCore import QObject, QThreadPool, Signal
+from PySide6.QtCore import QObject, Signal
 
 from analysis import residuals
 from analysis.derived import parameter_table
@@ -29,6 +28,7 @@ from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from app.result_curves import ResultCurves, result_curves
 from app.workers import USER_ERRORS, one_line
+from app.job_book import JobBook
 
 log = logging.getLogger(__name__)
 
@@ -217,7 +217,7 @@ class DiagnoseJob(LabJob):
         self._worker.diagnosis_finished.emit(self.id, DiagnosisOutcome(last.fit, rows, path, last.residual))
 
 
-class LabWorker(QObject):
+class LabWorker(QObject, JobBook):
     progress = Signal(int, str)                 # job id, what is being worked on
     refit_finished = Signal(int, object)        # job id, LabFit
     diagnosis_finished = Signal(int, object)    # job id, DiagnosisOutcome
@@ -226,32 +226,13 @@ class LabWorker(QObject):
 
     def __init__(self, parent: QObject | None = None):
         super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self._ids = itertools.count(1)
-        self._jobs: dict[int, LabJob] = {}
-        for signal in (self.refit_finished, self.diagnosis_finished, self.failed, self.cancelled):
-            signal.connect(self._forget)
+        self._init_jobs(self, (self.refit_finished, self.diagnosis_finished, self.failed, self.cancelled))
 
     def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabJob:
-        return self._start(RefitJob(next(self._ids), self, base, data, model, dict(start)))
+        return self._start(RefitJob(self._next_id(), self, base, data, model, dict(start)))
 
     def diagnose(self, base: AnalysisResult, data: FitData, start: FitResult, follow: bool = False,
                  taken: LabFit | None = None) -> LabJob:
-        return self._start(DiagnoseJob(next(self._ids), self, base, data, start, follow, taken))
+        return self._start(DiagnoseJob(self._next_id(), self, base, data, start, follow, taken))
 
-    def _start(self, job: LabJob) -> LabJob:
-        self._jobs[job.id] = job
-        self.pool.start(job)
-        return job
 
-    def cancel_all(self) -> None:
-        for job in list(self._jobs.values()):
-            job.cancel()
-
-    def shutdown(self, wait_ms: int) -> bool:
-        """Cancel every job and wait for the pool; True when all stopped in time."""
-        self.cancel_all()
-        return self.pool.waitForDone(wait_ms)
-
-    def _forget(self, job: int, *_args) -> None:
-        self._jobs.pop(job, None)

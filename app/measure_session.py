@@ -18,18 +18,18 @@ write_recording + analyze_recording); `runner_name()` says which.
 """
 from __future__ import annotations
 
-import itertools
 import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from PySide6.QtCore import QObject, QThreadPool, Signal
+from PySide6.QtCore import QObject, Signal
 
 from analysis.fit import FitCancelled
 from app.result_curves import result_curves
 from app.workers import USER_ERRORS, AnalysisOutcome, one_line
+from app.job_book import JobBook
 
 log = logging.getLogger(__name__)
 
@@ -127,7 +127,7 @@ class SessionJob:
                 session.finished.emit(self.id, result)
 
 
-class MeasureSession(QObject):
+class MeasureSession(QObject, JobBook):
     frame_ready = Signal(int, object)       # job id, analysis.live.LiveFrame
     progress = Signal(int, float, str)      # job id, fraction 0..1, what is being done
     finished = Signal(int, object)          # job id, the job's result
@@ -136,12 +136,7 @@ class MeasureSession(QObject):
 
     def __init__(self, parent: QObject | None = None):
         super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        self._ids = itertools.count(1)
-        self._jobs: dict[int, SessionJob] = {}
-        for signal in (self.finished, self.failed, self.cancelled):
-            signal.connect(self._forget)
+        self._init_jobs(self, (self.finished, self.failed, self.cancelled), max_threads=1)
 
     @property
     def busy(self) -> bool:
@@ -154,7 +149,7 @@ class MeasureSession(QObject):
         def work(job):
             from app.wizard.hardware import list_sound_cards
             return list_sound_cards()
-        return self._start("device list", work)
+        return self._launch("device list", work)
 
     def test_audio(self, config) -> SessionJob:
         def work(job):
@@ -162,13 +157,13 @@ class MeasureSession(QObject):
             job.progress(0.0, "playing a quiet test signal")
             return test_audio(config, job.cancel_event,
                               lambda kept, wanted: job.progress(kept / wanted, f"{kept} of {wanted} periods"))
-        return self._start("sound card test", work)
+        return self._launch("sound card test", work)
 
     def test_laser(self, config) -> SessionJob:
         def work(job):
             from app.wizard.hardware import test_laser
             return test_laser(config)
-        return self._start("laser test", work)
+        return self._launch("laser test", work)
 
     def calibrate(self, config, r_ohm: float, level_v: float) -> SessionJob:
         def work(job):
@@ -177,7 +172,7 @@ class MeasureSession(QObject):
                                     lambda kept, wanted: job.progress(kept / wanted,
                                                                       f"measuring the resistor: {kept} of {wanted} "
                                                                       f"periods"))
-        return self._start("calibration", work)
+        return self._launch("calibration", work)
 
     def check_level(self, config, template, corrections, v_min: float, v_max: float, x_limit_m: float) -> SessionJob:
         def work(job):
@@ -185,7 +180,7 @@ class MeasureSession(QObject):
             job.progress(0.0, "designing the multitone")
             return run_level_check(config, template, corrections, v_min, v_max, x_limit_m, job.frame,
                                    job.cancel_event, job.progress)
-        return self._start("level check", work)
+        return self._launch("level check", work)
 
     def measure(self, request) -> SessionJob:
         def work(job):
@@ -194,23 +189,9 @@ class MeasureSession(QObject):
             wav, result = run_measurement(request, job.frame, job.cancel_event, job.progress)
             job.progress(0.99, "preparing the plots")
             return MeasureOutcome(AnalysisOutcome(job.id, wav, result, result_curves(result)), request)
-        return self._start("measurement", work)
+        return self._launch("measurement", work)
 
     # -- bookkeeping -----------------------------------------------------------
-    def _start(self, kind: str, work: Callable[[SessionJob], object]) -> SessionJob:
-        job = SessionJob(next(self._ids), kind, work, self)
-        self._jobs[job.id] = job
-        self.pool.start(job)
-        return job
+    def _launch(self, kind: str, work: Callable[[SessionJob], object]) -> SessionJob:
+        return self._start(SessionJob(self._next_id(), kind, work, self))
 
-    def cancel_all(self) -> None:
-        for job in list(self._jobs.values()):
-            job.cancel()
-
-    def shutdown(self, wait_ms: int) -> bool:
-        """Cancel every job and wait for the pool; True when all stopped in time."""
-        self.cancel_all()
-        return self.pool.waitForDone(wait_ms)
-
-    def _forget(self, job: int, *_args) -> None:
-        self._jobs.pop(job, None)

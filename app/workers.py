@@ -9,13 +9,12 @@ has replaced. What crosses over is frozen (AnalysisOutcome) or a string.
 """
 from __future__ import annotations
 
-import itertools
 import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 
-from PySide6.QtCore import QObject, QThreadPool, Signal
+from PySide6.QtCore import QObject, Signal
 
 from analysis.fit import FitCancelled, FitError
 from analysis.model import ModelError
@@ -24,6 +23,7 @@ from analysis.recording import RecordingError, read_recording
 from analysis.spectra import SpectrumError
 from analysis.startvalues import StartValueError
 from app.result_curves import ResultCurves, result_curves
+from app.job_book import JobBook
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +75,7 @@ class AnalysisJob:
             signals.finished.emit(self.id, AnalysisOutcome(self.id, self.path, result, curves))
 
 
-class AnalysisWorker(QObject):
+class AnalysisWorker(QObject, JobBook):
     progress = Signal(int, str)         # job id, the stage being worked on
     finished = Signal(int, object)      # job id, AnalysisOutcome
     failed = Signal(int, str)           # job id, a one-line message for the user
@@ -83,29 +83,11 @@ class AnalysisWorker(QObject):
 
     def __init__(self, parent: QObject | None = None):
         super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self._ids = itertools.count(1)
-        self._jobs: dict[int, AnalysisJob] = {}
-        for signal in (self.finished, self.failed, self.cancelled):
-            signal.connect(self._forget)
+        self._init_jobs(self, (self.finished, self.failed, self.cancelled))
 
     def start(self, path: str | Path, sd_m2: float | None = None) -> AnalysisJob:
-        job = AnalysisJob(next(self._ids), Path(path), sd_m2, self)
-        self._jobs[job.id] = job
-        self.pool.start(job)
-        return job
+        return self._start(AnalysisJob(self._next_id(), Path(path), sd_m2, self))
 
-    def cancel_all(self) -> None:
-        for job in list(self._jobs.values()):
-            job.cancel()
-
-    def shutdown(self, wait_ms: int) -> bool:
-        """Cancel every job and wait for the pool; True when all stopped in time."""
-        self.cancel_all()
-        return self.pool.waitForDone(wait_ms)
-
-    def _forget(self, job: int, *_args) -> None:
-        self._jobs.pop(job, None)
 
 
 def one_line(exc: BaseException) -> str:
