@@ -30,7 +30,7 @@ from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
 from app.model_lab_candidates import CandidatesPanel
 from app.model_lab_catalogue import EffectCatalogue
 from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
-from app.parameter_table import ParameterTable
+from app.parameter_table import titled_parameter_table
 from app.result_curves import result_curves
 from app.workers import AnalysisOutcome
 
@@ -120,14 +120,7 @@ class ModelLab(QWidget):
         self.residual_panel = ResidualPanel()
         self.candidates = CandidatesPanel()
         self.chart = ChiSquareChart()
-        self.parameter_table = ParameterTable()
-        table_box = QWidget()
-        table_layout = QVBoxLayout(table_box)
-        table_layout.setContentsMargins(0, 0, 0, 0)
-        table_title = QLabel("<b>Parameters</b> of the current version (bold: fitted)")
-        table_title.setWordWrap(True)
-        table_layout.addWidget(table_title)
-        table_layout.addWidget(self.parameter_table, 1)
+        table_box, self.parameter_table = titled_parameter_table("<b>Parameters</b> of the current version (bold: fitted)")
 
         middle = QSplitter(Qt.Vertical)
         middle.addWidget(self.residual_panel)

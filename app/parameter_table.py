@@ -11,7 +11,7 @@ from typing import Mapping
 
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
+from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QLabel, QTableView, QVBoxLayout, QWidget
 
 from analysis.derived import NO_SD, ParameterValue
 from app import style
@@ -154,3 +154,16 @@ class ParameterTable(QTableView):
         for row in range(self.parameter_model.rowCount()):
             if self.parameter_model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
+
+
+def titled_parameter_table(title_html: str) -> tuple[QWidget, "ParameterTable"]:
+    """A ParameterTable under a bold title, in a box for a splitter: (box, table)."""
+    table = ParameterTable()
+    box = QWidget()
+    layout = QVBoxLayout(box)
+    layout.setContentsMargins(0, 0, 0, 0)
+    title = QLabel(title_html)
+    title.setWordWrap(True)
+    layout.addWidget(title)
+    layout.addWidget(table, 1)
+    return box, table

@@ -11,7 +11,7 @@ from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QSplitter, QStackedW
 from analysis.derived import parameter_table
 from analysis.pipeline import AnalysisResult
 from app import style
-from app.parameter_table import ParameterTable
+from app.parameter_table import titled_parameter_table
 from app.plots import TransferPlot
 from app.spl_panel import SplPanel
 from app.workers import AnalysisOutcome
@@ -101,14 +101,7 @@ class ResultsView(QWidget):
         self.plot_tabs.addTab(self.displacement_stack, "Displacement Hx")
         self.plot_tabs.addTab(self.spl_panel, "Predicted SPL")
 
-        self.parameter_table = ParameterTable()
-        table_box = QWidget()
-        table_layout = QVBoxLayout(table_box)
-        table_layout.setContentsMargins(0, 0, 0, 0)
-        table_title = QLabel("<b>Parameters</b> (bold: fitted; the rest derived from them)")
-        table_title.setWordWrap(True)
-        table_layout.addWidget(table_title)
-        table_layout.addWidget(self.parameter_table, 1)
+        table_box, self.parameter_table = titled_parameter_table("<b>Parameters</b> (bold: fitted; the rest derived from them)")
 
         splitter = QSplitter(Qt.Horizontal)
         splitter.addWidget(self.plot_tabs)

@@ -20,17 +20,18 @@ import time
 
 import numpy as np
 
+from instruments.audio.core_device import CoreBackedDevice
 from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
 from instruments.audio.errors import AudioError
 from instruments.audio.stream_core import (
-    INPUT_OVERFLOW, OUTPUT_UNDERFLOW, DuplexCore, InputBlock, LoopedExcitation, StreamCounters)
+    INPUT_OVERFLOW, OUTPUT_UNDERFLOW, DuplexCore, LoopedExcitation)
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP, RigEngine, RigFaults, RigNoise
 from instruments.simulation.block_driver import BlockDriver
 
 SIMULATED_DEVICE = AudioDeviceChoice("simulated rig", "in-process")
 
 
-class SimulatedAudio:
+class SimulatedAudio(CoreBackedDevice):
     """AudioInterface on a simulated rig. Constructor shape shared with SoundDeviceAudio.
 
     The simulated hardware follows ``calibration``, so a capture through it
@@ -126,22 +127,9 @@ class SimulatedAudio:
                 indata[:, channel] = getattr(answer, signal)
             n += B
 
-    def read_blocks(self, timeout: float) -> tuple[InputBlock, ...]:
-        return self._require_core().take_blocks(timeout)
-
     @property
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
-
-    def fade_out(self) -> None:
-        self._require_core().request_fade_out()
-
-    @property
-    def output_finished(self) -> bool:
-        return self._core is not None and self._core.output_finished
-
-    def counters(self) -> StreamCounters:
-        return self._core.counters() if self._core is not None else StreamCounters()
 
     def stop(self) -> None:
         thread, self._thread = self._thread, None
@@ -153,11 +141,6 @@ class SimulatedAudio:
     def describe(self) -> str:
         mode = "real time" if self.realtime else "as fast as read"
         return f"SimulatedAudio({self.engine.driver!r}, {self.sample_rate} Hz, {mode})"
-
-    def _require_core(self) -> DuplexCore:
-        if self._core is None:
-            raise AudioError("the stream was never started: call start() first")
-        return self._core
 
     def __enter__(self) -> SimulatedAudio:
         return self

@@ -10,10 +10,11 @@ import threading
 import time
 
 from instruments.audio import portaudio
+from instruments.audio.core_device import CoreBackedDevice
 from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
 from instruments.audio.errors import AudioError
 from instruments.audio.interface import AudioDeviceInfo
-from instruments.audio.stream_core import DuplexCore, InputBlock, LoopedExcitation, StreamCounters
+from instruments.audio.stream_core import DuplexCore, LoopedExcitation
 
 # How long stop() waits for PortAudio before it abandons the stream (see portaudio.py).
 STOP_TIMEOUT_S = 0.7
@@ -49,7 +50,7 @@ def find_device(choice: AudioDeviceChoice | None, devices: list[AudioDeviceInfo]
     raise AudioError(f"sound card {choice} not found{hint}; PortAudio lists: {listed}")
 
 
-class SoundDeviceAudio:
+class SoundDeviceAudio(CoreBackedDevice):
     """AudioInterface on a PortAudio device. Constructor shape shared with SimulatedAudio."""
 
     def __init__(self, device: AudioDeviceChoice | None, calibration: Calibration, sample_rate: int = 48000,
@@ -93,24 +94,11 @@ class SoundDeviceAudio:
                              f"{cm.n_inputs} in / {cm.n_outputs} out: {exc}") from None
         self._core, self._stream, self._device_info = core, stream, info
 
-    def read_blocks(self, timeout: float) -> tuple[InputBlock, ...]:
-        return self._require_core().take_blocks(timeout)
-
     @property
     def running(self) -> bool:
         stream = self._stream
         # NB: PortAudio's JACK host API clears "active" when the server shuts down.
         return stream is not None and not self._finished.is_set() and bool(stream.active)
-
-    def fade_out(self) -> None:
-        self._require_core().request_fade_out()
-
-    @property
-    def output_finished(self) -> bool:
-        return self._core is not None and self._core.output_finished
-
-    def counters(self) -> StreamCounters:
-        return self._core.counters() if self._core is not None else StreamCounters()
 
     def stop(self) -> None:
         """Stop and close; a PortAudio call that does not return in STOP_TIMEOUT_S is abandoned."""
@@ -138,11 +126,6 @@ class SoundDeviceAudio:
 
     def _uses_jack(self) -> bool:
         return self._device_info is not None and self._device_info.hostapi.startswith("JACK")
-
-    def _require_core(self) -> DuplexCore:
-        if self._core is None:
-            raise AudioError("the stream was never started: call start() first")
-        return self._core
 
     def __enter__(self) -> SoundDeviceAudio:
         return self
