@@ -8,6 +8,9 @@ when it is built, whether from files (read_recording), from signals
 
 Messages name the file (or "<in memory>"), the sidecar key or the channel, what
 was found and what was expected, on one line: they are shown to the user as is.
+
+The JSON of the sidecar is read and written by analysis.recording_sidecar, the
+samples by analysis.recording_wav; this module holds the rules and the files.
 """
 from __future__ import annotations
 
@@ -15,7 +18,6 @@ import json
 import math
 import numbers
 import os
-import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,34 +26,19 @@ from typing import Any, Mapping
 
 import numpy as np
 
+# The sidecar's vocabulary (FORMAT, UNITS, Channel, RecordingError) is defined there and importable from here.
+from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
+                                        RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
+                                        read_bytes, show, sidecar_of, unit_wanted)
 from analysis.recording_wav import WavFormatError, decode_wav, encode_float32_wav
 
-FORMAT = "linpar-recording/1"
-# The signals the analysis knows, with the only unit each may be in.
-UNITS = MappingProxyType({"voltage": "V", "current": "A", "displacement": "m"})
+__all__ = ["FORMAT", "IN_MEMORY", "MIN_PERIODS", "REQUIRED_SIGNALS", "UNITS", "Channel", "Recording",
+           "RecordingError", "make_recording", "read_recording", "recording_paths", "write_recording"]
+
 REQUIRED_SIGNALS = ("voltage", "current")
 # Two periods are the fewest from which the noise on a line can be estimated.
 MIN_PERIODS = 2
 IN_MEMORY = "<in memory>"
-_CHANNEL_KEYS = ("signal", "unit", "scale")
-_EXCITATION_KEYS = ("period_samples", "settle_periods", "excited_bins")
-_TOP_KEYS = ("format", "channels", "excitation", "driver")
-
-
-class RecordingError(ValueError):
-    """A recording that breaks the format. str(err) is ONE line naming the file, the key or channel, and what was expected."""
-
-    def __init__(self, message: str):
-        super().__init__(" ".join(str(message).splitlines()))
-
-
-@dataclass(frozen=True, slots=True)
-class Channel:
-    signal: str      # "voltage" | "current" | "displacement" | any other name (kept, not analysed)
-    unit: str
-    scale: float     # physical = sample * scale
-    # Other keys of the sidecar's channel entry, written back unchanged; not compared.
-    extra: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
 
 # eq=False: comparing recordings field by field would compare numpy arrays,
@@ -116,10 +103,10 @@ def read_recording(path: str | Path) -> Recording:
     for missing, other, what in ((json_path, wav_path, "sidecar"), (wav_path, json_path, "signals")):
         if not missing.is_file():
             raise RecordingError(f"{missing}: missing, expected the {what} of the recording next to {other.name}")
-    sidecar = _parse_sidecar(_load_json(json_path), str(json_path))
+    sidecar = parse_sidecar(load_sidecar(json_path), str(json_path))
     channels = _checked_channels(sidecar["channels"], str(json_path))
     try:
-        wav = decode_wav(_read_bytes(wav_path))
+        wav = decode_wav(read_bytes(wav_path))
     except WavFormatError as err:
         raise RecordingError(f"{wav_path}: {err}") from None
     _check_channel_count(wav.samples.shape[0], len(channels), str(wav_path), str(json_path))
@@ -149,7 +136,7 @@ def write_recording(path: str | Path, recording: Recording) -> tuple[Path, Path]
     except WavFormatError as err:
         raise RecordingError(f"{wav_path}: {err}") from None
     try:
-        json_bytes = _format_sidecar(_sidecar_of(recording)).encode("utf-8")
+        json_bytes = format_sidecar(sidecar_of(recording)).encode("utf-8")
     except UnicodeEncodeError as err:
         raise RecordingError(f"{json_path}: a string holds {err.object[err.start:err.end]!r}, half of a UTF-16 "
                              f"surrogate pair, expected Unicode text") from None
@@ -168,7 +155,7 @@ def make_recording(sample_rate: int, signals: Mapping[str, np.ndarray], period_s
     float64 in memory; a written and re-read copy is rounded to float32.
     """
     if not isinstance(signals, Mapping):
-        raise RecordingError(f"{IN_MEMORY}: signals: found {_show(signals)}, expected a mapping of name -> samples")
+        raise RecordingError(f"{IN_MEMORY}: signals: found {show(signals)}, expected a mapping of name -> samples")
     rows = []
     for name, values in signals.items():
         try:
@@ -177,7 +164,7 @@ def make_recording(sample_rate: int, signals: Mapping[str, np.ndarray], period_s
         except (TypeError, ValueError):
             row = None
         if row is None or row.ndim != 1:
-            raise RecordingError(f"{IN_MEMORY}: signal {name!r}: found {_show(values)}, "
+            raise RecordingError(f"{IN_MEMORY}: signal {name!r}: found {show(values)}, "
                                  f"expected a 1-D array of real numbers")
         if rows and len(row) != len(rows[0]):
             raise RecordingError(f"{IN_MEMORY}: signal {name!r}: {len(row)} samples, expected {len(rows[0])} "
@@ -221,36 +208,36 @@ def _checked_fields(rec: Recording) -> dict[str, Any]:
         "settle_periods": settle, "source": source,
         "excited_bins": _checked_bins(rec.excited_bins, period, json_label),
         "driver": _checked_driver(rec.driver, json_label),
-        "extra": _checked_mapping(rec.extra, _TOP_KEYS, json_label, ""),
-        "excitation_extra": _checked_mapping(rec.excitation_extra, _EXCITATION_KEYS, json_label, "excitation."),
+        "extra": _checked_mapping(rec.extra, TOP_KEYS, json_label, ""),
+        "excitation_extra": _checked_mapping(rec.excitation_extra, EXCITATION_KEYS, json_label, "excitation."),
     }
 
 
 def _checked_channels(channels, label: str) -> tuple[Channel, ...]:
     if not isinstance(channels, (list, tuple)) or not channels:
-        raise RecordingError(f"{label}: channels: found {_show(channels)}, "
+        raise RecordingError(f"{label}: channels: found {show(channels)}, "
                              f"expected a non-empty list of {{signal, unit, scale}}")
     checked: list[Channel] = []
     first_seen: dict[str, int] = {}
     for i, channel in enumerate(channels):
         key = f"channels[{i}]"
         if not isinstance(channel, Channel):
-            raise RecordingError(f"{label}: {key}: found {_show(channel)}, expected a Channel")
+            raise RecordingError(f"{label}: {key}: found {show(channel)}, expected a Channel")
         signal, unit, scale = channel.signal, channel.unit, channel.scale
         if not isinstance(signal, str) or not signal:
-            raise RecordingError(f"{label}: {key}.signal: found {_show(signal)}, expected a non-empty string")
+            raise RecordingError(f"{label}: {key}.signal: found {show(signal)}, expected a non-empty string")
         if signal in first_seen:
             raise RecordingError(f"{label}: {key}.signal: {signal!r} again (first in channels[{first_seen[signal]}]), "
                                  f"expected each signal once")
         first_seen[signal] = i
         expected_unit = UNITS.get(signal)
         if not isinstance(unit, str) or (expected_unit is not None and unit != expected_unit):
-            raise RecordingError(f"{label}: {key}.unit: found {_show(unit)} for signal {signal!r}, "
-                                 f"expected {_unit_wanted(signal)}")
+            raise RecordingError(f"{label}: {key}.unit: found {show(unit)} for signal {signal!r}, "
+                                 f"expected {unit_wanted(signal)}")
         if not _is_finite_real(scale) or scale == 0:
-            raise RecordingError(f"{label}: {key}.scale: found {_show(scale)} for signal {signal!r}, "
+            raise RecordingError(f"{label}: {key}.scale: found {show(scale)} for signal {signal!r}, "
                                  f"expected a finite nonzero number")
-        extra = _checked_mapping(channel.extra, _CHANNEL_KEYS, label, f"{key}.")
+        extra = _checked_mapping(channel.extra, CHANNEL_KEYS, label, f"{key}.")
         checked.append(Channel(signal, unit, float(scale), extra))
     for required in REQUIRED_SIGNALS:
         if required not in first_seen:
@@ -267,7 +254,7 @@ def _checked_data(data, channels: tuple[Channel, ...], wav_label: str, json_labe
         try:
             data = np.array(data, dtype=np.float64, order="C")
         except (TypeError, ValueError):
-            raise RecordingError(f"{wav_label}: data: found {_show(data)}, expected an array of numbers") from None
+            raise RecordingError(f"{wav_label}: data: found {show(data)}, expected an array of numbers") from None
         data.flags.writeable = False
     if data.ndim != 2:
         raise RecordingError(f"{wav_label}: data: found shape {data.shape}, expected (n_channels, n_samples)")
@@ -313,13 +300,13 @@ def _checked_bins(bins, period: int, label: str) -> tuple[int, ...] | None:
             raise TypeError
         bins = list(bins)
     except TypeError:
-        raise RecordingError(f"{label}: excitation.excited_bins: found {_show(bins)}, expected {expected}") from None
+        raise RecordingError(f"{label}: excitation.excited_bins: found {show(bins)}, expected {expected}") from None
     if not bins:
         raise RecordingError(f"{label}: excitation.excited_bins: found an empty list, expected {expected}")
     seen: set[int] = set()
     for i, b in enumerate(bins):
         if not _is_integer(b) or not 1 <= b <= top or b in seen:
-            problem = f"{b!r} again" if _is_integer(b) and b in seen else f"found {_show(b)}"
+            problem = f"{b!r} again" if _is_integer(b) and b in seen else f"found {show(b)}"
             raise RecordingError(f"{label}: excitation.excited_bins[{i}]: {problem}, expected {expected}")
         seen.add(int(b))
     return tuple(sorted(seen))
@@ -328,11 +315,11 @@ def _checked_bins(bins, period: int, label: str) -> tuple[int, ...] | None:
 def _checked_driver(driver, label: str) -> Mapping[str, Any]:
     driver = _checked_mapping(driver, (), label, "driver.", whole_key="driver")
     if "name" in driver and not isinstance(driver["name"], str):
-        raise RecordingError(f"{label}: driver.name: found {_show(driver['name'])}, expected a string")
+        raise RecordingError(f"{label}: driver.name: found {show(driver['name'])}, expected a string")
     if "sd_m2" in driver:
         sd = driver["sd_m2"]
         if not _is_finite_real(sd) or sd <= 0:
-            raise RecordingError(f"{label}: driver.sd_m2: found {_show(sd)}, expected a positive area in m^2")
+            raise RecordingError(f"{label}: driver.sd_m2: found {show(sd)}, expected a positive area in m^2")
     return driver
 
 
@@ -340,153 +327,20 @@ def _checked_mapping(mapping, reserved, label: str, prefix: str, whole_key: str 
     """A read-only copy of a mapping that must stay writable as JSON beside the keys in `reserved`."""
     where = whole_key or (prefix + "extra" if prefix else "extra")
     if not isinstance(mapping, Mapping):
-        raise RecordingError(f"{label}: {where}: found {_show(mapping)}, expected an object (a mapping)")
+        raise RecordingError(f"{label}: {where}: found {show(mapping)}, expected an object (a mapping)")
     for key, value in mapping.items():
         if not isinstance(key, str) or key in reserved:
             other_than = f" other than {', '.join(reserved)}" if reserved else ""
-            raise RecordingError(f"{label}: {where}: key {_show(key)}, expected a string{other_than}")
+            raise RecordingError(f"{label}: {where}: key {show(key)}, expected a string{other_than}")
         try:
-            json.dumps(value, allow_nan=False, default=_json_default)
+            json.dumps(value, allow_nan=False, default=json_default)
         except (TypeError, ValueError, RecursionError):
-            raise RecordingError(f"{label}: {prefix}{key}: found {_show(value)}, "
+            raise RecordingError(f"{label}: {prefix}{key}: found {show(value)}, "
                                  f"expected a JSON value (no NaN or infinity)") from None
     return MappingProxyType(dict(mapping))
 
 
-# --- the sidecar --------------------------------------------------------------
-
-def _load_json(path: Path) -> Any:
-    try:
-        text = _read_bytes(path).decode("utf-8-sig")   # tolerate the BOM that some editors add
-    except UnicodeDecodeError as err:
-        raise RecordingError(f"{path}: not UTF-8 (byte {err.start}), expected a UTF-8 JSON object") from None
-    try:
-        doc = json.loads(text, parse_constant=_refuse_constant)
-    except _NotJson as err:
-        line = _line_of(text, str(err))
-        raise RecordingError(f"{path}: invalid JSON at line {line}: {err} is not a JSON number, "
-                             f"expected a JSON object with finite numbers") from None
-    except json.JSONDecodeError as err:
-        raise RecordingError(f"{path}: invalid JSON at line {err.lineno}, column {err.colno}: {err.msg}, "
-                             f"expected a JSON object") from None
-    except RecursionError:
-        raise RecordingError(f"{path}: JSON nested too deeply, expected a JSON object") from None
-    except ValueError as err:   # e.g. an integer of more digits than Python converts
-        raise RecordingError(f"{path}: invalid JSON: {err}, expected a JSON object") from None
-    try:
-        # Valid JSON may escape half of a UTF-16 pair ("\\ud800"): no UTF-8 file could hold it again.
-        json.dumps(doc, ensure_ascii=False).encode("utf-8")
-    except UnicodeEncodeError as err:
-        raise RecordingError(f"{path}: a string holds {err.object[err.start:err.end]!r}, half of a UTF-16 "
-                             f"surrogate pair, expected Unicode text") from None
-    return doc
-
-
-class _NotJson(ValueError):
-    pass
-
-
-def _refuse_constant(name: str):
-    # NaN and Infinity are Python's extension, not JSON: other readers refuse them.
-    raise _NotJson(name)
-
-
-def _line_of(text: str, token: str) -> int:
-    """Line of the first bare `token` (not inside a string, as far as a regex can tell)."""
-    match = re.search(rf'(?<![\w"]){re.escape(token)}(?![\w"])', text)
-    return text.count("\n", 0, match.start()) + 1 if match else 1
-
-
-def _parse_sidecar(doc: Any, label: str) -> dict[str, Any]:
-    """Channels and the other Recording fields of a sidecar, by key; values are checked later."""
-    if not isinstance(doc, dict):
-        raise RecordingError(f"{label}: found a JSON {_json_type(doc)} at the top, expected a JSON object")
-    if doc.get("format") != FORMAT:
-        found = f"found {_show(doc['format'])}" if "format" in doc else "missing"
-        raise RecordingError(f"{label}: format: {found}, expected exactly {FORMAT!r}")
-    entries = _required(doc, "channels", list, label, "channels", "a non-empty list of {signal, unit, scale}")
-    channels = []
-    for i, entry in enumerate(entries):
-        if not isinstance(entry, dict):
-            raise RecordingError(f"{label}: channels[{i}]: found a JSON {_json_type(entry)}, "
-                                 f"expected an object with signal, unit and scale")
-        signal = entry.get("signal")
-        for key in _CHANNEL_KEYS:
-            if key not in entry:
-                wanted = {"signal": "a signal name (voltage, current, displacement or another)",
-                          "unit": _unit_wanted(signal),
-                          "scale": "a finite nonzero number (physical value = sample x scale)"}[key]
-                raise RecordingError(f"{label}: channels[{i}].{key}: missing, expected {wanted}")
-        extra = {k: v for k, v in entry.items() if k not in _CHANNEL_KEYS}
-        channels.append(Channel(entry["signal"], entry["unit"], entry["scale"], extra))
-    excitation = _required(doc, "excitation", dict, label, "excitation", "an object with period_samples")
-    if "period_samples" not in excitation:
-        raise RecordingError(f"{label}: excitation.period_samples: missing, "
-                             f"expected the length of one period in samples (a positive integer)")
-    return {"channels": channels, "rest": {
-        "period_samples": excitation["period_samples"],
-        "settle_periods": excitation.get("settle_periods", 0),
-        "excited_bins": excitation.get("excited_bins"),
-        "excitation_extra": {k: v for k, v in excitation.items() if k not in _EXCITATION_KEYS},
-        "driver": doc.get("driver", {}),
-        "extra": {k: v for k, v in doc.items() if k not in _TOP_KEYS},
-    }}
-
-
-def _required(doc: dict, key: str, kind: type, label: str, where: str, expected: str):
-    if key not in doc:
-        raise RecordingError(f"{label}: {where}: missing, expected {expected}")
-    if not isinstance(doc[key], kind):
-        raise RecordingError(f"{label}: {where}: found a JSON {_json_type(doc[key])}, expected {expected}")
-    return doc[key]
-
-
-def _sidecar_of(rec: Recording) -> dict[str, Any]:
-    excitation: dict[str, Any] = {"period_samples": rec.period_samples, "settle_periods": rec.settle_periods}
-    if rec.excited_bins is not None:
-        excitation["excited_bins"] = list(rec.excited_bins)
-    doc: dict[str, Any] = {
-        "format": FORMAT,
-        "channels": [{"signal": c.signal, "unit": c.unit, "scale": c.scale, **c.extra} for c in rec.channels],
-        "excitation": {**excitation, **rec.excitation_extra},
-    }
-    if rec.driver:
-        doc["driver"] = dict(rec.driver)
-    doc.update(rec.extra)
-    return doc
-
-
-def _format_sidecar(doc: dict[str, Any]) -> str:
-    """The layout of the spec's example: one line per top-level key and per channel."""
-    def compact(value: Any) -> str:
-        return json.dumps(value, ensure_ascii=False, allow_nan=False, default=_json_default)
-    lines = []
-    for key, value in doc.items():
-        if key == "channels":
-            entries = ",\n".join(f"    {compact(c)}" for c in value)
-            lines.append(f'  "channels": [\n{entries}\n  ]')
-        else:
-            lines.append(f"  {compact(key)}: {compact(value)}")
-    return "{\n" + ",\n".join(lines) + "\n}\n"
-
-
-def _json_default(value: Any) -> Any:
-    """What json.dumps cannot write by itself but a program may put in `extra`."""
-    if isinstance(value, Mapping):
-        return dict(value)
-    if isinstance(value, (np.generic, np.ndarray)):
-        return value.tolist()
-    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
-
-
 # --- files and small helpers -------------------------------------------------
-
-def _read_bytes(path: Path) -> bytes:
-    try:
-        return path.read_bytes()
-    except OSError as err:
-        raise RecordingError(f"{path}: cannot be read ({err.strerror or err}), expected a readable file") from None
-
 
 def _write_atomic(path: Path, payload: bytes) -> None:
     """Write to a temporary file in the same folder, then rename over `path`."""
@@ -504,7 +358,7 @@ def _write_atomic(path: Path, payload: bytes) -> None:
 
 def _integer(value, minimum: int, label: str, key: str, expected: str) -> int:
     if not _is_integer(value) or value < minimum:
-        raise RecordingError(f"{label}: {key}: found {_show(value)}, expected {expected}")
+        raise RecordingError(f"{label}: {key}: found {show(value)}, expected {expected}")
     return int(value)
 
 
@@ -519,23 +373,3 @@ def _is_finite_real(value) -> bool:
         return math.isfinite(value)
     except OverflowError:       # a JSON integer beyond the float range
         return False
-
-
-def _unit_wanted(signal) -> str:
-    if isinstance(signal, str) and signal in UNITS:
-        return f"{UNITS[signal]!r} for {signal}"
-    return "a unit string ('V', 'A' and 'm' for voltage, current and displacement)"
-
-
-def _json_type(value) -> str:
-    for kind, name in ((dict, "object"), (list, "array"), (str, "string"), (bool, "boolean"),
-                       (int, "number"), (float, "number")):
-        if isinstance(value, kind):
-            return name
-    return "null" if value is None else type(value).__name__
-
-
-def _show(value, width: int = 60) -> str:
-    """A short one-line repr for messages."""
-    text = repr(value)
-    return text if len(text) <= width else text[:width - 3] + "..."

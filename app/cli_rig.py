@@ -1,6 +1,7 @@
 """`linpar rig start|stop|status|fault`: the virtual rig from the command line.
 
-    linpar rig start [--name linpar] [--driver paper|FILE] [--effects IDS] [--noise SPEC] [--fault SPEC]...
+    linpar rig start [--name linpar] [--driver paper|FILE] [--model linear|nonlinear] [--effects IDS]
+                     [--noise SPEC] [--fault SPEC]...
     linpar rig status [--name linpar] [--json]
     linpar rig fault [--name linpar] SPEC... | --clear | --xrun [SECONDS] | --kill-client
     linpar rig stop [--name linpar]
@@ -17,6 +18,9 @@ from pathlib import Path
 
 
 EXIT_OK, EXIT_NOT_RUNNING = 0, 1
+# The rig server's --model choices (instruments/rig/server.py), spelled here so that the parser loads no rig code.
+RIG_MODELS = ("linear", "nonlinear")
+
 # Errors shown to the user as one line (exit 2) by app.cli.
 def _manager():
     """instruments.rig.manager, imported on use: it loads scipy, which plain `linpar` commands do not need."""
@@ -40,7 +44,12 @@ def add_commands(sub) -> None:
 
     start = actions.add_parser("start", parents=[common], help="start the rig in the background")
     start.add_argument("--driver", default="paper", help="driver name in resources/drivers, or a JSON file")
-    start.add_argument("--effects", metavar="IDS", help="effect ids replacing the driver file's (comma-separated)")
+    start.add_argument("--model", choices=RIG_MODELS, default="linear",
+                       help="how the rig simulates the driver: 'linear' (default), the small-signal model as "
+                            "FIRs; 'nonlinear', Bl(x), Kms(x) and Le(x) integrated in the time domain, so that "
+                            "distortion and level-dependent parameters appear at high drive (more CPU per cycle)")
+    start.add_argument("--effects", metavar="IDS",
+                       help="effect ids replacing the driver file's (comma-separated; linear model only)")
     start.add_argument("--noise", metavar="SPEC",
                        help="sensor noise rms, e.g. voltage=1e-4,current=1e-5,displacement=1e-8 (V, A, m)")
     start.add_argument("--fault", action="append", default=[], metavar="SPEC",
@@ -76,7 +85,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _start(args) -> int:
-    handle = _manager().start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir)
+    if args.model != "linear" and args.effects:
+        # The nonlinear driver takes its small-signal model from the driver file's values.
+        raise ValueError(f"--effects applies to the linear model only, not to --model {args.model}")
+    handle = _manager().start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir,
+                                  model=args.model)
     if args.json:
         print(handle.state.to_json())
         return EXIT_OK
@@ -124,7 +137,8 @@ def format_status(status: dict) -> str:
         f"  JACK server   {state['jack_server']} (set JACK_DEFAULT_SERVER={state['jack_server']}), "
         f"{state['sample_rate']} Hz, {state['period_frames']} frames per cycle",
         f"  driver        {state['extra'].get('driver_name', state['driver'])} "
-        f"[{', '.join(state['effects']) or 'textbook'}], FIR {state['fir_length']} taps",
+        f"[{', '.join(state['effects']) or 'textbook'}], {state['extra'].get('model', 'linear')} model, "
+        f"FIR {state['fir_length']} taps",
         f"  faults        {', '.join(status.get('faults') or []) or 'none'}"
         f"{'' if status.get('client_alive', True) else '; JACK client killed'}",
         f"  calibration   {cal['volts_per_fs_out']:g} V/FS out, {cal['volts_per_fs_voltage_sense']:g} V/FS voltage, "

@@ -2,12 +2,29 @@
 
 A thin layer over QSettings so that tests can hand in a QSettings on a
 temporary file instead of touching the user's real settings.
+
+The settings file is checked before Qt reads it. Qt turns an INI value
+"@Variant(...)" (or "@DateTime(...)", which carries a QVariant too) back into an
+object through QDataStream, and PySide6 registers a type, PyObjectWrapper, whose
+loader is pickle.loads: a crafted entry in ~/.config/linpar/linpar.conf would run
+code as soon as any key of its section is read. linpar writes only strings,
+string lists, @ByteArray values and @Invalid() (an empty list), so every entry
+that Qt would decode as anything else is removed from the file, with a warning
+naming the key, before the first read. Qt parses a section only on access, so the check must come
+before any value(), contains() or allKeys() on the file.
 """
 from __future__ import annotations
 
+import logging
+import sys
+import tempfile
 from pathlib import Path
 
-from PySide6.QtCore import QByteArray, QSettings
+from PySide6.QtCore import QByteArray, QLockFile, QSettings
+
+from app.settings_ini import replace_bytes, sanitized_ini
+
+log = logging.getLogger(__name__)
 
 ORGANIZATION = "linpar"
 APPLICATION = "linpar"
@@ -17,14 +34,19 @@ _RECENT = "recent_files"
 _GEOMETRY = "window/geometry"
 _STATE = "window/state"
 
-
 def default_qsettings() -> QSettings:
     return QSettings(ORGANIZATION, APPLICATION)
 
 
 class Settings:
     def __init__(self, qsettings: QSettings | None = None):
-        self._q = qsettings if qsettings is not None else default_qsettings()
+        q = qsettings if qsettings is not None else default_qsettings()
+        # The organisation-wide and system files (~/.config/linpar.conf, /etc/xdg/...) are
+        # read as fallbacks; linpar never writes them, so it does not read them either.
+        q.setFallbacksEnabled(False)
+        self._scratch: tempfile.TemporaryDirectory | None = None
+        self.dropped: list[str] = []       # the keys removed from the file as unsafe
+        self._q = self._made_safe(q)
 
     @property
     def qsettings(self) -> QSettings:
@@ -38,7 +60,9 @@ class Settings:
             return []
         if isinstance(value, str):
             value = [value]
-        return [str(v) for v in value if v][:MAX_RECENT]
+        if not isinstance(value, list):
+            return []
+        return [v for v in value if isinstance(v, str) and v][:MAX_RECENT]
 
     def add_recent_file(self, path: str | Path) -> list[str]:
         path = str(Path(path).resolve())
@@ -70,3 +94,42 @@ class Settings:
     def _bytes(self, key: str) -> QByteArray | None:
         value = self._q.value(key)
         return value if isinstance(value, QByteArray) and not value.isEmpty() else None
+
+    # -- the file's safety -------------------------------------------------
+    def _made_safe(self, q: QSettings) -> QSettings:
+        """`q`, once its file holds no entry Qt would unpickle; a sanitised copy if that file cannot be rewritten."""
+        ini = q.format() == QSettings.IniFormat or (
+            q.format() == QSettings.NativeFormat and sys.platform not in ("win32", "darwin"))
+        path = Path(q.fileName())
+        if not ini or not path.is_file():
+            return q
+        try:
+            data = path.read_bytes()
+        except OSError:
+            return q                        # Qt cannot read it either: it treats it as empty
+        cleaned, dropped = sanitized_ini(data)
+        if not dropped:
+            return q
+        self.dropped = dropped
+        for key in dropped:
+            log.warning("settings: dropped %r from %s: its value is a serialised object that Qt would "
+                        "unpickle, which can run code; linpar never writes such values", key, path)
+        # The lock QSettings takes to write the file, so that another linpar's write is not lost in between.
+        lock = QLockFile(str(path) + ".lock")
+        lock.tryLock(2000)                  # without it after 2 s, rather than not start
+        try:
+            cleaned, _ = sanitized_ini(path.read_bytes())
+            replace_bytes(path.resolve(), cleaned)
+        except OSError as error:
+            log.error("settings: cannot rewrite %s (%s); using a cleaned copy, changes will not be saved",
+                      path, error)
+            self._scratch = tempfile.TemporaryDirectory(prefix="linpar-settings-")
+            copy = Path(self._scratch.name) / path.name
+            copy.write_bytes(cleaned)
+            safe = QSettings(str(copy), QSettings.IniFormat)
+            safe.setFallbacksEnabled(False)
+            return safe
+        finally:
+            lock.unlock()
+        q.sync()    # Qt may hold the old bytes from its constructor; the size changed, so it reads them again
+        return q

@@ -21,6 +21,8 @@ from typing import Sequence
 from instruments.rig.control import ControlError, send_command
 from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, pid_alive, read_pid, read_state
 
+MODELS = ("linear", "nonlinear")     # the rig server's --model choices
+
 
 class RigError(RuntimeError):
     """The rig could not be started or stopped; one line for the user."""
@@ -56,7 +58,11 @@ def find_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None) -> RigHa
 
 def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | None = None,
               faults: Sequence[str] = (), noise: str | None = None, runtime_dir: Path | None = None,
-              seed: int | None = None, timeout: float = 20.0, extra_args: Sequence[str] = ()) -> RigHandle:
+              seed: int | None = None, timeout: float = 20.0, extra_args: Sequence[str] = (),
+              model: str = "linear") -> RigHandle:
+    """The rig `name`, started in the background unless it runs; `model` is the server's --model."""
+    if model not in MODELS:
+        raise RigError(f"unknown rig model {model!r} (expected {' or '.join(MODELS)})")
     paths = RigPaths.for_name(name, runtime_dir)
     running = find_rig(name, runtime_dir)
     if running is not None:
@@ -64,7 +70,8 @@ def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | No
     if pid_alive(read_pid(paths)):
         raise RigError(f"rig {name!r} is starting or stopping (pid {read_pid(paths)}); try again in a moment")
     paths.ensure()
-    cmd = [sys.executable, "-m", "instruments.rig.server", "--name", name, "--driver", str(driver)]
+    cmd = [sys.executable, "-m", "instruments.rig.server", "--name", name, "--driver", str(driver),
+           "--model", model]
     if runtime_dir is not None:
         cmd += ["--runtime-dir", str(runtime_dir)]
     if effects:

@@ -106,6 +106,7 @@ class NonlinearBlockDriver:
                                                      ((bl_poly, "bl_poly"), (kms_poly, "kms_poly"),
                                                       (le_poly, "le_poly")))
         self.x_range_m = float(x_range_m)
+        self.fir_length = int(fir_length)       # the rig's state reports it, as for the linear driver
         self.model = _small_signal_model(self.values)
         p = self.values
         self._consts = _constants(p)
