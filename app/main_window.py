@@ -10,18 +10,20 @@ from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QP
                                QTabWidget)
 
 from app import style
+from app.archive_page import ArchivePage
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
 from app.qa_view import QAView
 from app.series_page import SeriesPage
 from app.results_view import ResultsView
 from app.settings import Settings
+from app.staged_fanout import StagedFanOut
 from app.wizard import MeasureWizard
 from app.workers import AnalysisJob, AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
-PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "QA")
+PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "QA", "Archive")
 CLOSE_WAIT_MS = 5000        # a cancelled fit stops at its next iteration; this is ample
 
 
@@ -56,17 +58,24 @@ class MainWindow(QMainWindow):
         self.results = ResultsView()
         self.model_lab = ModelLab()
         # The lab starts from each result the Results page shows; its versions go back there.
-        self.results.result_changed.connect(self.model_lab.set_result)
         self.model_lab.model_adopted.connect(self.results.show_outcome)
         self.wizard = MeasureWizard(self.settings.qsettings)
         self.qa = QAView(self.settings.qsettings)
         # A finished measurement goes to the Results page, and from there to the lab and QA.
         self.wizard.measurement_finished.connect(self.on_measured)
         self.wizard.open_results_requested.connect(self.on_open_measured)
-        self.results.result_changed.connect(self.qa.set_result)
+        # The lab and QA follow the Results page, each in its own turn of the event loop (app/staged_fanout.py).
+        self.result_pages = StagedFanOut([self.model_lab.set_result, self.qa.set_result], self)
+        self.results.result_changed.connect(self.result_pages.send)
         self.series = SeriesPage()
+        # Every measurement the wizard finishes is stored in the archive; an archived one opens like a file.
+        self.archive = ArchivePage(self.settings)
+        self.archive.open_requested.connect(self.on_open_archived)
+        self.archive.stored.connect(self.on_archived)
+        self.archive.store_failed.connect(self.on_archive_failed)
+        self._titles: dict[Path, str] = {}      # recording path -> what the title bar calls it (archived ones)
         built = {"Measure": self.wizard, "Results": self.results, "Model lab": self.model_lab,
-                 "Series": self.series, "QA": self.qa}
+                 "Series": self.series, "QA": self.qa, "Archive": self.archive}
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
@@ -166,10 +175,10 @@ class MainWindow(QMainWindow):
         self.results.show_outcome(outcome)
         self.settings.add_recent_file(outcome.path)
         self._rebuild_recent_menu()
-        self.setWindowTitle(f"linpar — {outcome.path.name}")
+        self.setWindowTitle(f"linpar — {self._titles.get(outcome.path, outcome.path.name)}")
         self.status_label.setText(f"Loaded {outcome.path} — model {outcome.result.fit.model.describe()}, "
                                   f"analysed in {elapsed:.2g} s")
-        self.analysis_shown.emit(outcome)
+        self.result_pages.after(lambda: self.analysis_shown.emit(outcome))
 
     @Slot(int, str)
     def on_failed(self, job: int, message: str) -> None:
@@ -217,7 +226,7 @@ class MainWindow(QMainWindow):
         """A measurement the wizard finished: shown (it is already analysed), and remembered.
 
         In the next turn of the event loop: the wizard's own page updates first, so the two do not add
-        up to one long stall of the GUI (the Results page and the Model lab take ~40 ms to show it).
+        up to one long stall of the GUI (the Results page takes ~30 ms to show it, the lab as much again).
         """
         if self.job is not None:            # an opened file still being analysed would replace it: drop that
             self.job.cancel()
@@ -229,8 +238,34 @@ class MainWindow(QMainWindow):
         self.settings.add_recent_file(outcome.path)
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {outcome.path.name}")
-        self.status_label.setText(f"Measured {outcome.path}")
-        self.measurement_shown.emit(outcome)
+        self.status_label.setText(f"Measured {outcome.path}; storing it in the archive…")
+        self._store_measured(outcome)
+        self.result_pages.after(lambda: self.measurement_shown.emit(outcome))
+
+    def _store_measured(self, outcome) -> None:
+        """Into the archive, in its worker. Whatever happens there, the recording stays where it was written."""
+        request = outcome.request
+        driver = request.driver
+        meta = {"driver": driver.name, "serial": driver.serial,
+                "operator": driver.operator, "station": driver.station,
+                "settings": {"template": request.template.as_json(), "level_v_rms": request.level_v,
+                             "level_reason": request.level_reason, "hardware": request.hardware.describe()},
+                "calibration": {"corrections": request.corrections.to_dict()}}
+        self.archive.store_measurement(outcome.path, outcome.analysis.result, meta)
+
+    @Slot(str, str)
+    def on_archived(self, measurement_id: str, recording: str) -> None:
+        self.status_label.setText(f"Measured {recording}; stored in the archive as {measurement_id}")
+
+    @Slot(str, str)
+    def on_archive_failed(self, message: str, recording: str) -> None:
+        self.status_label.setText(f"Measured {recording}, but NOT stored in the archive ({message}); "
+                                  "the recording stays where it was written")
+
+    @Slot(object, str)
+    def on_open_archived(self, path: Path, title: str) -> None:
+        self._titles[Path(path)] = title
+        self.open_path(path)
 
     @Slot(object)
     def on_open_measured(self, outcome: AnalysisOutcome) -> None:
@@ -327,6 +362,7 @@ class MainWindow(QMainWindow):
         self.model_lab.shutdown(CLOSE_WAIT_MS)
         self.wizard.shutdown(CLOSE_WAIT_MS)
         self.qa.shutdown(CLOSE_WAIT_MS)
+        self.archive.shutdown(CLOSE_WAIT_MS)
         self.series.worker.cancel()
         self.series.worker.pool.waitForDone(CLOSE_WAIT_MS)
         self.settings.save_window(self.saveGeometry(), self.saveState())

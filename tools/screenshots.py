@@ -1,6 +1,6 @@
 """Screenshots of the main window on a synthetic recording, for docs and for looking at.
 
-    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR]
+    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] [--only archive]
 
 Writes results.png (and one PNG per Results plot tab and per other page) to
 docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
@@ -10,8 +10,11 @@ Model lab, before and after applying the top candidate; then wizard-1-driver.png
 simulator, live-panels.png: the live panels in the middle of a real-time
 measurement, and qa-measured.png, qa-limits.png, qa-invalid.png: the QA page on
 the measured driver, with limits, and on a recording whose current input was
-disconnected. Nothing of the user's settings is touched: the window gets a
-QSettings file in the temporary folder.
+disconnected; then archive-list.png and archive-compare.png: the Archive page
+with a batch of drivers stored (and the wizard's measurement), four of them
+compared (--only archive: just these two, without the wizard's measurement).
+Nothing of the user's settings or archive is touched: the window gets
+a QSettings file and an archive in the temporary folder.
 """
 from __future__ import annotations
 
@@ -26,7 +29,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PySide6.QtCore import QEventLoop, QSettings, QTimer  # noqa: E402
+from PySide6.QtCore import QEventLoop, QItemSelection, QItemSelectionModel, QSettings, QTimer  # noqa: E402
 from PySide6.QtWidgets import QApplication  # noqa: E402
 
 from analysis.drivers import load_driver  # noqa: E402
@@ -116,6 +119,8 @@ def measure_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
     page.serial_edit.setText("0042")
     page.sd_value.setValue(133.0)
     page.impedance.setValue(4.0)
+    page.operator_edit.setText("ana")
+    page.station_edit.setText("QA1")
     shot("wizard-1-driver")
     wizard.next_button.click()
     hardware = wizard.hardware_page
@@ -190,6 +195,70 @@ def series_screenshots(app: QApplication, window, folder: Path, out: Path) -> li
     return [path]
 
 
+# A production batch of the paper's driver measured in the days before: (serial, operator, station, days and
+# hours before now, relative change of Bl, Mms, Cms, RE). Electrical analogues: CMES = Mms/Bl^2, LCES = Cms*Bl^2,
+# RES = Bl^2/Rms.
+ARCHIVE_BATCH = (
+    ("0031", "ana", "QA1", 3, 6.0, 0.00, 0.00, 0.00, 0.000),
+    ("0032", "ana", "QA1", 3, 5.9, 0.02, -0.03, 0.06, 0.010),
+    ("0033", "ana", "QA1", 3, 5.8, -0.03, 0.04, -0.08, -0.012),
+    ("0034", "ben", "QA2", 2, 2.0, 0.05, 0.01, 0.12, 0.020),
+    ("0035", "ben", "QA2", 2, 1.9, -0.01, -0.02, 0.03, 0.004),
+)
+
+
+def archive_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Archive page: a batch of one driver stored over a few days (one measured with the laser unplugged),
+    the list, then four of them compared."""
+    from analysis.archive import Archive
+    from analysis.pipeline import analyze_recording
+    from analysis.recording import read_recording
+    from instruments.simulation import faults
+
+    from datetime import datetime, timedelta, timezone
+
+    def before(days: float, hours: float) -> str:
+        return (datetime.now(timezone.utc) - timedelta(days=days, hours=hours)).isoformat(timespec="seconds")
+
+    driver = load_driver("paper")
+    mt = design_multitone(48000, 16384, 5.0, 10000.0, rms=1.0)
+    archive = Archive(window.archive.root)
+    for number, (serial, operator, station, days, hours, bl, mms, cms, re) in enumerate(ARCHIVE_BATCH):
+        p = dict(driver.parameters)
+        b, m, c = p["Bl"] * (1 + bl), p["CMES"] * p["Bl"] ** 2 * (1 + mms), p["LCES"] / p["Bl"] ** 2 * (1 + cms)
+        p.update(Bl=b, CMES=m / b**2, LCES=c * b**2, RES=p["RES"] / p["Bl"] ** 2 * b**2, RE=p["RE"] * (1 + re))
+        recording = synthesize_recording(driver.model(), p, mt.waveform, mt.excited_bins, mt.sample_rate, 8, 1,
+                                         ChannelNoise(1e-4, 1e-4, 1e-8), seed=10 + number,
+                                         driver={"name": "W18-PAPER", "sd_m2": driver.sd_m2})
+        wav, _ = write_recording(folder / f"batch-{serial}", recording)
+        archive.store(wav, analyze_recording(read_recording(wav)),
+                      {"driver": "W18-PAPER", "serial": serial, "operator": operator, "station": station,
+                       "measured_at": before(days, hours)})
+    wav, _ = write_recording(folder / "batch-0036", faults.laser_disconnected())
+    archive.store(wav, analyze_recording(read_recording(wav)),
+                  {"driver": "W18-PAPER", "serial": "0036", "operator": "ben", "station": "QA2",
+                   "measured_at": before(2, 1.8)})
+    page = window.archive
+    window.pages.setCurrentWidget(page)
+    page.tabs.setCurrentWidget(page.list_tab)
+    page.refresh_now()
+    selection = QItemSelection()
+    for row in range(page.table.proxy.rowCount()):
+        if page.table.entry_at(row).serial in ("0031", "0032", "0033", "0034"):
+            selection.select(page.table.proxy.index(row, 0), page.table.proxy.index(row, 0))
+    page.table.selectionModel().select(selection, QItemSelectionModel.ClearAndSelect | QItemSelectionModel.Rows)
+    settle(app)
+    written = [out / "archive-list.png", out / "archive-compare.png"]
+    window.grab().save(str(written[0]))
+    page.compare_button.click()
+    if not wait_for(page.comparison_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the comparison of the stored measurements did not come", file=sys.stderr)
+        return written[:1]
+    settle(app)
+    window.grab().save(str(written[1]))
+    return written
+
+
 def wait_for_click(button, busy_changed, timeout_s: float = ANALYSIS_TIMEOUT_S) -> bool:
     """Click `button` and wait until the job it starts is over (busy_changed(False))."""
     loop = QEventLoop()
@@ -225,6 +294,14 @@ def settle(app: QApplication, ms: int = 300) -> None:
 
 
 def main(argv: list[str]) -> int:
+    only = None
+    if "--only" in argv:
+        at = argv.index("--only")
+        only = argv[at + 1] if at + 1 < len(argv) else ""
+        argv = argv[:at] + argv[at + 2:]
+        if only != "archive":
+            print("screenshots: --only takes 'archive'", file=sys.stderr)
+            return 2
     out = Path(argv[1]) if len(argv) > 1 else ROOT / "docs" / "screenshots"
     out.mkdir(parents=True, exist_ok=True)
     app = QApplication.instance() or QApplication(argv[:1])
@@ -235,8 +312,15 @@ def main(argv: list[str]) -> int:
         folder = Path(tmp)
         wav = synthetic_recording(folder)
         window = MainWindow(Settings(QSettings(str(folder / "settings.ini"), QSettings.IniFormat)))
+        window.archive.set_root(folder / "archive")      # the wizard's measurement is stored there too
         window.resize(*SIZE)
         window.show()
+        if only == "archive":
+            written = archive_screenshots(app, window, folder, out)
+            window.close()
+            for path in written:
+                print(path)
+            return 0
         window.open_path(wav)
         if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
             print(f"screenshots: the analysis did not finish in {ANALYSIS_TIMEOUT_S} s", file=sys.stderr)
@@ -253,7 +337,7 @@ def main(argv: list[str]) -> int:
         tabs.setCurrentIndex(0)
         for index in range(window.pages.count()):
             page = window.pages.tabText(index)
-            if page == "Results":
+            if page in ("Results", "Archive"):      # the Archive page once it has measurements, below
                 continue
             window.pages.setCurrentIndex(index)
             settle(app)
@@ -272,6 +356,7 @@ def main(argv: list[str]) -> int:
         written += model_lab_screenshots(app, window, folder, out)
         written += measure_screenshots(app, window, folder, out)
         written += series_screenshots(app, window, folder, out)
+        written += archive_screenshots(app, window, folder, out)
         window.close()
     for path in written:
         print(path)

@@ -1,5 +1,7 @@
-"""Step 1: which driver is measured: name, serial number, Sd, nominal impedance and its class."""
+"""Step 1: which driver is measured: name, serial number, Sd, nominal impedance and its class; who measures where."""
 from __future__ import annotations
+
+import socket
 
 from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout, QLineEdit, QVBoxLayout
 
@@ -8,6 +10,16 @@ from app.wizard.plans import TEMPLATES, DriverInfo, sd_from_diameter
 
 SD_AREA, SD_DIAMETER = 0, 1
 TEMPLATE_KEY = "measure/template"
+OPERATOR_KEY = "measure/operator"
+STATION_KEY = "measure/station"
+
+
+def default_station() -> str:
+    """This computer's name: a station is usually one computer with its rig."""
+    try:
+        return socket.gethostname()
+    except OSError:
+        return ""
 
 
 class DriverPage(WizardPage):
@@ -44,6 +56,11 @@ class DriverPage(WizardPage):
         saved = state.settings.value(TEMPLATE_KEY, "woofer")
         self.template.setCurrentIndex(max(0, self.template.findData(saved)))
         self.template_note = rich_label()
+        # Remembered: the same person measures a batch at the same station.
+        self.operator_edit = QLineEdit(str(state.settings.value(OPERATOR_KEY, "") or ""))
+        self.operator_edit.setPlaceholderText("optional: who measures (kept in the archive)")
+        self.station_edit = QLineEdit(str(state.settings.value(STATION_KEY, default_station()) or ""))
+        self.station_edit.setPlaceholderText("optional: which rig or bench (kept in the archive)")
 
         form = QFormLayout()
         form.addRow("Name", self.name_edit)
@@ -53,6 +70,8 @@ class DriverPage(WizardPage):
         form.addRow("Nominal impedance", self.impedance)
         form.addRow("Class (template)", self.template)
         form.addRow("", self.template_note)
+        form.addRow("Operator", self.operator_edit)
+        form.addRow("Station", self.station_edit)
         # A form as wide as the window reads badly: keep it to a column, left.
         row = QHBoxLayout()
         row.addLayout(form, 3)
@@ -96,6 +115,9 @@ class DriverPage(WizardPage):
 
     def commit(self) -> None:
         key = self.template.currentData()
+        operator, station = self.operator_edit.text().strip(), self.station_edit.text().strip()
         self.state.settings.setValue(TEMPLATE_KEY, key)
+        self.state.settings.setValue(OPERATOR_KEY, operator)
+        self.state.settings.setValue(STATION_KEY, station)
         self.state.driver = DriverInfo(self.name_edit.text().strip(), self.serial_edit.text().strip(),
-                                       self.sd_m2(), self.impedance.value() or None, key)
+                                       self.sd_m2(), self.impedance.value() or None, key, operator, station)

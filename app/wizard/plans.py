@@ -27,6 +27,9 @@ class DriverInfo:
     sd_m2: float | None = None
     nominal_impedance_ohm: float | None = None
     template: str = "woofer"
+    # Who measured, and where: for the archive's record, not part of the recording's driver object.
+    operator: str = ""
+    station: str = ""
 
     def as_json(self) -> dict:
         """The recording's "driver" object (analysis.pipeline.resolve_sd reads sd_m2 from it)."""

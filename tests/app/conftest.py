@@ -58,6 +58,15 @@ def settings(tmp_path):
 
 
 @pytest.fixture(autouse=True)
+def archive_root(monkeypatch, tmp_path) -> Path:
+    """The measurement archive of a test: never the user's. A window whose settings name no archive folder
+    uses analysis.archive.default_root(), which $LINPAR_ARCHIVE points here."""
+    root = tmp_path / "archive"
+    monkeypatch.setenv("LINPAR_ARCHIVE", str(root))
+    return root
+
+
+@pytest.fixture(autouse=True)
 def dialogs(monkeypatch) -> list[tuple[str, str, str]]:
     """(kind, title, text) of every message box the code under test opens."""
     shown: list[tuple[str, str, str]] = []

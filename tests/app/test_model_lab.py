@@ -280,6 +280,8 @@ def test_the_main_window_hands_its_result_to_the_lab_and_shows_the_labs_model(qt
     assert window.results.result.fit is lab.current.fitted.fit     # the Results page shows the lab's model
     assert len(lab.versions) == 2                                   # and that did not restart the lab
     window.results.on_sd_changed(0.02)
+    # The lab follows the Results page in a later turn of the event loop (app/staged_fanout.py).
+    qtbot.waitUntil(lambda: not window.result_pages.pending, timeout=2000)
     assert lab.current.fitted.result.sd_m2 == 0.02 and len(lab.versions) == 2
     vas = lab.current.fitted.result.parameters["Vas"]
     assert vas.value == pytest.approx(window.results.result.parameters["Vas"].value)

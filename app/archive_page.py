@@ -1,0 +1,339 @@
+"""The Archive page: the stored measurements, filtered as one types; open one, compare up to eight.
+
+The list is read on the GUI thread (the index answers 1000 entries in ~0.1 s);
+storing, comparing (it reads every results file) and rebuilding the index run
+in app.archive_worker. Open hands the stored recording to the main window,
+which analyses it again like any opened file: the Results page, the Model lab
+and QA then have a full analysis (a stored results file has no covariance to
+refit or diagnose from). Every archive error is one line on the page.
+"""
+from __future__ import annotations
+
+import html
+import logging
+from pathlib import Path
+
+from PySide6.QtCore import QItemSelection, QItemSelectionModel, Qt, QTimer, Signal
+from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QTabWidget, QVBoxLayout,
+                               QWidget)
+
+from analysis.archive import MAX_COMPARED, Archive, ArchiveError, default_root
+from app import style
+from app.archive_filter import FilterBar
+from app.archive_overlay import CompareView
+from app.archive_table import ArchiveTable
+from app.archive_worker import ArchiveWorker, archive_error_text
+
+log = logging.getLogger(__name__)
+
+FILTER_DELAY_MS = 250           # typing a serial number should not list the archive once per key
+LIST_LIMIT = 2000               # newest first; more than this is a filter's job, not a scroll bar's
+ROOT_KEY = "archive/root"       # in the window's QSettings: the folder chosen on this page
+COLOURS = {"error": style.VALIDITY_COLOURS["red"][1], "note": style.VALIDITY_COLOURS["yellow"][1],
+           "info": style.VALIDITY_COLOURS["unknown"][1]}
+
+
+def archive_root(qsettings) -> Path:
+    """The folder chosen on the page, else analysis.archive's default ($LINPAR_ARCHIVE or ~/.local/share/...)."""
+    saved = qsettings.value(ROOT_KEY, "")
+    return Path(saved).expanduser() if isinstance(saved, str) and saved else default_root()
+
+
+class ArchivePage(QWidget):
+    open_requested = Signal(object, str)    # the stored recording's path, a label for the window title
+    listed = Signal(int)                    # the number of measurements the table now shows
+    stored = Signal(str, str)               # the id of a measurement stored, the recording it was stored from
+    store_failed = Signal(str, str)         # why a measurement was not stored (one line), its recording
+    comparison_shown = Signal(object)       # app.archive_worker.ComparisonData
+    rebuilt = Signal(str)                   # the rebuild's report
+
+    def __init__(self, settings, parent=None):
+        super().__init__(parent)
+        self.settings = settings
+        self.worker = ArchiveWorker(self)
+        self._jobs: dict[int, str] = {}      # job id -> what it does, for its failure's message
+        self._storing: dict[int, Path] = {}  # job id -> the recording being stored
+        self._compare_job = None            # the ArchiveJob whose comparison will be shown
+        self._list_error = False
+
+        self.root_label = QLabel()
+        self.root_label.setTextFormat(Qt.PlainText)
+        self.root_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        # A long path must not set the window's minimum width: it is cut, and whole in the tooltip.
+        self.root_label.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
+        self.root_button = QPushButton("Change…")
+        self.root_button.setToolTip("Choose the archive's folder (shared by the people at this station)")
+        self.rebuild_button = QPushButton("Rebuild index")
+        self.rebuild_button.setToolTip("Read every measurement folder again and rebuild the index from them")
+        self.refresh_button = QPushButton("Refresh")
+
+        self.filters = FilterBar()
+
+        self.message = QLabel()
+        self.message.setWordWrap(True)
+        self.message.setTextFormat(Qt.RichText)
+        self.message.hide()
+        self.table = ArchiveTable()
+        self.count_label = QLabel()
+        self.count_label.setWordWrap(True)      # "The archive is empty: ..." must not widen the window
+        self.selection_label = QLabel()
+        self.open_button = QPushButton("Open")
+        self.open_button.setToolTip("Analyse the stored recording again and show it on the Results page "
+                                    "(double-click a row does the same)")
+        self.compare_button = QPushButton("Compare")
+        self.compare_button.setToolTip(f"Overlay the curves and tabulate the parameters of up to {MAX_COMPARED} "
+                                       "selected measurements (Ctrl- or Shift-click to select several)")
+        self.compare_view = CompareView()
+        self.tabs = QTabWidget()
+        self._build_layout()
+
+        self.filter_timer = QTimer(self)
+        self.filter_timer.setSingleShot(True)
+        self.filter_timer.setInterval(FILTER_DELAY_MS)
+        self.filter_timer.timeout.connect(self.refresh_now)
+        self.filters.changed.connect(self.refresh)
+        self.root_button.clicked.connect(self.on_choose_root)
+        self.rebuild_button.clicked.connect(self.on_rebuild)
+        self.refresh_button.clicked.connect(self.refresh_now)
+        self.open_button.clicked.connect(self.on_open)
+        self.compare_button.clicked.connect(self.on_compare)
+        self.table.doubleClicked.connect(lambda _index: self.on_open())
+        self.table.selectionModel().selectionChanged.connect(self.on_selection_changed)
+        self.worker.stored.connect(self.on_stored)
+        self.worker.compared.connect(self.on_compared)
+        self.worker.rebuilt.connect(self.on_rebuilt)
+        self.worker.failed.connect(self.on_failed)
+        self.worker.cancelled.connect(self.on_cancelled)
+        self._show_root()
+        self.on_selection_changed()
+
+    def _build_layout(self) -> None:
+        top = QHBoxLayout()
+        top.addWidget(QLabel("<b>Archive</b>"))
+        top.addWidget(self.root_label, 1)
+        for button in (self.root_button, self.rebuild_button, self.refresh_button):
+            top.addWidget(button)
+        actions = QHBoxLayout()
+        actions.addWidget(self.count_label, 1)
+        actions.addWidget(self.selection_label)
+        actions.addWidget(self.open_button)
+        actions.addWidget(self.compare_button)
+        list_tab = QWidget()
+        list_layout = QVBoxLayout(list_tab)
+        list_layout.addWidget(self.filters)
+        list_layout.addWidget(self.table, 1)
+        list_layout.addLayout(actions)
+        self.list_tab = list_tab
+        self.tabs.addTab(list_tab, "Measurements")
+        self.tabs.addTab(self.compare_view, "Comparison")
+        layout = QVBoxLayout(self)
+        layout.addLayout(top)
+        layout.addWidget(self.message)
+        layout.addWidget(self.tabs, 1)
+
+    # -- the archive's folder --------------------------------------------------
+    @property
+    def root(self) -> Path:
+        return archive_root(self.settings.qsettings)
+
+    def set_root(self, path: str | Path) -> None:
+        self.settings.qsettings.setValue(ROOT_KEY, str(path))
+        self.settings.qsettings.sync()
+        self._show_root()
+        self.compare_view.clear()           # those were measurements of the other archive
+        self.tabs.setCurrentWidget(self.list_tab)
+        self.refresh_now()
+
+    def _show_root(self) -> None:
+        self.root_label.setText(str(self.root))
+        self.root_label.setToolTip(f"{self.root}\nEvery measurement finished on the Measure page is stored here")
+
+    def on_choose_root(self) -> None:
+        folder = QFileDialog.getExistingDirectory(self, "Archive folder", str(self.root))
+        if folder:
+            self.set_root(folder)
+
+    # -- messages --------------------------------------------------------------
+    def show_message(self, text: str, kind: str = "info") -> None:
+        self.message.setText(f"<span style='color:{COLOURS[kind]}'>{html.escape(text)}</span>")
+        self.message.setToolTip(text)
+        self.message.setVisible(bool(text))
+
+    def clear_message(self) -> None:
+        self.message.clear()
+        self.message.hide()
+
+    def _error_text(self, exc: Exception) -> str:
+        text = archive_error_text(exc, self.root)
+        if text is None:
+            log.exception("archive page")
+            text = f"internal error ({type(exc).__name__}: {exc}); the details are in the log"
+        return text
+
+    # -- listing -----------------------------------------------------------------
+    def refresh(self, *_args) -> None:
+        """List again once the typing stops."""
+        self.filter_timer.start()
+
+    def refresh_now(self) -> int:
+        """List the archive with the filter now; the number of measurements shown."""
+        self.filter_timer.stop()
+        root = self.root
+        keep = {e.id for e in self.table.selected_entries()}
+        try:
+            archive = Archive(root)
+            entries = archive.list(self.filters.filter(LIST_LIMIT + 1))
+        except Exception as exc:  # noqa: BLE001 - every error is a message on the page
+            self.table.set_entries([])
+            self.count_label.setText("")
+            self.show_message(f"Cannot read the archive in {root}: {self._error_text(exc)}", "error")
+            self._list_error = True
+            self.listed.emit(0)
+            return 0
+        if self._list_error:
+            self.clear_message()
+            self._list_error = False
+        if archive.notes:
+            self.show_message("The index was repaired: " + "; ".join(archive.notes), "note")
+        more = len(entries) > LIST_LIMIT
+        entries = entries[:LIST_LIMIT]
+        self.table.set_entries(entries)
+        self._reselect(keep)
+        self.count_label.setText(self._count_text(len(entries), more, root))
+        self.listed.emit(len(entries))
+        return len(entries)
+
+    def _count_text(self, n: int, more: bool, root: Path) -> str:
+        filtered = self.filters.active
+        if n == 0 and not filtered:
+            return ("The archive is empty" if root.is_dir() else "No archive in this folder yet") + \
+                ": every measurement finished on the Measure page is stored here."
+        if n == 0:
+            return "No measurement matches the filter."
+        if more:
+            return f"The newest {n} measurements{' that match' if filtered else ''}: narrow the filter to see older ones."
+        return f"{n} measurement{'s' if n != 1 else ''}{' match the filter' if filtered else ''}."
+
+    def _reselect(self, ids: set[str]) -> None:
+        if not ids:
+            return
+        selection = QItemSelection()
+        for row in range(self.table.proxy.rowCount()):
+            if self.table.entry_at(row).id in ids:
+                index = self.table.proxy.index(row, 0)
+                selection.select(index, index)
+        self.table.selectionModel().select(selection, QItemSelectionModel.Select | QItemSelectionModel.Rows)
+
+    def on_selection_changed(self, *_args) -> None:
+        n = len(self.table.selectionModel().selectedRows())
+        self.open_button.setEnabled(n >= 1)
+        self.compare_button.setEnabled(n >= 1)
+        if n > MAX_COMPARED:
+            self.selection_label.setText(f"<span style='color:{COLOURS['error']}'>{n} selected: at most "
+                                         f"{MAX_COMPARED} can be compared</span>")
+        else:
+            self.selection_label.setText(f"{n} selected" if n else "")
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        self.refresh_now()          # another program (linpar archive store) may have added some
+
+    # -- open and compare ----------------------------------------------------------
+    def on_open(self) -> Path | None:
+        entry = self.table.current_entry()
+        if entry is None:
+            self.show_message("Select the measurement to open.", "error")
+            return None
+        try:
+            measurement = Archive(self.root).get(entry.id)
+            path = measurement.recording_path()
+            if path is None or not path.is_file():
+                raise ArchiveError(f"{measurement.folder}: the recording is missing")
+        except Exception as exc:  # noqa: BLE001 - every error is a message on the page
+            self.show_message(f"Cannot open {entry.id}: {self._error_text(exc)}", "error")
+            return None
+        label = " ".join(x for x in (entry.driver, entry.serial) if x) or entry.id
+        self.show_message(f"Opened {label} ({entry.id}): its stored recording is analysed again for the "
+                          "Results page.", "info")
+        self.open_requested.emit(path, f"{label} (archive {entry.measured_at[:10]})")
+        return path
+
+    def on_compare(self) -> None:
+        entries = self.table.selected_entries()
+        if not entries:
+            self.show_message("Select the measurements to compare (Ctrl- or Shift-click).", "error")
+            return
+        if len(entries) > MAX_COMPARED:
+            self.show_message(f"{len(entries)} measurements are selected, but at most {MAX_COMPARED} can be "
+                              f"compared: deselect {len(entries) - MAX_COMPARED}.", "error")
+            return
+        if self._compare_job is not None:
+            self._compare_job.cancel()      # replaced: its outcome would be dropped anyway
+        job = self.worker.compare(self.root, [e.id for e in entries])
+        self._jobs[job.id] = "compare"
+        self._compare_job = job
+        self.show_message(f"Loading {len(entries)} measurement{'s' if len(entries) != 1 else ''}…", "info")
+
+    def on_compared(self, job: int, data) -> None:
+        self._jobs.pop(job, None)
+        if self._compare_job is None or job != self._compare_job.id:
+            return
+        self._compare_job = None
+        self.compare_view.set_data(data)
+        self.tabs.setCurrentWidget(self.compare_view)
+        if data.notes:
+            self.show_message("The index was repaired: " + "; ".join(data.notes), "note")
+        else:
+            self.clear_message()
+        self.comparison_shown.emit(data)
+
+    # -- storing and rebuilding ------------------------------------------------------
+    def store_measurement(self, recording: Path, result, meta: dict) -> int:
+        """Store in the worker; `stored` or `store_failed` tells how it went. The job's id."""
+        job = self.worker.store(self.root, Path(recording), result, meta)
+        self._jobs[job.id] = "store"
+        self._storing[job.id] = Path(recording)
+        return job.id
+
+    def on_stored(self, job: int, stored) -> None:
+        self._jobs.pop(job, None)
+        self._storing.pop(job, None)
+        self.refresh_now()
+        text = f"Stored {stored.recording.name} as {stored.id}."
+        if stored.notes:
+            text += " The index was repaired: " + "; ".join(stored.notes)
+        self.show_message(text, "note" if stored.notes else "info")
+        self.stored.emit(stored.id, str(stored.recording))
+
+    def on_rebuild(self) -> None:
+        self.rebuild_button.setEnabled(False)
+        job = self.worker.rebuild(self.root)
+        self._jobs[job.id] = "rebuild"
+        self.show_message("Rebuilding the index from the measurement folders…", "info")
+
+    def on_rebuilt(self, job: int, done) -> None:
+        self._jobs.pop(job, None)
+        self.rebuild_button.setEnabled(True)
+        self.refresh_now()
+        self.show_message(done.text[:1].upper() + done.text[1:], "note" if done.skipped else "info")
+        self.rebuilt.emit(done.text)
+
+    def on_failed(self, job: int, message: str) -> None:
+        kind = self._jobs.pop(job, "")
+        if kind == "store":
+            recording = self._storing.pop(job, Path())
+            self.show_message(f"{recording.name} was not stored in the archive: {message}", "error")
+            self.store_failed.emit(message, str(recording))
+        elif kind == "rebuild":
+            self.rebuild_button.setEnabled(True)
+            self.show_message(f"Cannot rebuild the index: {message}", "error")
+        elif self._compare_job is not None and job == self._compare_job.id:
+            self._compare_job = None
+            self.show_message(f"Cannot compare: {message}", "error")
+
+    def on_cancelled(self, job: int) -> None:
+        self._jobs.pop(job, None)
+        self._storing.pop(job, None)
+
+    def shutdown(self, wait_ms: int) -> bool:
+        return self.worker.shutdown(wait_ms)

@@ -1,0 +1,152 @@
+"""The archive's slow work off the GUI thread: storing a measurement, loading a comparison, rebuilding the index.
+
+Built like app.workers: one long-lived ArchiveWorker (a QObject of the GUI
+thread) owns a one-thread QThreadPool, so a store and the rebuild that
+follows it run in the order asked. Each job opens its own Archive (its own
+SQLite connection, its own repair notes). What crosses to the GUI thread is
+frozen, or one line of text: every archive error (ArchiveError, SQLite,
+the file system, a results file that does not read) becomes that line.
+"""
+from __future__ import annotations
+
+import logging
+import sqlite3
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+from PySide6.QtCore import QObject, Signal
+
+from app.job_book import JobBook
+from app.workers import one_line
+
+log = logging.getLogger(__name__)
+LASER_SUFFIX = ".laser.npz"     # instruments.measurement.raw_stream.SUFFIX: the raw laser stream beside NAME.wav
+
+
+class ArchiveCancelled(Exception):
+    pass
+
+
+@dataclass(frozen=True, slots=True)
+class StoredMeasurement:
+    id: str
+    recording: Path             # the recording that was stored (it stays where it was)
+    notes: tuple[str, ...]      # what opening the index had to repair
+
+
+@dataclass(frozen=True, slots=True)
+class ComparisonData:
+    comparison: Any                         # analysis.archive.Comparison
+    dates: tuple[str, ...]                  # measured_at of each, as the index has it
+    curves: tuple[Mapping[str, Any], ...]   # per measurement: channel -> analysis.archive.results.Curve
+    notes: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class RebuildDone:
+    text: str                   # RebuildReport.describe()
+    skipped: int
+
+
+def archive_error_text(exc: BaseException, root: Path) -> str | None:
+    """The one line a user reads for an error of the archive; None for a bug."""
+    from analysis.archive import ArchiveError
+    from analysis.archive.results import ResultsFormatError
+    from analysis.recording import RecordingError
+    if isinstance(exc, ArchiveError):
+        return one_line(exc)
+    if isinstance(exc, sqlite3.Error):
+        return f"the archive's index in {root} cannot be used ({one_line(exc)}); try Rebuild index"
+    if isinstance(exc, (OSError, RecordingError, ResultsFormatError)):
+        return one_line(exc)
+    return None
+
+
+def laser_stream_of(recording: Path) -> Path | None:
+    """NAME.laser.npz next to NAME.wav, written by the runner when a serial laser was read."""
+    path = recording.with_name(recording.stem + LASER_SUFFIX)
+    return path if path.is_file() else None
+
+
+class ArchiveJob:
+    """One job in the pool thread: `work(job)` returns what the kind's signal carries."""
+
+    def __init__(self, job: int, kind: str, root: Path, work: Callable[["ArchiveJob"], object],
+                 worker: "ArchiveWorker"):
+        self.id = job
+        self.kind = kind
+        self.root = root
+        self._work = work
+        self._worker = worker
+        # NB: set by the GUI thread, read between measurements by the pool thread.
+        self.cancel_event = threading.Event()
+
+    def cancel(self) -> None:
+        self.cancel_event.set()
+
+    def check(self) -> None:
+        if self.cancel_event.is_set():
+            raise ArchiveCancelled
+
+    def __call__(self) -> None:
+        worker = self._worker
+        try:
+            result = self._work(self)
+        except ArchiveCancelled:
+            worker.cancelled.emit(self.id)
+        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
+            text = archive_error_text(exc, self.root)
+            if text is None:
+                log.exception("archive %s failed", self.kind)
+                text = (f"internal error in the archive's {self.kind} ({type(exc).__name__}: {one_line(exc)}); "
+                        "the details are in the log")
+            worker.failed.emit(self.id, text)
+        else:
+            getattr(worker, self.kind).emit(self.id, result)
+
+
+class ArchiveWorker(QObject, JobBook):
+    stored = Signal(int, object)        # job id, StoredMeasurement
+    compared = Signal(int, object)      # job id, ComparisonData
+    rebuilt = Signal(int, object)       # job id, RebuildDone
+    failed = Signal(int, str)           # job id, a one-line message for the user
+    cancelled = Signal(int)             # job id
+
+    def __init__(self, parent: QObject | None = None):
+        super().__init__(parent)
+        self._init_jobs(self, (self.stored, self.compared, self.rebuilt, self.failed, self.cancelled), max_threads=1)
+
+    def store(self, root: Path, recording: Path, result, meta: Mapping[str, Any]) -> ArchiveJob:
+        """Store a recording file and its analysis.pipeline.AnalysisResult with `meta` (MeasurementMeta's keys)."""
+        def work(job):
+            from analysis.archive import Archive
+            archive = Archive(root)
+            mid = archive.store(recording, result, dict(meta), laser_stream=laser_stream_of(recording))
+            return StoredMeasurement(mid, recording, tuple(archive.notes))
+        return self._start(ArchiveJob(self._next_id(), "stored", root, work, self))
+
+    def compare(self, root: Path, ids: list[str]) -> ArchiveJob:
+        """analysis.archive.compare of `ids`, with each one's stored curves for the overlay."""
+        ids = list(ids)
+
+        def work(job):
+            from analysis.archive import Archive, compare
+            archive = Archive(root)
+            comparison = compare(archive, ids)
+            dates, curves = [], []
+            for mid in comparison.ids:
+                job.check()
+                m = archive.get(mid)
+                dates.append(m.entry.measured_at)
+                curves.append(dict(m.result().curves))
+            return ComparisonData(comparison, tuple(dates), tuple(curves), tuple(archive.notes))
+        return self._start(ArchiveJob(self._next_id(), "compared", root, work, self))
+
+    def rebuild(self, root: Path) -> ArchiveJob:
+        def work(job):
+            from analysis.archive import Archive
+            report = Archive(root).rebuild()
+            return RebuildDone(report.describe(), len(report.skipped))
+        return self._start(ArchiveJob(self._next_id(), "rebuilt", root, work, self))

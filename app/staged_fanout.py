@@ -1,0 +1,62 @@
+"""One value handed to several slow receivers, each in its own turn of the event loop."""
+from __future__ import annotations
+
+from typing import Callable
+
+from PySide6.QtCore import QObject, QTimer
+
+
+class StagedFanOut(QObject):
+    """Calls each receiver with the value in a later turn of the event loop than the one before.
+
+    A new result reaches the Results page, the Model lab and the QA view. One
+    after the other in a single turn they held the GUI thread for 60-80 ms (the
+    lab alone takes 30 ms to set up its plots); one per turn, the event loop
+    runs, and the pages paint, in between. `then` callbacks run after the last
+    receiver, so "shown" signals still mean every page has the value.
+
+    A value sent while an earlier one is still on its way replaces it: the
+    receivers left get the newer one, and the receivers already served get it
+    too, in the new round.
+    """
+
+    def __init__(self, receivers: list[Callable[[object], None]], parent: QObject | None = None):
+        super().__init__(parent)
+        self._receivers = list(receivers)
+        self._value = None
+        self._left: list[Callable[[object], None]] = []
+        self._then: list[Callable[[], None]] = []
+        self._round = 0
+
+    @property
+    def pending(self) -> bool:
+        return bool(self._left)
+
+    def send(self, value, then: Callable[[], None] | None = None) -> None:
+        self._value = value
+        self._left = list(self._receivers)
+        if then is not None:
+            self._then.append(then)
+        self._round += 1
+        self._schedule(self._round)
+
+    def after(self, callback: Callable[[], None]) -> None:
+        """`callback` once every receiver has the value on its way; at once when none is."""
+        if self._left:
+            self._then.append(callback)
+        else:
+            callback()
+
+    def _schedule(self, round_: int) -> None:
+        QTimer.singleShot(0, self, lambda: self._next(round_))
+
+    def _next(self, round_: int) -> None:
+        if round_ != self._round:
+            return                      # a newer send() runs its own round
+        if self._left:
+            self._left.pop(0)(self._value)
+            self._schedule(round_)
+            return
+        then, self._then = self._then, []
+        for callback in then:
+            callback()
