@@ -60,6 +60,7 @@ samples.
 
 from __future__ import annotations
 
+import functools
 import math
 import operator
 from dataclasses import dataclass
@@ -188,6 +189,35 @@ def design_multitone(
     level = _level_target(rms, peak) or ("rms", _DEFAULT_RMS)
     _check_design_inputs(sample_rate, period_samples, f_min, f_max, lines_per_octave, crest_iterations)
 
+    if amplitude_shape is None:
+        bins, shape, phases = _flat_design(sample_rate, period_samples, float(f_min), float(f_max),
+                                           float(lines_per_octave), n_lines, seed, crest_iterations)
+    else:
+        bins, shape, phases = _design(sample_rate, period_samples, f_min, f_max, lines_per_octave, n_lines,
+                                      amplitude_shape, seed, crest_iterations)
+    unit = synthesize(period_samples, bins, shape, phases)
+    measure = np.sqrt(np.mean(unit**2)) if level[0] == "rms" else np.max(np.abs(unit))
+    amplitudes = shape * (level[1] / measure)
+    return Multitone(sample_rate, period_samples, bins, amplitudes, phases,
+                     synthesize(period_samples, bins, amplitudes, phases))
+
+
+@functools.lru_cache(maxsize=16)
+def _flat_design(sample_rate: int, period_samples: int, f_min: float, f_max: float, lines_per_octave: float,
+                 n_lines: int | None, seed: int, crest_iterations: int) -> tuple[np.ndarray, ...]:
+    """_design with flat lines, remembered: a measurement designs the same excitation as the level check
+    before it, and the crest-factor descent is 0.5 s or more of work that holds the GIL in short slices,
+    which the GUI thread feels as stalls. Read-only arrays, so the cached design cannot be altered."""
+    design = _design(sample_rate, period_samples, f_min, f_max, lines_per_octave, n_lines, None, seed,
+                     crest_iterations)
+    for array in design:
+        array.flags.writeable = False
+    return design
+
+
+def _design(sample_rate, period_samples, f_min, f_max, lines_per_octave, n_lines, amplitude_shape, seed,
+            crest_iterations) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(excited bins, relative line amplitudes, phases) of design_multitone, before its level is set."""
     allowed = excitable_bins(sample_rate, period_samples, f_min, f_max)
     if allowed.size == 0:
         raise ValueError(
@@ -206,12 +236,7 @@ def design_multitone(
     start = schroeder_phases(bins, shape) + rng.normal(0.0, _SEED_DITHER_RAD, bins.size)
     phases = reduce_crest_factor(bins, shape, start, crest_iterations)
     phases = np.mod(phases, 2 * np.pi)
-
-    unit = synthesize(period_samples, bins, shape, phases)
-    measure = np.sqrt(np.mean(unit**2)) if level[0] == "rms" else np.max(np.abs(unit))
-    amplitudes = shape * (level[1] / measure)
-    return Multitone(sample_rate, period_samples, bins, amplitudes, phases,
-                     synthesize(period_samples, bins, amplitudes, phases))
+    return bins, shape, phases
 
 
 def unexcited_bins(mt: Multitone, f_min: float | None = None, f_max: float | None = None) -> np.ndarray:

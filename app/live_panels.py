@@ -234,6 +234,7 @@ class LivePanels(QWidget):
         self.timer.timeout.connect(self.on_repaint_timer)
         self._pending: LiveFrame | None = None
         self._idle = 0
+        self._drawing = 0               # counts draws begun: a channel left over from an older one is skipped
         self.frame: LiveFrame | None = None        # the frame on screen
         self.frames_received = 0
         self.paint_times: list[float] = []          # time.monotonic() when each repaint began (bench, tests)
@@ -259,10 +260,24 @@ class LivePanels(QWidget):
         self.draw(frame)
 
     def draw(self, frame: LiveFrame) -> None:
+        """Draw `frame`: one channel now and each of the others in a later turn of the event loop.
+
+        All three at once (their new data, then their repaint) held the GUI thread for 40 ms and more
+        on a busy machine; a channel at a time gives the loop room in between, and the three still
+        change within a few milliseconds of each other. `repainted` follows the last channel.
+        """
         self.paint_times.append(time.monotonic())
         self.frame = frame
-        for panel in self.panels.values():
-            panel.show_frame(frame)
+        self._drawing += 1
+        self._draw_channel(self._drawing, frame, list(self.panels.values()))
+
+    def _draw_channel(self, drawing: int, frame: LiveFrame, panels: list) -> None:
+        if drawing != self._drawing:        # a newer frame, or clear(), took over
+            return
+        panels[0].show_frame(frame)
+        if len(panels) > 1:
+            QTimer.singleShot(0, self, lambda: self._draw_channel(drawing, frame, panels[1:]))
+            return
         peak = frame.peak_displacement_m
         peak_text = f", peak excursion {peak * 1e3:.3f} mm" if peak is not None else ""
         self.status.setText(f"<b>{frame.n_periods} period{'s' if frame.n_periods != 1 else ''} averaged</b>"
@@ -273,6 +288,7 @@ class LivePanels(QWidget):
         """Empty panels; `band_hz`, when known, sets the frequency axis already."""
         self._pending = None
         self.frame = None
+        self._drawing += 1
         self.timer.stop()
         for panel in self.panels.values():
             panel.clear(band_hz=band_hz)

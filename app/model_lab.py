@@ -27,6 +27,7 @@ from analysis.fit import FitData
 from analysis.model import Model, ModelError
 from analysis.pipeline import AnalysisResult
 from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
+from app.layout_room import keep_room_when_hidden
 from app.model_lab_candidates import CandidatesPanel
 from app.model_lab_catalogue import EffectCatalogue
 from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
@@ -115,6 +116,7 @@ class ModelLab(QWidget):
         header.addWidget(self.status_label, 1)
         header.addWidget(self.progress)
         header.addWidget(self.cancel_button)
+        keep_room_when_hidden(self.progress, self.cancel_button)
 
         self.catalogue = EffectCatalogue()
         self.residual_panel = ResidualPanel()

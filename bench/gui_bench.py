@@ -48,6 +48,7 @@ def run(workdir: Path) -> list[Row]:
     folder = Path(tempfile.mkdtemp(prefix="gui-bench-", dir=workdir))
     settings = Settings(QSettings(str(folder / "settings.ini"), QSettings.IniFormat))
     settings.qsettings.setValue("measure/out_dir", str(folder / "measurements"))
+    settings.qsettings.setValue("archive/root", str(folder / "archive"))     # never the user's archive
     rig = _start_rig(folder) if shutil.which("jackd") else None
     try:
         window = MainWindow(settings)
@@ -175,6 +176,7 @@ def _measuring(app, window, rig) -> list[Row]:
     state.level_v, state.level_reason, state.level_words = level, "the bench's level", "bench"
     window.pages.setCurrentWidget(wizard)
     wizard.go_to(4)
+    _wait(app, lambda: False, 0.5)          # the window's first paint is its showing's, not the measurement's
     page = wizard.measure_page
     alone = _measure_once(app, wizard, page, template, [], 0)
     offered = _measure_once(app, wizard, page, template, _offered_frames(template, level), OFFERED_HZ)
@@ -267,6 +269,7 @@ def _diagnosing(app, window, folder: Path) -> list[Row]:
         return [Row("gui: the recording for the diagnosis was not analysed in time", 0.0, "", "", False)]
     lab = window.model_lab
     window.pages.setCurrentWidget(lab)
+    _wait(app, lambda: False, 0.5)          # the page's first paint is the tab switch's, not the diagnosis's
     done = []
     lab.diagnosis_shown.connect(done.append)
     with StallMeter() as meter:

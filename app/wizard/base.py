@@ -8,6 +8,7 @@ from typing import Callable
 from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QProgressBar, QPushButton, QWidget
 
+from app.layout_room import keep_room_when_hidden
 from app.measure_session import MeasureSession, SessionJob
 from app.wizard.calibration import Corrections
 from app.wizard.hardware import HardwareConfig
@@ -97,6 +98,7 @@ class JobControls(QWidget):
         layout.addWidget(self.progress)
         layout.addWidget(self.text, 1)
         layout.addWidget(self.cancel_button)
+        keep_room_when_hidden(self.progress, self.cancel_button)
         self._callbacks: dict[str, Callable] = {}
         session.progress.connect(self.on_progress)
         session.frame_ready.connect(self.on_frame)

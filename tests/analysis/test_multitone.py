@@ -304,3 +304,14 @@ def test_scaled_rejects_bad_levels(short_mt):
         short_mt.scaled()
     with pytest.raises(ValueError, match="rms must be a positive"):
         short_mt.scaled(rms=-1.0)
+
+
+def test_a_repeated_design_reuses_the_phases_and_only_rescales():
+    first = design_multitone(48000, 4096, 20.0, 2000.0, rms=1.0, seed=7)
+    again = design_multitone(48000, 4096, 20.0, 2000.0, rms=2.0, seed=7)
+    np.testing.assert_array_equal(first.phases, again.phases)
+    np.testing.assert_allclose(again.waveform, 2.0 * first.waveform, rtol=0, atol=1e-12)
+    other_seed = design_multitone(48000, 4096, 20.0, 2000.0, rms=1.0, seed=8)
+    assert not np.allclose(other_seed.phases, first.phases)
+    with pytest.raises(ValueError):
+        first.phases[0] = 0.0          # what is remembered cannot be altered through a result
