@@ -88,6 +88,25 @@ class Verdict:
     passed: bool
     note: str
 
+    def margin(self) -> tuple[float, str] | None:
+        """(distance to the nearest bound in SI, "min" or "max"): positive inside, negative outside.
+
+        Outside, the bound it is outside of. None when the parameter was not measured.
+        """
+        if self.value is None:
+            return None
+        sides = [(self.value - self.limit.low, "min")] if self.limit.low is not None else []
+        if self.limit.high is not None:
+            sides.append((self.limit.high - self.value, "max"))
+        return min(sides)
+
+    def tolerance_used(self) -> float | None:
+        """|value - centre| / half-width of a two-sided limit (1.0 on a bound), or None."""
+        low, high = self.limit.low, self.limit.high
+        if self.value is None or low is None or high is None or high <= low:
+            return None
+        return abs(self.value - (low + high) / 2) / ((high - low) / 2)
+
     def as_json(self) -> dict:
         return {"parameter": self.limit.name, "value": self.value, "low": self.limit.low, "high": self.limit.high,
                 "unit": parameter_units()[self.limit.name][0], "limit": self.limit.text,

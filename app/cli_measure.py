@@ -3,7 +3,8 @@
     linpar measure --out DIR [--rig virtual|soundcard] [--device NAME] [--calibration FILE]
                    [--laser URL|analog|none] [--template woofer|midrange|tweeter|microspeaker]
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
-                   [--on-xrun end|restart] [--json]
+                   [--on-xrun end|restart] [--serial TEXT] [--operator TEXT] [--station TEXT]
+                   [--archive-root DIR | --no-archive] [--json]
 
 With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
 used, started first if it is not running and stopped at the end if this
@@ -19,12 +20,22 @@ analyze` prints (the same JSON with --json, validity included); progress and
 the files written go to stderr. A measurement that a device ends (or Ctrl-C)
 keeps what was recorded and exits with 2 and a message that says what
 happened and where the data are.
+
+A complete measurement is then stored in the measurement archive
+(analysis.archive: ``--archive-root``, default $LINPAR_ARCHIVE or
+~/.local/share/linpar/archive; ``--no-archive``: not stored) and stderr says
+its id; with --json the printed object gets "archive": {"id", "root"}. When
+storing fails (a read-only or full disk ...), nothing is lost, since the
+recording is already written: a warning on stderr says why and how to store it
+later (``linpar archive store``), --json gets "archive": {"error", "root"},
+and the exit code is 3 (EXIT_NOT_STORED): measured and analysed, not archived.
 """
 from __future__ import annotations
 
 import argparse
 import dataclasses
 import json
+import shlex
 import sys
 import threading
 from contextlib import ExitStack
@@ -34,6 +45,7 @@ from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
 LASER_ANALOG, LASER_NONE = "analog", "none"
+EXIT_NOT_STORED = 3
 
 
 def add_commands(sub) -> None:
@@ -59,6 +71,13 @@ def add_commands(sub) -> None:
                         "serial laser), or average again")
     m.add_argument("--model", metavar="EFFECTS",
                    help="effect ids (default lr2,creep-log; with the serial laser also delay-x)")
+    for field in ("serial", "operator", "station"):
+        m.add_argument(f"--{field}", default="", metavar="TEXT", help=f"the {field} kept with it in the archive")
+    where = m.add_mutually_exclusive_group()
+    where.add_argument("--archive-root", type=Path, metavar="DIR",
+                       help="archive to store the measurement in (default: $LINPAR_ARCHIVE or "
+                            "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
+    where.add_argument("--no-archive", action="store_true", help="do not store the measurement in the archive")
     m.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -104,12 +123,52 @@ def run(args: argparse.Namespace) -> int:
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
             _say(f"wrote {path}")
+    archived = None if args.no_archive else _store(args, outcome, plan)
     result = outcome.result
     if args.json:
-        print(json.dumps(result_json(result), allow_nan=False, default=lambda value: None))
+        doc = result_json(result)
+        if archived is not None:
+            doc = {**doc, "archive": archived}
+        print(json.dumps(doc, allow_nan=False, default=lambda value: None))
     else:
         print(format_result(result))
-    return 0
+    return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
+
+
+def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan) -> dict:
+    """Store the measurement in the archive: {"id", "root"}, or {"error", "root"} and a warning (module doc)."""
+    from analysis.archive import Archive, default_root
+    root = Path(args.archive_root).expanduser() if args.archive_root else default_root()
+    meta = {"serial": args.serial, "operator": args.operator, "station": args.station,
+            "settings": {"template": plan.template, "rig": args.rig,
+                         "laser": "serial" if outcome.raw_path is not None else (args.laser or LASER_ANALOG)}}
+    archive = None
+    try:
+        archive = Archive(root)
+        mid = archive.store(outcome.recording_path, outcome.result, meta, laser_stream=outcome.raw_path)
+    except Exception as exc:  # noqa: BLE001 - whatever went wrong, the recording is on disk: say so, lose nothing
+        known = isinstance(exc, (OSError, ValueError, RuntimeError))      # ArchiveError is a RuntimeError
+        why = " ".join(str(exc).split()) or type(exc).__name__
+        why = why if known else f"internal error ({type(exc).__name__}: {why})"
+        _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
+             f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root)}")
+        return {"error": why, "root": str(root)}
+    finally:
+        for note in archive.notes if archive is not None else ():
+            _say(f"note: {note}")
+    _say(f"stored in the archive {root} as {mid}")
+    return {"id": mid, "root": str(root)}
+
+
+def _store_later(args: argparse.Namespace, outcome, root: Path) -> str:
+    """The `linpar archive store` command that stores this measurement as this command would have."""
+    effects = ",".join(outcome.result.fit.model.effect_ids) or "none"
+    command = ["linpar", "archive", "store", str(outcome.recording_path.with_suffix("")), "--model", effects]
+    if outcome.raw_path is not None:
+        command += ["--laser-stream", str(outcome.raw_path)]
+    for key in ("serial", "operator", "station"):
+        command += [f"--{key}", getattr(args, key)] if getattr(args, key) else []
+    return shlex.join(command + ["--root", str(root)])
 
 
 def _devices(args: argparse.Namespace, stack: ExitStack):

@@ -2,6 +2,12 @@
 
 A PATH that names an existing recording is analysed on the fly; anything
 else is looked up in the archive as a measurement id (or its first characters).
+
+`linpar report ... --limits FILE` judges the parameters against a QA limits
+file: the report carries the verdict (a banner under the title and a table
+per parameter), and the verdict is printed ("QA: PASS|FAIL|NOT JUDGED").
+The exit code says whether the report was written (0) or not (2), not the
+verdict: `linpar analyze --limits` is the command whose exit code is the verdict.
 """
 from __future__ import annotations
 
@@ -28,6 +34,8 @@ def add_commands(sub) -> None:
     _source_arguments(report)
     report.add_argument("--pdf", metavar="FILE")
     report.add_argument("--html", metavar="FILE")
+    report.add_argument("--limits", metavar="FILE",
+                        help="QA limits (JSON, linpar-limits/1): the report shows pass/fail per parameter and overall")
 
     export = sub.add_parser("export", help="parameters, curves and a driver file of one measurement")
     _source_arguments(export)
@@ -66,9 +74,14 @@ def run(args: argparse.Namespace) -> int:
     if args.command == "report":
         if not args.pdf and not args.html:
             raise ValueError("report: give --pdf FILE and/or --html FILE")
+        from analysis.limits import load_limits
         from analysis.report import build_report, write_report
+        limits = load_limits(args.limits) if args.limits else None    # a bad file fails before the analysis
         stored, header, settings, calibration = load_source(args)
-        written = write_report(build_report(stored, header, settings, calibration), args.pdf, args.html)
+        content = build_report(stored, header, settings, calibration, limits)
+        written = write_report(content, args.pdf, args.html)
+        if content.qa is not None:
+            print(f"QA: {content.qa.headline}: {content.qa.why} (limits {content.qa.file})")
     else:
         targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
         if not targets:

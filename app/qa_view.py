@@ -76,13 +76,14 @@ class ReportWorker(QObject):
         self.pool.setMaxThreadCount(1)
         self._next = 0
 
-    def start(self, result: AnalysisResult, path: Path, cancel: threading.Event) -> int:
+    def start(self, result: AnalysisResult, path: Path, cancel: threading.Event, limits=None) -> int:
+        """limits: the analysis.limits.Limits the page shows, for the report's QA section (None: none)."""
         self._next += 1
         job = self._next
-        self.pool.start(lambda: self._run(job, result, path, cancel))
+        self.pool.start(lambda: self._run(job, result, path, cancel, limits))
         return job
 
-    def _run(self, job: int, result: AnalysisResult, path: Path, cancel: threading.Event) -> None:
+    def _run(self, job: int, result: AnalysisResult, path: Path, cancel: threading.Event, limits) -> None:
         try:
             from analysis.archive.results import StoredResult, results_document
             from analysis.recording import read_recording
@@ -94,7 +95,7 @@ class ReportWorker(QObject):
                       "source": str(result.source or "")}
             extra = dict(recording.extra) if recording is not None else {}
             calibration = {k: extra[k] for k in ("calibration", "capture") if k in extra}
-            content = build_report(stored, header, None, calibration)
+            content = build_report(stored, header, None, calibration, limits)
             if cancel.is_set():
                 return
             kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
@@ -316,7 +317,9 @@ class QAView(QWidget):
         if self.result is None:
             self.export_label.setText("Nothing to report yet.")
         elif not self.export_label.text().startswith(("Written", "Could not", "Export cancelled")):
-            self.export_label.setText("A PDF or HTML report of this result: parameters, validity, plots.")
+            self.export_label.setText("A PDF or HTML report of this result: parameters, validity, plots"
+                                      + (", and the QA verdict against the loaded limits." if self.limits is not None
+                                         else "."))
 
     def _set_exporting(self, exporting: bool) -> None:
         self.export_progress.setVisible(exporting)
@@ -340,7 +343,8 @@ class QAView(QWidget):
 
     def export_to(self, path: Path) -> None:
         self._cancel = threading.Event()
-        self._job = self.worker.start(self.result, path, self._cancel)
+        # Limits are frozen dataclasses: handing the loaded ones to the pool thread is safe.
+        self._job = self.worker.start(self.result, path, self._cancel, self.limits)
         self.export_label.setText(f"Writing {path.name}…")
         self._set_exporting(True)
 

@@ -126,3 +126,56 @@ def test_analyze_limits_exit_codes(capsys, rec_path, red_path, tmp_path):
     code, out, err = run(capsys, "analyze", rec_path, "--limits", broken)
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and str(broken) in err and "parameters.fs.tolerance" in err and "line " in err
+
+
+def test_report_with_limits_carries_the_verdict(capsys, root, rec_path, tmp_path):
+    ok = write_limits(tmp_path, fs={"nominal": 70.5, "tolerance": "2%", "unit": "Hz"},
+                      Mms={"min": 11, "max": 13, "unit": "g"})
+    code, out, err = run(capsys, "report", rec_path, "--html", tmp_path / "ok.html", "--limits", ok)
+    assert code == 0, err
+    assert out.startswith("QA: PASS") and "QA: PASS" in (tmp_path / "ok.html").read_text()
+    bad = tmp_path / "bad-limits.json"
+    bad.write_text(json.dumps({"format": "linpar-limits/1", "parameters": {"fs": {"max": 60, "unit": "Hz"}}}))
+    mid = store(capsys, rec_path, "--serial", "SN7")
+    code, out, err = run(capsys, "report", mid, "--html", tmp_path / "bad.html", "--pdf", tmp_path / "bad.pdf",
+                         "--limits", bad)
+    assert code == 0, err                          # the report was written; `analyze --limits` gives the verdict
+    page = (tmp_path / "bad.html").read_text()
+    assert out.startswith("QA: FAIL") and "QA: FAIL" in page and "bad-limits.json" in page
+    assert (tmp_path / "bad.pdf").read_bytes().startswith(b"%PDF")
+    broken = write_limits(tmp_path, fs={"nominal": 50, "unit": "Hz"})
+    code, out, err = run(capsys, "report", rec_path, "--html", tmp_path / "never.html", "--limits", broken)
+    assert code == 2 and "parameters.fs.tolerance" in err and not (tmp_path / "never.html").exists()
+
+
+def test_a_read_only_archive_lists_from_its_folders_and_says_so(capsys, root, rec_path, monkeypatch):
+    import sqlite3
+
+    from analysis.archive.index import Index
+    ids = {store(capsys, rec_path, "--serial", f"R{i}") for i in range(2)}
+    (root / "index.sqlite").unlink()
+    # As in a folder this user may not write (tests run as root): every index file opens read-only.
+    monkeypatch.setattr(Index, "_open", lambda self, path=None: sqlite3.connect(
+        f"file:{path or self.path}?mode=ro", uri=True, timeout=0.1))
+    code, out, err = run(capsys, "archive", "list", "--json")
+    assert code == 0, err
+    assert {e["id"] for e in json.loads(out)} == ids
+    assert "listed from the measurement folders" in err and "linpar archive rebuild" in err
+    assert "Traceback" not in err and not (root / "index.sqlite").exists()
+    code, out, err = run(capsys, "archive", "rebuild")
+    assert code == 2 and err.startswith("linpar: error:") and err.count("\n") == 1
+    assert "cannot rebuild the index" in err and str(root) in err
+
+
+def test_an_sqlite_error_is_one_line_not_a_traceback(capsys, root, rec_path, monkeypatch):
+    import sqlite3
+
+    from analysis.archive.index import Index
+    mid = store(capsys, rec_path)
+
+    def io_error(*args, **kwargs):
+        raise sqlite3.OperationalError("disk I/O error")
+    monkeypatch.setattr(Index, "matching_ids", io_error)
+    code, out, err = run(capsys, "archive", "show", mid)
+    assert code == 2 and err.count("\n") == 1
+    assert "disk I/O error" in err and "linpar archive rebuild" in err

@@ -1,4 +1,5 @@
-"""`linpar measure`: on the session's virtual rig, on a rig of its own that it starts and stops, and its errors."""
+"""`linpar measure`: on the session's virtual rig, on a rig of its own that it starts and stops, its errors, and
+the archive it stores into (on the in-process simulated sound card)."""
 from __future__ import annotations
 
 import json
@@ -16,6 +17,14 @@ from instruments.measurement.runner import default_effects
 SHORT = ["--period", "16384", "--periods", "4"]
 
 
+@pytest.fixture(autouse=True)
+def archive_root(tmp_path_factory, monkeypatch):
+    """The default archive of every test here: a fresh folder, never the user's."""
+    root = tmp_path_factory.mktemp("archive") / "archive"
+    monkeypatch.setenv("LINPAR_ARCHIVE", str(root))
+    return root
+
+
 @pytest.mark.rig
 def test_measure_on_the_running_rig_writes_then_prints_what_analyze_prints(virtual_rig, tmp_path, capsys):
     rig = ["--rig-name", virtual_rig.name, "--runtime-dir", str(virtual_rig.paths.directory.parent)]
@@ -23,7 +32,9 @@ def test_measure_on_the_running_rig_writes_then_prints_what_analyze_prints(virtu
     out, err = capsys.readouterr()
     assert code == 0, err
     printed = json.loads(out)
-    assert set(printed) == {"parameters", "model", "validity"}
+    assert set(printed) == {"parameters", "model", "validity", "archive"}
+    stored = printed.pop("archive")
+    assert f"stored in the archive {stored['root']} as {stored['id']}" in err
     assert printed["parameters"]["Bl"]["value"] == pytest.approx(5.23, rel=0.005)
     assert "delay-x" in printed["model"]["effects"]          # the serial laser's default
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.json", "m.laser.npz", "m.wav"]
@@ -69,3 +80,62 @@ def test_mistakes_are_one_line_errors_before_anything_starts(tmp_path, capsys, a
     assert code == 2
     assert message in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "rigs").exists()                   # no rig was started
+
+
+@pytest.fixture
+def simulated_card(monkeypatch):
+    """`linpar measure` on the in-process simulated sound card (no JACK), analog laser on its input."""
+    import app.cli_measure as cli_measure
+    from instruments.audio.simulated import SimulatedAudio
+    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+        SimulatedAudio(realtime=False, seed=1), None, {"name": "paper (simulated)", "sd_m2": 0.0133}))
+
+
+def measure(capsys, tmp_path, *extra):
+    code = main(["measure", "--out", str(tmp_path / "out"), "--name", "m", *SHORT, "--json", *extra])
+    out, err = capsys.readouterr()
+    return code, (json.loads(out) if out else None), err
+
+
+def test_a_measurement_is_stored_in_the_archive_with_its_id_printed(simulated_card, tmp_path, capsys):
+    from analysis.archive import Archive
+    root = tmp_path / "qa-archive"
+    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(root), "--serial", "SN-7",
+                                 "--operator", "ana")
+    assert code == 0, err
+    mid = printed["archive"]["id"]
+    assert printed["archive"]["root"] == str(root) and f"stored in the archive {root} as {mid}" in err
+    (entry,) = Archive(root).list()
+    assert (entry.id, entry.serial, entry.operator, entry.driver) == (mid, "SN-7", "ana", "paper (simulated)")
+    m = Archive(root).get(mid)
+    assert m.path("recording").read_bytes() == (tmp_path / "out" / "m.wav").read_bytes()
+    assert m.result().parameters["fs"].value == pytest.approx(printed["parameters"]["fs"]["value"])
+
+
+def test_the_default_archive_and_no_archive(simulated_card, tmp_path, capsys, archive_root):
+    from analysis.archive import Archive
+    code, printed, err = measure(capsys, tmp_path, "--no-archive")
+    assert code == 0, err
+    assert "archive" not in printed and "stored in the archive" not in err and not archive_root.exists()
+    code, printed, err = measure(capsys, tmp_path, "--name", "m2")      # $LINPAR_ARCHIVE, as default_root()
+    assert code == 0, err
+    assert [e.id for e in Archive(archive_root).list()] == [printed["archive"]["id"]]
+
+
+def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, tmp_path, capsys):
+    not_a_folder = tmp_path / "archive-is-a-file"
+    not_a_folder.write_text("")
+    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(not_a_folder), "--serial", "SN-8")
+    assert code == 3, err
+    assert printed["parameters"]["Bl"]["value"] > 0 and set(printed["archive"]) == {"error", "root"}
+    assert "warning: not stored in the archive" in err and printed["archive"]["error"] in err
+    assert (tmp_path / "out" / "m.wav").is_file() and (tmp_path / "out" / "m.json").is_file()
+    # What the warning says to do stores it.
+    hint = err.split("store it later with: ")[1].split()
+    root = tmp_path / "later"
+    assert hint[:3] == ["linpar", "archive", "store"] and hint[-2] == "--root"
+    assert "--model" in hint and main([*hint[1:-1], str(root)]) == 0
+    assert capsys.readouterr().out.startswith("stored ")
+    from analysis.archive import Archive
+    (entry,) = Archive(root).list()
+    assert entry.serial == "SN-8" and entry.effects == tuple(printed["model"]["effects"])

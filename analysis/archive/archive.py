@@ -19,7 +19,9 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import sqlite3
 import tempfile
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
@@ -27,6 +29,7 @@ from typing import Any, Mapping
 
 from analysis.archive.atomic import DIR_MODE, FILE_MODE, fsync_dir, write_atomic
 from analysis.archive.index import Filter, Index, RebuildReport, insert
+from analysis.archive.leftovers import INCOMING_PREFIX
 from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, clean_text, folder_name, inside,
                                     new_measurement_id, safe_suffix)
 from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
@@ -156,8 +159,20 @@ class Archive:
         return self._index.notes
 
     def _connect(self):
-        self.folders.mkdir(parents=True, exist_ok=True)
+        try:
+            self.folders.mkdir(parents=True, exist_ok=True)
+        except OSError:
+            pass       # a read-only archive: the index says so, or lists what there is
         return self._index.connect()
+
+    @contextmanager
+    def _index_errors(self, doing: str):
+        """An SQLite error of the index as an ArchiveError that says what to do (no traceback for users)."""
+        try:
+            yield
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{self._index.path}: {doing}: {exc} (the index is a cache of the folders: "
+                               f"'linpar archive rebuild' makes it anew)") from None
 
     # --- storing --------------------------------------------------------------------
 
@@ -212,8 +227,9 @@ class Archive:
                                    "unit": params[k].get("unit", "")} for k in KEY_PARAMETERS if k in params},
             "files": files,
         }
-        conn = self._connect()
-        tmp = Path(tempfile.mkdtemp(dir=self.folders, prefix=".incoming-"))
+        with self._index_errors("opening the index"):
+            conn = self._connect()
+        tmp = Path(tempfile.mkdtemp(dir=self.folders, prefix=INCOMING_PREFIX))
         try:
             if isinstance(recording, Recording):
                 write_recording(tmp / "recording", recording)
@@ -236,6 +252,10 @@ class Archive:
         try:
             with conn:   # a crash before this line is repaired by the next open (folders vs index)
                 insert(conn, record)
+        except sqlite3.Error as exc:
+            # The folder is in place, so the measurement is stored: the next open adds it to the index.
+            self._index.notes.append(f"stored {mid}, but the index {self._index.path} could not be updated "
+                                     f"({exc}): the next opening of the archive adds it")
         finally:
             conn.close()
         return mid
@@ -247,22 +267,24 @@ class Archive:
         flt = flt or Filter(**kwargs)
         if not self.root.is_dir():
             return []        # reading never creates an archive
-        conn = self._connect()
-        try:
-            return self._index.query(conn, flt)
-        finally:
-            conn.close()
+        with self._index_errors("listing"):
+            conn = self._connect()
+            try:
+                return self._index.query(conn, flt)
+            finally:
+                conn.close()
 
     def resolve(self, id_or_prefix: str) -> tuple[MeasurementId, str]:
         """(id, folder) of the one measurement whose id is, or starts with, the text."""
         check_id_prefix(id_or_prefix)
         if not self.root.is_dir():
             raise ArchiveError(f"no archive at {self.root} (store a measurement first, or give --root)")
-        conn = self._connect()
-        try:
-            found = self._index.matching_ids(conn, id_or_prefix)
-        finally:
-            conn.close()
+        with self._index_errors(f"looking up {id_or_prefix!r}"):
+            conn = self._connect()
+            try:
+                found = self._index.matching_ids(conn, id_or_prefix)
+            finally:
+                conn.close()
         if not found:
             raise ArchiveError(f"no measurement {id_or_prefix!r} in the archive {self.root}")
         if len(found) > 1:
@@ -281,7 +303,12 @@ class Archive:
 
     def rebuild(self) -> RebuildReport:
         self.folders.mkdir(parents=True, exist_ok=True)
-        return self._index.rebuild()
+        self._index.sweep_leftovers()
+        try:
+            return self._index.rebuild()
+        except sqlite3.Error as exc:
+            raise ArchiveError(f"{self._index.path}: cannot rebuild the index: {exc} (it is written beside the "
+                               f"old one: may this user write to {self.root}?)") from None
 
     def export(self, id_or_prefix: str, directory: str | Path) -> Path:
         """Copy a measurement's folder into `directory` (made if missing); return the copy's path."""

@@ -11,6 +11,12 @@ is picked up: the folders are the truth, the index only a cache.
 
 A rebuild writes a new database next to the old one and renames it into
 place: readers see the old index or the new one.
+
+When the index cannot be written (a read-only archive, a database another
+program keeps locked) while it is stale, missing or damaged, the archive is
+still readable: the index is built in memory from the folders for this one
+use, and a note says what is wrong and how to repair it. Opening and
+rebuilding also remove what interrupted programs left (analysis.archive.leftovers).
 """
 from __future__ import annotations
 
@@ -22,6 +28,7 @@ from pathlib import Path
 from typing import Iterable
 
 from analysis.archive.atomic import fsync_dir
+from analysis.archive.leftovers import STALE_AFTER_S, sweep
 from analysis.archive.names import ArchiveError
 from analysis.archive.record import Entry, entry_of, read_record
 from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate
@@ -71,6 +78,42 @@ class Index:
     # --- opening and checking ---------------------------------------------
 
     def connect(self) -> sqlite3.Connection:
+        """The index, checked and brought up to date; in memory when the file cannot be (module doc)."""
+        self.sweep_leftovers()
+        try:
+            return self._connect_file()
+        except (sqlite3.DatabaseError, OSError) as exc:
+            return self._connect_memory(exc)
+
+    def sweep_leftovers(self) -> None:
+        """Remove what interrupted stores and rebuilds left, once surely abandoned (analysis.archive.leftovers)."""
+        removed = sweep(self.folders, self.path.parent, INDEX_FILE)
+        if removed:
+            self.notes.append(f"removed {len(removed)} unfinished store(s) or rebuild(s) left by interrupted "
+                              f"programs more than {STALE_AFTER_S / 3600:g} h ago: {', '.join(removed)}")
+
+    def _connect_memory(self, why: BaseException) -> sqlite3.Connection:
+        """An index of the folders in memory, for an archive whose index file cannot be used or written."""
+        conn = sqlite3.connect(":memory:")
+        try:
+            migrate(conn)
+            skipped = 0
+            with conn:
+                for name in sorted(self._folder_names()):
+                    try:
+                        insert(conn, read_record(self.folders / name))
+                    except (ArchiveError, sqlite3.IntegrityError):
+                        skipped += 1
+        except OSError as exc:
+            conn.close()
+            raise ArchiveError(f"{self.folders}: cannot be read ({exc.strerror or exc}); the index "
+                               f"{self.path} cannot be used either ({why})") from None
+        self.notes.append(f"the index {self.path} cannot be used or updated ({why}): listed from the measurement "
+                          f"folders instead" + (f" ({skipped} unreadable)" if skipped else "") +
+                          f"; to repair it, run 'linpar archive rebuild' as a user who may write to {self.path.parent}")
+        return conn
+
+    def _connect_file(self) -> sqlite3.Connection:
         problem = self._problem()
         if problem:
             report = self.rebuild(problem)
@@ -85,7 +128,11 @@ class Index:
             conn.close()
             self.notes.append(self.rebuild(f"unusable: {exc}").describe())
             conn = self._open()
-        self._sync(conn)
+        try:
+            self._sync(conn)
+        except BaseException:
+            conn.close()
+            raise
         return conn
 
     def _open(self, path: Path | None = None) -> sqlite3.Connection:

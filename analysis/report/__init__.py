@@ -1,6 +1,7 @@
 """Reports of one measurement, as HTML (self-contained) and PDF.
 
-    content = report_content(stored_result, header, settings, calibration)   (or report_for_measurement / report_for_recording)
+    content = build_report(stored_result, header, settings, calibration, limits)
+              (or report_for_measurement / report_for_recording; limits: analysis.limits.Limits or None)
     write_report(content, pdf="r.pdf", html="r.html")
 """
 from __future__ import annotations
@@ -21,20 +22,23 @@ def render_pdf(content: ReportContent) -> bytes:
     return _render(content)
 
 
-def report_for_measurement(measurement) -> ReportContent:
-    """The report of an archived measurement (analysis.archive.Measurement), from what is stored."""
+def report_for_measurement(measurement, limits=None) -> ReportContent:
+    """The report of an archived measurement (analysis.archive.Measurement), from what is stored.
+
+    limits: an analysis.limits.Limits, or None for a report without QA limits.
+    """
     record = measurement.record
     header = {k: record.get(k) for k in ("driver", "serial", "measured_at", "operator", "station", "id")}
     return build_report(measurement.result(), header, measurement.load_json("settings"),
-                        measurement.load_json("calibration"))
+                        measurement.load_json("calibration"), limits)
 
 
-def report_for_recording(path, sd_m2=None, effects=None, header=None) -> ReportContent:
+def report_for_recording(path, sd_m2=None, effects=None, header=None, limits=None) -> ReportContent:
     """Analyse a recording now and report it (the same content an archived copy would give)."""
     from analysis.archive.results import stored_from_recording
     stored, head, calibration = stored_from_recording(path, sd_m2, effects)
     head.update({k: v for k, v in (header or {}).items() if v})
-    return build_report(stored, head, None, calibration)
+    return build_report(stored, head, None, calibration, limits)
 
 
 def write_report(content: ReportContent, pdf: str | Path | None = None, html: str | Path | None = None) -> list[Path]:

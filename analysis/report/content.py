@@ -14,6 +14,7 @@ from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
 from analysis.report.numbers import format_number, parameter_cells, pretty_unit
+from analysis.report.qa import LimitRow, QASection, qa_section
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
 HEADER_FIELDS = (("driver", "Driver"), ("serial", "Serial number"), ("measured_at", "Date"),
@@ -66,6 +67,7 @@ class ReportContent:
     calibration: tuple[tuple[str, str], ...]
     result: StoredResult = field(repr=False)
     notes: tuple[str, ...] = ()          # e.g. why there is no SPL plot
+    qa: QASection | None = None          # the verdict against a limits file, when one was given
 
     @property
     def has_spl(self) -> bool:
@@ -141,8 +143,12 @@ def _settings_rows(settings: Mapping) -> tuple[tuple[str, str], ...]:
 
 
 def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapping | None = None,
-                 calibration: Mapping | None = None) -> ReportContent:
-    """header: driver, serial, measured_at, operator, station, id, source (any may be missing)."""
+                 calibration: Mapping | None = None, limits=None) -> ReportContent:
+    """header: driver, serial, measured_at, operator, station, id, source (any may be missing).
+
+    limits: an analysis.limits.Limits to judge the parameters against (the report then carries the
+    QA verdict); None: the report says nothing about limits.
+    """
     head = tuple((label, str(header.get(key) or "–")) for key, label in HEADER_FIELDS
                  if header.get(key) or key in ("driver", "serial", "measured_at", "operator", "station"))
     params = []
@@ -164,7 +170,9 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
         header=head, overall=result.overall, lights=_lights(result.validity), peak_displacement=peak_text,
         parameters=tuple(params), model=_model_rows(result),
         settings=_settings_rows({**dict(result.settings), **dict(settings or {})}),
-        calibration=tuple(cal) or (("Calibration", "not recorded"),), result=result, notes=tuple(notes))
+        calibration=tuple(cal) or (("Calibration", "not recorded"),), result=result, notes=tuple(notes),
+        qa=None if limits is None else qa_section(limits, result.parameters, result.overall))
 
 
-__all__ = ["Finding", "Light", "ParameterRow", "ReportContent", "build_report", "pretty_unit"]
+__all__ = ["Finding", "Light", "LimitRow", "ParameterRow", "QASection", "ReportContent", "build_report",
+           "pretty_unit"]

@@ -9,6 +9,7 @@ from html import escape
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
 from analysis.report.plots import figures, svg_of
+from analysis.report.qa import VERDICT_COLOURS, QASection
 
 LIGHT_COLOURS = {"green": "#2e9d44", "yellow": "#e0b000", "red": "#d23a2c", "absent": "#b8b8b8",
                  "unknown": "#b8b8b8"}
@@ -27,6 +28,9 @@ th { border-bottom: 1px solid #999; }
          margin-right: 0.35em; border: 1px solid #555; }
 .finding { margin: 0.2em 0 0.5em 1.6em; } .remedy { color: #444; } .note { color: #555; font-style: italic; }
 figure { margin: 1em 0; } figure svg { width: 100%; height: auto; } figcaption { font-weight: bold; }
+.verdict { border: 2px solid; border-radius: 6px; padding: 0.4em 0.8em; margin: 0.6em 0; }
+.verdict .headline { font-size: 1.6em; font-weight: bold; margin-right: 0.6em; }
+table.params td.fail { color: #8e1b1b; font-weight: bold; } table.params td.pass { color: #1b5e20; }
 """
 
 
@@ -40,10 +44,35 @@ def _pairs(rows) -> str:
     return f"<table>{body}</table>"
 
 
+def _verdict_banner(qa: QASection) -> str:
+    background, colour = VERDICT_COLOURS[qa.verdict]
+    return (f"<div class='verdict' id='qa-verdict' style='background:{background};color:{colour};"
+            f"border-color:{colour}'><span class='headline'>QA: {escape(qa.headline)}</span> {escape(qa.why)}"
+            f"<br><small>limits: {escape(qa.name)} ({escape(qa.file)})</small></div>")
+
+
+def _qa_table(qa: QASection) -> str:
+    parts = [f"<h2>QA limits</h2><p>Limits file <b>{escape(qa.file)}</b> ({escape(qa.name)}): "
+             f"<b>{escape(qa.headline)}</b>. Values in the file's units; “tolerance used” is the distance "
+             "from the middle of a two-sided limit as a share of its half-width (over 100 % fails).</p>",
+             "<table class='params'><tr><th>parameter</th><th>result</th><th class='num'>measured</th>"
+             "<th class='num'>tolerance used</th><th>limit</th><th>margin</th></tr>"]
+    for r in qa.rows:
+        css = {"pass": "pass", "FAIL": "fail"}.get(r.outcome, "")
+        parts.append(f"<tr><td>{escape(r.name)}</td><td class='{css}'>{escape(r.outcome)}</td>"
+                     f"<td class='num'>{escape(r.value)}</td><td class='num'>{escape(r.used)}</td>"
+                     f"<td>{escape(r.limit)}</td><td>{escape(r.margin or r.note)}</td></tr>")
+    parts.append("</table>")
+    return "".join(parts)
+
+
 def render_html(content: ReportContent) -> str:
     c = content
     parts = [f"<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>{escape(c.title)}</title>"
-             f"<style>{CSS}</style></head><body>", f"<h1>{escape(c.title)}</h1>", _pairs(c.header)]
+             f"<style>{CSS}</style></head><body>", f"<h1>{escape(c.title)}</h1>"]
+    if c.qa is not None:
+        parts.append(_verdict_banner(c.qa))
+    parts.append(_pairs(c.header))
 
     parts.append(f"<h2>Validity</h2><p>{_light(c.overall)}<b>Overall: {escape(c.overall)}</b> "
                  f"&nbsp; peak excursion {escape(c.peak_displacement)}</p><ul style='list-style:none;padding:0'>")
@@ -55,6 +84,8 @@ def render_html(content: ReportContent) -> str:
                          f"<br><span class='remedy'>Remedy: {escape(f.remedy)}</span></div>")
         parts.append("</li>")
     parts.append("</ul>")
+    if c.qa is not None:
+        parts.append(_qa_table(c.qa))
 
     parts.append("<h2>Parameters</h2><table class='params'><tr><th>parameter</th><th class='num'>value</th>"
                  "<th class='num'>± 1σ</th><th>unit</th><th class='num'>rel.</th><th>note</th></tr>")

@@ -1,8 +1,16 @@
-"""The report as a PDF (A4 portrait), drawn with matplotlib: text pages, then pages of plots.
+"""The report as a PDF (A4 portrait), drawn with matplotlib, in the order of the HTML page.
 
-Text is laid out top-down in inches; a line that would run past the bottom
-margin starts a new page, and long messages are wrapped, so nothing is
-clipped however many findings or parameters there are.
+Everything flows top-down in inches: text lines, the QA verdict banner and
+the plots. A line that would run past the bottom margin starts a new page,
+long messages are wrapped, and a plot that does not fit what is left of a
+page starts the next one (it may shrink to PLOT_SHRINK of its height to stay),
+so nothing is clipped. A dry run of the layout counts the pages first: when
+slightly smaller plots (PLOT_SCALES) save a page, they are used, so that no
+last page holds only the few lines that ran over.
+
+The plots of one page are laid out together by matplotlib's constrained
+layout inside the band of the page they occupy; the text around them is
+placed by hand and lies outside that band.
 """
 from __future__ import annotations
 
@@ -12,44 +20,72 @@ import textwrap
 import matplotlib
 from matplotlib.backends.backend_pdf import PdfPages
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle
+from matplotlib.font_manager import FontProperties
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.textpath import TextPath
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
 from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
+from analysis.report.qa import VERDICT_COLOURS, QASection
 
 A4 = (8.27, 11.69)
 MARGIN = 0.7             # inches
-BODY_PT, HEAD_PT, TITLE_PT = 8.5, 11.5, 15
+BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT = 8.5, 11.5, 15, 16
 GAP = 1.3            # line height / font size
-# Characters per line of body text across the page: DejaVu Sans averages ~0.55 em.
-WRAP = int((A4[0] - 2 * MARGIN) * 72 / (BODY_PT * 0.56))
+EM = 0.56            # DejaVu Sans averages ~0.55 em per character
+# Characters per line of body text across the page.
+WRAP = int((A4[0] - 2 * MARGIN) * 72 / (BODY_PT * EM))
+LINE = BODY_PT * GAP / 72
+KEEP_TOGETHER = 2.5      # inches: a shorter section is not split across pages
+PLOT_LEFT = 0.6 * MARGIN        # axis labels sit in the left margin's outer part: plots use the width
+PLOT_SHRINK = 0.8
+PLOT_SCALES = (0.95, 0.9, 0.85, 0.8, 0.75, 0.7)    # tried in turn: the first that saves a page is used
+PLOT_HEIGHTS = {"impedance": 4.6, "hx": 4.6, "spl": 3.0, "residuals": 2.4}     # inches; residuals per channel
 
 
-class _TextPages:
-    """Places lines of text down A4 pages, opening a new page when one is full."""
+def _chars(width_in: float) -> int:
+    return max(12, int(width_in * 72 / (BODY_PT * EM)))
 
-    def __init__(self, pdf: PdfPages, footer: str):
-        self.pdf, self.footer, self.page_no = pdf, footer, 0
+
+class _Pages:
+    """Places text and plots down A4 pages, opening a new page when one is full."""
+
+    def __init__(self, pdf: PdfPages | None, footer: str, content: ReportContent, plot_scale: float = 1.0,
+                 total: int | None = None):
+        """pdf None: a dry run that only counts pages (nothing is plotted or saved)."""
+        self.pdf, self.footer, self.content, self.page_no = pdf, footer, content, 0
+        self.plot_scale, self.total = plot_scale, total
         self.fig: Figure | None = None
         self.y = 0.0
+        self.plots: list[tuple[str, float, float]] = []      # (what, top, height) on the current page
+
+    @property
+    def bottom(self) -> float:
+        return A4[1] - MARGIN
 
     def _new_page(self) -> None:
         self.close()
         self.fig = Figure(figsize=A4)
         self.page_no += 1
         self.y = MARGIN
-        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], f"{self.footer}   page {self.page_no}", fontsize=7,
+        of = f" of {self.total}" if self.total else ""
+        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], f"{self.footer}   page {self.page_no}{of}", fontsize=7,
                       color="#666666")
 
     def close(self) -> None:
         if self.fig is not None:
-            self.pdf.savefig(self.fig)
+            if self.pdf is not None:
+                self._draw_plots()
+                self.pdf.savefig(self.fig)
+            self.plots = []
             self.fig = None
 
     def _room(self, height: float) -> None:
-        if self.fig is None or self.y + height > A4[1] - MARGIN:
+        if self.fig is None or self.y + height > self.bottom:
             self._new_page()
+
+    # --- text ---------------------------------------------------------------------
 
     def text(self, x: float, s: str, size: float = BODY_PT, **kw) -> None:
         """Draw at the current line, x inches from the left margin (the line does not advance)."""
@@ -62,13 +98,15 @@ class _TextPages:
             self.text(x, s, size, **kw)
         self.y += height
 
-    def heading(self, s: str) -> None:
-        self._room(0.7)       # never leave a heading alone at the bottom of a page
+    def heading(self, s: str, keep: float = 0.7) -> None:
+        self._room(keep)       # never leave a heading alone at the bottom of a page
         self.y += 0.12
         self.line(s, HEAD_PT, weight="bold")
         self.y += 0.04
 
     def light(self, x: float, status: str) -> None:
+        """A validity light at the start of the line about to be written."""
+        self._room(LINE)
         r = BODY_PT / 72 * 0.42
         centre = ((MARGIN + x + r), A4[1] - self.y - r * 1.15)
         self.fig.add_artist(Circle(centre, r, transform=self.fig.dpi_scale_trans,
@@ -76,86 +114,72 @@ class _TextPages:
                                    linewidth=0.5))
 
     def wrapped(self, s: str, x: float = 0.0, **kw) -> None:
-        width = max(20, WRAP - int(x * 72 / (BODY_PT * 0.56)))
-        for part in textwrap.wrap(s, width) or [""]:
+        for part in textwrap.wrap(s, _chars(A4[0] - 2 * MARGIN - x)) or [""]:
             self.line(part, x=x, **kw)
+
+    def section(self, title: str, rows, key_width: float = 2.0) -> None:
+        """A heading and its key-value rows, kept on one page when they are short (up to KEEP_TOGETHER)."""
+        height = LINE * sum(len(self._wrap_value(value, key_width)) for _, value in rows)
+        self.heading(title, keep=0.55 + height if height <= KEEP_TOGETHER else 0.7)
+        self.pairs(rows, key_width)
+
+    @staticmethod
+    def _wrap_value(value: str, key_width: float) -> list[str]:
+        return textwrap.wrap(value, _chars(A4[0] - 2 * MARGIN - key_width)) or [""]
 
     def pairs(self, rows, key_width: float = 2.0) -> None:
         for key, value in rows:
-            lines = textwrap.wrap(value, max(20, WRAP - int(key_width * 72 / (BODY_PT * 0.56)))) or [""]
-            self._room(BODY_PT * GAP / 72 * len(lines))
+            lines = self._wrap_value(value, key_width)
+            self._room(LINE * len(lines))
             self.text(0, key, weight="bold")
             for part in lines:
                 self.line(part, x=key_width)
 
+    def banner(self, qa: QASection) -> None:
+        """The QA verdict in a coloured box across the page: the first thing a QA reader looks for."""
+        background, colour = VERDICT_COLOURS[qa.verdict]
+        headline = f"QA: {qa.headline}"
+        width_pt = TextPath((0, 0), headline, size=VERDICT_PT, prop=FontProperties(weight="bold")).get_extents().width
+        left = 0.12 + width_pt / 72 + 0.3
+        width = _chars(A4[0] - 2 * MARGIN - left - 0.1)
+        lines = textwrap.wrap(qa.why, width) + textwrap.wrap(f"limits: {qa.name} ({qa.file})", width)
+        height = max(0.5, LINE * len(lines) + 0.2)
+        self._room(height + 0.15)
+        self.y += 0.05
+        self.fig.add_artist(Rectangle((MARGIN, A4[1] - self.y - height), A4[0] - 2 * MARGIN, height,
+                                      transform=self.fig.dpi_scale_trans, facecolor=background, edgecolor=colour,
+                                      linewidth=1.5))
+        top = self.y
+        self.y = top + (height - VERDICT_PT / 72 * 1.2) / 2
+        self.text(0.12, headline, VERDICT_PT, weight="bold", color=colour)
+        self.y = top + (height - LINE * len(lines)) / 2
+        for part in lines:
+            self.text(left, part, color=colour)
+            self.y += LINE
+        self.y = top + height + 0.1
 
-def _text_pages(pages: _TextPages, c: ReportContent) -> None:
-    for part in textwrap.wrap(c.title, int((A4[0] - 2 * MARGIN) * 72 / (TITLE_PT * 0.62))):
-        pages.line(part, TITLE_PT, gap=1.6, weight="bold")
-    pages.pairs(c.header, 1.5)
+    # --- plots ----------------------------------------------------------------------
 
-    pages.heading("Validity")
-    pages.line("")
-    pages.y -= BODY_PT * GAP / 72
-    pages.light(0, c.overall)
-    pages.line(f"Overall: {c.overall}        peak excursion {c.peak_displacement}", x=0.25, weight="bold")
-    for light in c.lights:
-        pages.line("")
-        pages.y -= BODY_PT * GAP / 72
-        pages.light(0.1, light.status)
-        pages.line(f"{CHANNEL_TITLES.get(light.channel, light.channel)}: {light.status}", x=0.35)
-        for f in light.findings:
-            pages.line("")
-            pages.y -= BODY_PT * GAP / 72
-            pages.light(0.45, f.severity)
-            pages.wrapped(f"{f.code}: {f.message}", x=0.7)
-            pages.wrapped(f"Remedy: {f.remedy}", x=0.7, color="#333333", style="italic")
+    def plot(self, what: str, height: float) -> None:
+        """Reserve a band for a plot; it is drawn when the page closes."""
+        height *= self.plot_scale
+        if self.fig is None or self.bottom - self.y < PLOT_SHRINK * height:
+            self._new_page()
+        band = min(height, self.bottom - self.y)
+        self.plots.append((what, self.y, band))
+        self.y += band
 
-    pages.heading("Parameters")
-    cols = (0.0, 1.6, 2.6, 3.3, 4.0)   # name | value (right-aligned at) | ±1σ | unit | rel | note
-    pages.text(cols[0], "parameter", weight="bold")
-    pages.text(cols[1] + 0.6, "value", weight="bold", ha="right")
-    pages.text(cols[2] + 0.5, "± 1σ", weight="bold", ha="right")
-    pages.text(cols[3], "unit", weight="bold")
-    pages.text(cols[4], "rel.", weight="bold")
-    pages.line("")
-    for p in c.parameters:
-        note_lines = textwrap.wrap(p.note, max(20, WRAP - int((cols[4] + 0.6) * 72 / (BODY_PT * 0.56))))
-        pages._room(BODY_PT * GAP / 72 * max(1, len(note_lines)))
-        pages.text(cols[0], p.name)
-        pages.text(cols[1] + 0.6, p.value, ha="right", family="DejaVu Sans Mono")
-        pages.text(cols[2] + 0.5, p.std, ha="right", family="DejaVu Sans Mono")
-        pages.text(cols[3], p.unit)
-        pages.text(cols[4], p.relative)
-        if note_lines:
-            for part in note_lines:
-                pages.line(part, x=cols[4] + 0.6, color="#555555")
-        else:
-            pages.line("")
-
-    pages.heading("Model and fit quality")
-    pages.pairs(c.model)
-    for note in c.notes:
-        pages.wrapped(note, style="italic", color="#555555")
-    pages.heading("Measurement settings")
-    pages.pairs(c.settings)
-    pages.heading("Calibration")
-    pages.pairs(c.calibration)
-    pages.close()
-
-
-def _plot_pages(pdf: PdfPages, c: ReportContent, footer: str, first_page: int) -> None:
-    r = c.result
-    page = first_page
-    groups = [["impedance", "hx"] if c.has_displacement else ["impedance"],
-              (["spl"] if c.has_spl else []) + ["residuals"]]
-    for group in groups:
-        fig = Figure(figsize=A4, layout="constrained")
-        fig.get_layout_engine().set(h_pad=0.12, rect=(MARGIN / A4[0] * 0.6, 0.6 / A4[1], 1 - 1.2 * MARGIN / A4[0],
-                                                       1 - 1.1 / A4[1]))
-        heights = {"impedance": 5, "hx": 5, "spl": 3, "residuals": 2.5 * len(r.curves)}
-        sub = fig.subfigures(len(group), 1, height_ratios=[heights[g] for g in group], squeeze=False)[:, 0]
-        for sf, what in zip(sub, group):
+    def _draw_plots(self) -> None:
+        if not self.plots:
+            return
+        r = self.content.result
+        # The plots of a page follow one another (_flow writes no text between them): one band, laid out together.
+        top, bottom = self.plots[0][1], self.plots[-1][1] + self.plots[-1][2]
+        self.fig.set_layout_engine("constrained", h_pad=0.12, rect=(
+            PLOT_LEFT / A4[0], 1 - bottom / A4[1], 1 - (PLOT_LEFT + MARGIN * 0.6) / A4[0], (bottom - top) / A4[1]))
+        sub = self.fig.subfigures(len(self.plots), 1, height_ratios=[h for _, _, h in self.plots],
+                                  squeeze=False)[:, 0]
+        for sf, (what, _, _) in zip(sub, self.plots):
             if what == "impedance":
                 draw_impedance(r, *sf.subplots(2, 1, sharex=True, height_ratios=[3, 2]))
             elif what == "hx":
@@ -164,18 +188,125 @@ def _plot_pages(pdf: PdfPages, c: ReportContent, footer: str, first_page: int) -
                 draw_spl(r, sf.subplots())
             else:
                 draw_residuals(r, sf.subplots(len(r.curves), 1, squeeze=False)[:, 0])
-        fig.text(MARGIN / A4[0], 0.4 / A4[1], f"{footer}   page {page}", fontsize=7, color="#666666")
-        pdf.savefig(fig)
-        page += 1
+
+
+def _validity(pages: _Pages, c: ReportContent) -> None:
+    pages.heading("Validity")
+    pages.light(0, c.overall)
+    pages.line(f"Overall: {c.overall}        peak excursion {c.peak_displacement}", x=0.25, weight="bold")
+    for light in c.lights:
+        pages.light(0.1, light.status)
+        pages.line(f"{CHANNEL_TITLES.get(light.channel, light.channel)}: {light.status}", x=0.35)
+        for f in light.findings:
+            pages.light(0.45, f.severity)
+            pages.wrapped(f"{f.code}: {f.message}", x=0.7)
+            pages.wrapped(f"Remedy: {f.remedy}", x=0.7, color="#333333", style="italic")
+
+
+def _qa_table(pages: _Pages, qa: QASection) -> None:
+    pages.heading("QA limits")
+    pages.wrapped(f"Limits file {qa.file} ({qa.name}): {qa.headline}. Values in the file's units; "
+                  "tolerance used: distance from the middle of a two-sided limit as a share of its half-width.")
+    cols = (0.0, 0.95, 2.75, 3.4, 3.55, 5.05)   # name | result | measured (right) | used (right) | limit | margin
+    widths = {4: _chars(cols[5] - cols[4] - 0.1), 5: _chars(A4[0] - 2 * MARGIN - cols[5])}
+    pages.line("", gap=0.5)
+    pages._room(LINE * 2)
+    for x, title, kw in ((cols[0], "parameter", {}), (cols[1], "result", {}), (cols[2], "measured", {"ha": "right"}),
+                         (cols[3], "tol. used", {"ha": "right"}), (cols[4], "limit", {}), (cols[5], "margin", {})):
+        pages.text(x, title, weight="bold", **kw)
+    pages.line("")
+    colours = {"pass": "#1b5e20", "FAIL": "#8e1b1b"}
+    for row in qa.rows:
+        limit = textwrap.wrap(row.limit, widths[4]) or [""]
+        margin = textwrap.wrap(row.margin or row.note, widths[5]) or [""]
+        pages._room(LINE * max(len(limit), len(margin)))
+        pages.text(cols[0], row.name)
+        pages.text(cols[1], row.outcome, weight="bold" if row.outcome == "FAIL" else "normal",
+                   color=colours.get(row.outcome, "#555555"))
+        pages.text(cols[2], row.value, ha="right", family="DejaVu Sans Mono")
+        pages.text(cols[3], row.used, ha="right")
+        for i in range(max(len(limit), len(margin))):
+            if i < len(limit):
+                pages.text(cols[4], limit[i])
+            grey = {"color": "#555555"} if row.note and not row.margin else {}
+            pages.line(margin[i] if i < len(margin) else "", x=cols[5], **grey)
+
+
+def _parameters(pages: _Pages, c: ReportContent) -> None:
+    pages.heading("Parameters")
+    cols = (0.0, 1.6, 2.6, 3.3, 4.0)   # name | value (right-aligned at) | ±1σ | unit | rel | note
+    pages._room(LINE * 2)
+    pages.text(cols[0], "parameter", weight="bold")
+    pages.text(cols[1] + 0.6, "value", weight="bold", ha="right")
+    pages.text(cols[2] + 0.5, "± 1σ", weight="bold", ha="right")
+    pages.text(cols[3], "unit", weight="bold")
+    pages.text(cols[4], "rel.", weight="bold")
+    pages.line("")
+    previous = ""
+    for p in c.parameters:
+        # A missing value has no relative uncertainty: its note starts in that column. The same reason for
+        # the next parameter (all the mechanical ones without a laser) is not repeated in full.
+        x_note = cols[4] + (0.6 if p.relative else 0.0)
+        note = "as above" if p.note and p.note == previous else p.note
+        previous = p.note
+        note_lines = textwrap.wrap(note, _chars(A4[0] - 2 * MARGIN - x_note))
+        pages._room(LINE * max(1, len(note_lines)))
+        pages.text(cols[0], p.name)
+        pages.text(cols[1] + 0.6, p.value, ha="right", family="DejaVu Sans Mono")
+        pages.text(cols[2] + 0.5, p.std, ha="right", family="DejaVu Sans Mono")
+        pages.text(cols[3], p.unit)
+        pages.text(cols[4], p.relative)
+        for part in note_lines or [""]:
+            pages.line(part, x=x_note, color="#555555")
+
+
+def _flow(pages: _Pages, c: ReportContent) -> None:
+    for part in textwrap.wrap(c.title, int((A4[0] - 2 * MARGIN) * 72 / (TITLE_PT * 0.62))):
+        pages.line(part, TITLE_PT, gap=1.6, weight="bold")
+    if c.qa is not None:
+        pages.banner(c.qa)
+    pages.pairs(c.header, 1.5)
+    _validity(pages, c)
+    if c.qa is not None:
+        _qa_table(pages, c.qa)
+    _parameters(pages, c)
+    pages.section("Model and fit quality", c.model)
+    for note in c.notes:
+        pages.wrapped(note, style="italic", color="#555555")
+
+    plots = ["impedance"] + (["hx"] if c.has_displacement else []) + (["spl"] if c.has_spl else [])
+    heights = {**PLOT_HEIGHTS, "residuals": PLOT_HEIGHTS["residuals"] * len(c.result.curves)}
+    for i, what in enumerate(plots + ["residuals"]):
+        if i == 0:      # the heading goes with the first plot, never alone at the foot of a page
+            pages.heading("Plots", keep=0.5 + PLOT_SHRINK * heights[what] * pages.plot_scale)
+        pages.plot(what, heights[what])
+
+    pages.section("Measurement settings", c.settings)
+    pages.section("Calibration", c.calibration)
+    pages.close()
+
+
+def _layout(content: ReportContent) -> tuple[float, int]:
+    """(scale of the plots, pages): 1, or the largest smaller scale that saves a page (text that ran a few
+    lines over onto a page of its own)."""
+    def pages_at(scale: float) -> int:
+        pages = _Pages(None, content.title, content, scale)
+        _flow(pages, content)
+        return pages.page_no
+
+    full = pages_at(1.0)
+    for scale in PLOT_SCALES:
+        fewer = pages_at(scale)
+        if fewer < full:
+            return scale, fewer
+    return 1.0, full
 
 
 def render_pdf(content: ReportContent) -> bytes:
-    footer = content.title
     buf = io.BytesIO()
     with matplotlib.rc_context(STYLE):
+        scale, total = _layout(content)
         # No creation date: the same measurement gives the same file.
         with PdfPages(buf, metadata={"Title": content.title, "Creator": "linpar", "CreationDate": None}) as pdf:
-            pages = _TextPages(pdf, footer)
-            _text_pages(pages, content)
-            _plot_pages(pdf, content, footer, pages.page_no + 1)
+            _flow(_Pages(pdf, content.title, content, scale, total), content)
     return buf.getvalue()

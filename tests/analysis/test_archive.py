@@ -1,12 +1,14 @@
 """The archive: folders + SQLite index; the index survives deletion, garbage, truncation and wrong schemas."""
 import json
+import os
 import sqlite3
+import time
 
 import pytest
 
 from analysis.archive import Archive, ArchiveError, compare
 from analysis.archive.archive import FOLDERS
-from analysis.archive.index import INDEX_FILE
+from analysis.archive.index import INDEX_FILE, Index
 from analysis.archive.names import folder_name, inside, safe_suffix, slug
 from analysis.archive.results import StoredResult, results_document
 from analysis.archive.schema import CURRENT_VERSION, MIGRATIONS
@@ -279,6 +281,88 @@ def test_meta_is_checked(tmp_path, measured):
     with pytest.raises(ArchiveError, match="ISO 8601"):
         archive.store(measured[0], measured[1], {"measured_at": "yesterday"})
     assert not any((tmp_path / FOLDERS).iterdir())     # nothing half-stored
+
+
+def _age(path, seconds):
+    """Set the modification time of a path and of what is in it `seconds` into the past."""
+    when = time.time() - seconds
+    for p in [*(path.iterdir() if path.is_dir() else ()), path]:
+        os.utime(p, (when, when), follow_symlinks=False)
+
+
+def test_leftovers_of_interrupted_programs_are_removed_once_an_hour_old(tmp_path, measured):
+    archive, (mid,) = fill(tmp_path, measured, 1)
+    folders, hour = tmp_path / FOLDERS, 3600
+    made = {}
+    for name in ("old", "fresh", "busy"):
+        made[name] = folders / f".incoming-{name}"
+        made[name].mkdir()
+        (made[name] / "recording.wav").write_bytes(b"RIFF")
+    _age(made["old"], 2 * hour)
+    _age(made["busy"], 2 * hour)
+    os.utime(made["busy"] / "recording.wav")                   # a copy still writing into an old folder
+    rebuild_tmp = tmp_path / f".{INDEX_FILE}.4242.1.tmp"
+    rebuild_tmp.write_bytes(b"half an index")
+    _age(rebuild_tmp, 2 * hour)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "keep").write_text("not the archive's")
+    (folders / ".incoming-link").symlink_to(elsewhere)         # not ours to follow
+    _age(folders / ".incoming-link", 2 * hour)
+
+    opened = Archive(tmp_path)
+    assert [e.id for e in opened.list()] == [mid]
+    assert not made["old"].exists() and not rebuild_tmp.exists()
+    assert made["fresh"].exists() and made["busy"].exists() and (elsewhere / "keep").exists()
+    assert any("removed 2 unfinished" in n for n in opened.notes), opened.notes
+    _age(made["fresh"], 2 * hour)
+    Archive(tmp_path).rebuild()                                # a rebuild sweeps too
+    assert not made["fresh"].exists() and made["busy"].exists()
+
+
+@pytest.mark.parametrize("state", ["stale", "missing", "damaged"])
+def test_a_read_only_archive_with_an_unusable_index_lists_from_the_folders(tmp_path, measured, state,
+                                                                           monkeypatch):
+    archive, ids = fill(tmp_path, measured, 3)
+    index = tmp_path / INDEX_FILE
+    if state == "stale":        # a store whose program died before it reached the index
+        with sqlite3.connect(index) as conn:
+            conn.execute("DELETE FROM measurements WHERE id = ?", (ids[1],))
+    elif state == "missing":
+        index.unlink()
+    else:
+        index.write_bytes(b"garbage" * 100)
+    before = index.read_bytes() if index.exists() else None
+    # As in a folder this user may not write (tests run as root: chmod cannot show it): SQLite opens every
+    # index file read-only, so updating the index or writing a new one fails as it would there.
+    monkeypatch.setattr(Index, "_open", lambda self, path=None: sqlite3.connect(
+        f"file:{path or self.path}?mode=ro", uri=True, timeout=0.1))
+    ro = Archive(tmp_path)
+    assert {e.id for e in ro.list()} == set(ids)
+    assert ro.get(ids[1]).id == ids[1]
+    assert any("listed from the measurement folders" in n and "linpar archive rebuild" in n for n in ro.notes)
+    assert (index.read_bytes() if index.exists() else None) == before      # nothing was written
+    with pytest.raises(ArchiveError, match="cannot rebuild the index"):
+        ro.rebuild()
+
+
+def test_other_sqlite_errors_become_archive_errors_and_a_failed_index_update_loses_nothing(tmp_path, measured,
+                                                                                           monkeypatch):
+    archive, (mid,) = fill(tmp_path, measured, 1)
+    def malformed(*args, **kwargs):
+        raise sqlite3.DatabaseError("database disk image is malformed")
+    monkeypatch.setattr(Index, "query", malformed)
+    with pytest.raises(ArchiveError, match=r"index.sqlite: listing: database disk image is malformed.*rebuild"):
+        Archive(tmp_path).list()
+    monkeypatch.undo()
+    import analysis.archive.archive as archive_module
+    def locked(conn, record):
+        raise sqlite3.OperationalError("database is locked")
+    monkeypatch.setattr(archive_module, "insert", locked)
+    second = archive.store(measured[0], measured[1], {"serial": "late"})
+    assert any("could not be updated (database is locked)" in n for n in archive.notes)
+    monkeypatch.undo()
+    assert {e.id for e in Archive(tmp_path).list()} == {mid, second}     # the next opening indexes it
 
 
 def test_layers_archive_loads_no_numpy_and_report_export_load_no_qt():

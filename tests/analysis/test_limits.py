@@ -96,3 +96,15 @@ def test_unreadable_file(tmp_path):
     path.write_bytes(b'{"name": "\xe9"}')
     with pytest.raises(LimitsError, match="not UTF-8"):
         load_limits(path)
+
+
+def test_margin_is_the_distance_to_the_nearest_bound_signed_inside_positive(tmp_path):
+    limits = load_limits(write(tmp_path, limits_doc(fs={"min": 60, "max": 72, "unit": "Hz"},
+                                                    Mms={"max": 11, "unit": "g"},
+                                                    LE={"min": 0.1, "unit": "mH"},
+                                                    Bl={"min": 5, "unit": "T*m"})))
+    fs, mms, le, bl = limits.judge(PARAMS)
+    assert fs.margin() == pytest.approx((1.5, "max")) and fs.tolerance_used() == pytest.approx(4.5 / 6)
+    assert mms.margin()[1] == "max" and mms.margin()[0] == pytest.approx(-0.87e-3)       # 11.87 g > 11 g: outside
+    assert le.margin() == pytest.approx((0.032e-3, "min")) and le.tolerance_used() is None
+    assert bl.margin() is None and bl.tolerance_used() is None                            # not measured

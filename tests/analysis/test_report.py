@@ -1,4 +1,5 @@
 """Reports: content, a self-contained HTML page, and a PDF whose pages (rendered by pdftoppm) are not clipped."""
+import json
 import re
 import shutil
 import subprocess
@@ -83,9 +84,9 @@ def _pages(pdf, tmp_path):
 
 @needs_pdftoppm
 def test_pdf_pages_have_ink_inside_the_margins_only(stored, faulty, tmp_path):
-    for name, s in (("ok", stored), ("faulty", faulty)):
+    for name, s, limits in (("ok", stored, None), ("faulty", faulty, None), ("limits", stored, FAILING)):
         pdf = tmp_path / f"{name}.pdf"
-        write_report(build_report(s, HEADER), pdf=pdf)
+        write_report(build_report(s, HEADER, limits=limits and limits_file(tmp_path, **limits)), pdf=pdf)
         (tmp_path / name).mkdir()
         pages = _pages(pdf, tmp_path / name)
         assert len(pages) >= 3
@@ -96,7 +97,7 @@ def test_pdf_pages_have_ink_inside_the_margins_only(stored, faulty, tmp_path):
                                      img[:, -edge:].ravel()])
             assert border.min() > 240, f"{name}: ink in the page border (clipped?)"
             assert (img < 128).mean() > 2e-4                        # no blank page
-        # The plot pages: axes and data lines (dark pixels spread over most of the page height).
+        # The last two pages hold plots: dark pixels over most of the page height (no page of a few lines).
         for img in pages[-2:]:
             rows_with_ink = (img < 160).any(axis=1).mean()
             assert rows_with_ink > 0.5
@@ -113,3 +114,87 @@ def test_report_of_an_archived_measurement_equals_the_fresh_one(tmp_path):
     assert archived.parameters == fresh.parameters and archived.model == fresh.model
     assert dict(archived.header)["Serial number"] == "S"
     assert dict(archived.header)["Measurement id"] == mid
+
+
+# --- QA limits -------------------------------------------------------------------------------------------
+
+def limits_file(tmp_path, name="limits.json", **parameters):
+    from analysis.limits import load_limits
+    path = tmp_path / name
+    path.write_text(json.dumps({"format": "linpar-limits/1", "name": "paper QA", "parameters": parameters}))
+    return load_limits(path)
+
+
+PASSING = dict(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"}, fs={"min": 65, "max": 75, "unit": "Hz"},
+               Bl={"min": 5.0, "unit": "T*m"})
+FAILING = dict(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+               fs={"nominal": 50, "tolerance": "2%", "unit": "Hz"},
+               Mms={"max": 11, "unit": "g"}, Bl={"min": 5.5, "unit": "T*m"})
+
+
+def test_passing_limits_give_pass_with_margins_in_the_files_units(stored, tmp_path):
+    c = build_report(stored, HEADER, limits=limits_file(tmp_path, "ok.json", **PASSING))
+    assert c.qa.verdict == "pass" and c.qa.headline == "PASS" and c.qa.file == "ok.json"
+    rows = {r.name: r for r in c.qa.rows}
+    assert [r.outcome for r in c.qa.rows] == ["pass"] * 3
+    # fs = 70.56 Hz against 65..75 Hz: 4.44 Hz inside the max, 11 % of the half-width used.
+    assert rows["fs"].margin == "inside by 4.44 Hz" and rows["fs"].used == "11 %"
+    assert rows["fs"].value.startswith("70.55") and rows["fs"].value.endswith(" Hz")
+    assert rows["Bl"].used == ""                                     # one-sided: no share of a tolerance
+
+
+def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
+    c = build_report(stored, HEADER, limits=limits_file(tmp_path, **FAILING))
+    assert c.qa.verdict == "fail" and "3 of 4" in c.qa.why and "fs, Mms, Bl" in c.qa.why
+    rows = {r.name: r for r in c.qa.rows}
+    assert rows["RE"].outcome == "pass" and rows["fs"].outcome == "FAIL" and rows["Mms"].outcome == "FAIL"
+    assert rows["fs"].margin == "19.6 Hz above max"    # 70.56 Hz against 50 Hz ± 1 Hz
+    assert rows["fs"].used == "2056 %"
+    assert rows["Mms"].margin == "0.844 g above max"   # 11.84 g against <= 11 g
+    assert rows["Bl"].margin == "0.27 T*m below min"   # 5.23 T*m against >= 5.5 T*m
+
+
+def test_a_red_measurement_is_not_judged_and_a_missing_parameter_fails(stored, faulty, tmp_path):
+    c = build_report(faulty, HEADER, limits=limits_file(tmp_path, **PASSING))
+    assert c.qa.verdict == "not judged" and {r.outcome for r in c.qa.rows} == {"not judged"}
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=10, displacement=False)
+    no_laser = StoredResult.from_json(results_document(analyze_recording(rec), rec))
+    c = build_report(no_laser, HEADER, limits=limits_file(tmp_path, **PASSING))
+    bl = {r.name: r for r in c.qa.rows}["Bl"]
+    assert c.qa.verdict == "fail" and bl.outcome == "FAIL" and bl.value == "n/a" and "not measured" in bl.note
+
+
+def test_html_carries_the_verdict_banner_and_table_only_with_limits(stored, tmp_path):
+    ok = render_html(build_report(stored, HEADER, limits=limits_file(tmp_path, "ok.json", **PASSING)))
+    bad = render_html(build_report(stored, HEADER, limits=limits_file(tmp_path, "bad.json", **FAILING)))
+    none = render_html(build_report(stored, HEADER))
+    assert "id='qa-verdict'" in ok and "QA: PASS" in ok and "QA: FAIL" not in ok and "ok.json" in ok
+    assert "QA: FAIL" in bad and "QA: PASS" not in bad and "19.6 Hz above max" in bad
+    assert bad.index("QA: FAIL") < bad.index("<h2>Validity")              # in the header area
+    assert "<h2>QA limits</h2>" in bad and bad.count("class='fail'>FAIL<") == 3
+    assert "QA:" not in none and "QA limits" not in none and "qa-verdict" not in none
+
+
+needs_pdftotext = pytest.mark.skipif(shutil.which("pdftotext") is None,
+                                     reason="pdftotext is missing: install poppler-utils (tools/system-packages.sh)")
+
+
+def _pdf_text(pdf) -> str:
+    return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], check=True, capture_output=True,
+                          text=True).stdout
+
+
+@needs_pdftotext
+def test_pdf_carries_the_verdict_on_its_first_page(stored, tmp_path):
+    for name, limits, verdict, other in (("ok", PASSING, "QA: PASS", "QA: FAIL"),
+                                         ("bad", FAILING, "QA: FAIL", "QA: PASS")):
+        pdf = tmp_path / f"{name}.pdf"
+        write_report(build_report(stored, HEADER, limits=limits_file(tmp_path, f"{name}.json", **limits)), pdf=pdf)
+        first_page = _pdf_text(pdf).split("\f")[0]
+        assert verdict in first_page and other not in first_page and f"{name}.json" in first_page
+        assert "QA limits" in first_page
+    assert re.search(r"fs\s+FAIL\s+70\.5\d+ Hz", first_page) and "19.6 Hz above max" in first_page
+    plain = tmp_path / "none.pdf"
+    write_report(build_report(stored, HEADER), pdf=plain)
+    text = _pdf_text(plain)
+    assert "QA:" not in text and "QA limits" not in text

@@ -1,6 +1,7 @@
 """The QA page: the lights with their findings, pass/fail against limits, the report export."""
 from __future__ import annotations
 
+import copy
 import json
 
 import pytest
@@ -59,8 +60,9 @@ def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limi
     assert rows == {"RE": "pass", "fs": "pass", "Bl": "FAIL"}          # the paper's Bl is 5.23 T*m
     assert qa.verdict == "fail"
     assert window.settings.qsettings.value("qa/limits_file") == str(limits_file)
-    LIMITS["parameters"]["Bl"] = {"min": 5.0, "unit": "T*m"}
-    limits_file.write_text(json.dumps(LIMITS), encoding="utf-8")
+    looser = copy.deepcopy(LIMITS)          # the module's LIMITS stay as other tests expect them
+    looser["parameters"]["Bl"] = {"min": 5.0, "unit": "T*m"}
+    limits_file.write_text(json.dumps(looser), encoding="utf-8")
     assert qa.load_limits(limits_file)
     assert qa.verdict == "pass"
 
@@ -112,3 +114,16 @@ def test_a_cancelled_export_writes_nothing(qtbot, window, recordings, tmp_path):
     assert "cancelled" in qa.export_label.text()
     qa.worker.pool.waitForDone(60_000)
     assert not target.exists()
+
+
+def test_the_report_carries_the_loaded_limits_verdict(qtbot, window, recordings, limits_file, tmp_path):
+    if not (qa_view.available(qa_view.REPORT_MODULE) and qa_view.available(qa_view.LIMITS_MODULE)):
+        pytest.skip("analysis/report or analysis/limits.py is not in this installation")
+    open_and_wait(qtbot, window, recordings["paper"])
+    qa = window.qa
+    assert qa.load_limits(limits_file) and qa.verdict == "fail"            # Bl 5.23 T*m against >= 5.5
+    target = tmp_path / "paper-qa.html"
+    with qtbot.waitSignal(qa.report_written, timeout=60_000):
+        qa.export_to(target)
+    page = target.read_text(encoding="utf-8")
+    assert "QA: FAIL" in page and "limits.json" in page and "paper QA" in page
