@@ -290,6 +290,13 @@ class LivePanels(QWidget):
         self.frame = None
         self._drawing += 1
         self.timer.stop()
-        for panel in self.panels.values():
-            panel.clear(band_hz=band_hz)
         self.status.setText(f"{text} {LEGEND}")
+        self._clear_channel(self._drawing, list(self.panels.values()), band_hz)
+
+    def _clear_channel(self, drawing: int, panels: list, band_hz: tuple[float, float] | None) -> None:
+        """As _draw_channel: a channel per turn of the event loop (a measurement starts with this)."""
+        if drawing != self._drawing:
+            return
+        panels[0].clear(band_hz=band_hz)
+        if len(panels) > 1:
+            QTimer.singleShot(0, self, lambda: self._clear_channel(drawing, panels[1:], band_hz))

@@ -239,8 +239,8 @@ class MainWindow(QMainWindow):
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {outcome.path.name}")
         self.status_label.setText(f"Measured {outcome.path}; storing it in the archive…")
-        self._store_measured(outcome)
-        self.result_pages.after(lambda: self.measurement_shown.emit(outcome))
+        # Stored once the lab and QA have it: the store's thread would slow their setting up (the GIL).
+        self.result_pages.after(lambda: (self.measurement_shown.emit(outcome), self._store_measured(outcome)))
 
     def _store_measured(self, outcome) -> None:
         """Into the archive, in its worker. Whatever happens there, the recording stays where it was written."""
