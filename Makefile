@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: run test bench soak setup system screenshots clean
+.PHONY: run test bench soak setup system screenshots example-report clean
 
 setup: system $(STAMP)
 
@@ -33,6 +33,9 @@ soak: setup
 
 screenshots: setup
 	QT_QPA_PLATFORM=offscreen $(BIN)/python tools/screenshots.py
+
+example-report: setup
+	$(BIN)/python tools/example_report.py
 
 clean:
 	rm -rf $(VENV) build *.egg-info .pytest_cache
