@@ -21,7 +21,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter
 
 from analysis.report.numbers import format_number, format_std, pretty_unit
 from app.archive_table import date_text
-from app.plots import LogFrequencyAxis, _style_plot
+from app.plots import LogFrequencyAxis, style_plot
 
 # Eight colours told apart on white paper (Tableau 10 without its grey and olive).
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
@@ -50,8 +50,8 @@ class OverlayPlot(pg.GraphicsLayoutWidget):
         super().__init__(parent=parent)
         self.impedance = self.addPlot(row=0, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
         self.displacement = self.addPlot(row=0, col=1, axisItems={"bottom": LogFrequencyAxis("bottom")})
-        _style_plot(self.impedance, "|Z| (Ω)", bottom="frequency (Hz)")
-        _style_plot(self.displacement, "|Hx| (mm/V)", log_y=True, bottom="frequency (Hz)")
+        style_plot(self.impedance, "|Z| (Ω)", bottom="frequency (Hz)")
+        style_plot(self.displacement, "|Hx| (mm/V)", log_y=True, bottom="frequency (Hz)")
         self.displacement.setXLink(self.impedance)
         self.impedance.setTitle("Impedance |Z| = |U / I|, measured")
         self.displacement.setTitle("Displacement per volt |Hx| = |X / U|, measured")
@@ -108,9 +108,6 @@ class ComparisonTable(QTableWidget):
         self.n_measurements = 0
         self.names: list[str] = []
 
-    def measurement_column(self, number: int) -> int:
-        return number
-
     def set_comparison(self, comparison, dates) -> None:
         comparison = dataclasses.replace(comparison, rows=tuple(sorted(comparison.rows, key=_row_order)))
         n = len(comparison.ids)
@@ -143,7 +140,7 @@ class ComparisonTable(QTableWidget):
                 item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
                 if i and dev is not None:
                     item.setToolTip(f"{dev:+.2f} % from measurement 1")
-                self.setItem(r, self.measurement_column(i), item)
+                self.setItem(r, i, item)
             spread = QTableWidgetItem("" if row.spread is None else f"{row.spread:.3g}")
             spread.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
             if row.mean is not None:
@@ -154,8 +151,7 @@ class ComparisonTable(QTableWidget):
 
     def values(self, number: int) -> dict[str, float | None]:
         """Parameter -> the value shown for measurement `number` (0-based), in the display unit."""
-        col = self.measurement_column(number)
-        return {name: self.item(r, col).data(VALUE_ROLE) for r, name in enumerate(self.names)}
+        return {name: self.item(r, number).data(VALUE_ROLE) for r, name in enumerate(self.names)}
 
 
 class CompareView(QWidget):

@@ -48,7 +48,7 @@ class LogFrequencyAxis(pg.AxisItem):
         return f"{f / 1000:g}k" if f >= 999.5 else f"{f:.3g}"
 
 
-def _style_plot(plot: pg.PlotItem, left: str, log_y: bool = False, bottom: str | None = None) -> None:
+def style_plot(plot: pg.PlotItem, left: str, log_y: bool = False, bottom: str | None = None) -> None:
     plot.setLogMode(x=True, y=log_y)
     plot.showGrid(x=True, y=True, alpha=0.25)
     plot.setLabel("left", left)
@@ -107,9 +107,9 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         self.magnitude = self.addPlot(row=0, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
         self.phase = self.addPlot(row=1, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
         self.residual = self.addPlot(row=2, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
-        _style_plot(self.magnitude, magnitude_label, log_y)
-        _style_plot(self.phase, "phase (deg)")
-        _style_plot(self.residual, "residual (σ)", bottom="frequency (Hz)")
+        style_plot(self.magnitude, magnitude_label, log_y)
+        style_plot(self.phase, "phase (deg)")
+        style_plot(self.residual, "residual (σ)", bottom="frequency (Hz)")
         for plot in (self.phase, self.residual):
             plot.setXLink(self.magnitude)
         layout = self.ci.layout
@@ -183,7 +183,7 @@ class SplPlot(pg.GraphicsLayoutWidget):
     def __init__(self, parent=None):
         super().__init__(parent=parent)
         self.plot = self.addPlot(row=0, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
-        _style_plot(self.plot, "SPL (dB SPL)", bottom="frequency (Hz)")
+        style_plot(self.plot, "SPL (dB SPL)", bottom="frequency (Hz)")
         self.plot.addLegend(offset=(-10, -10))      # bottom right: the SPL curve runs along the top
         self.error = _error_item()
         self.measured = _measured_item("from measured Hx")

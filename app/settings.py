@@ -107,7 +107,11 @@ class Settings:
             data = path.read_bytes()
         except OSError:
             return q                        # Qt cannot read it either: it treats it as empty
-        cleaned, dropped = sanitized_ini(data)
+        try:
+            cleaned, dropped = sanitized_ini(data)
+        except RuntimeError as error:
+            log.error("settings: %s is not used (%s); starting with empty settings", path, error)
+            return self._scratch_settings(path.name, b"")
         if not dropped:
             return q
         self.dropped = dropped
@@ -120,16 +124,20 @@ class Settings:
         try:
             cleaned, _ = sanitized_ini(path.read_bytes())
             replace_bytes(path.resolve(), cleaned)
-        except OSError as error:
+        except (OSError, RuntimeError) as error:
             log.error("settings: cannot rewrite %s (%s); using a cleaned copy, changes will not be saved",
                       path, error)
-            self._scratch = tempfile.TemporaryDirectory(prefix="linpar-settings-")
-            copy = Path(self._scratch.name) / path.name
-            copy.write_bytes(cleaned)
-            safe = QSettings(str(copy), QSettings.IniFormat)
-            safe.setFallbacksEnabled(False)
-            return safe
+            return self._scratch_settings(path.name, cleaned)
         finally:
             lock.unlock()
         q.sync()    # Qt may hold the old bytes from its constructor; the size changed, so it reads them again
         return q
+
+    def _scratch_settings(self, name: str, content: bytes) -> QSettings:
+        """Settings on a private copy holding `content`: read, but never written back to the user's file."""
+        self._scratch = tempfile.TemporaryDirectory(prefix="linpar-settings-")
+        copy = Path(self._scratch.name) / name
+        copy.write_bytes(content)
+        safe = QSettings(str(copy), QSettings.IniFormat)
+        safe.setFallbacksEnabled(False)
+        return safe

@@ -30,7 +30,8 @@ class StagedFanOut(QObject):
 
     @property
     def pending(self) -> bool:
-        return bool(self._left)
+        """A value is on its way: a receiver, or a callback after them, has yet to run."""
+        return bool(self._left or self._then)
 
     def send(self, value, then: Callable[[], None] | None = None) -> None:
         self._value = value
@@ -42,7 +43,7 @@ class StagedFanOut(QObject):
 
     def after(self, callback: Callable[[], None]) -> None:
         """`callback` once every receiver has the value on its way; at once when none is."""
-        if self._left:
+        if self.pending:
             self._then.append(callback)
         else:
             callback()
@@ -54,9 +55,13 @@ class StagedFanOut(QObject):
         if round_ != self._round:
             return                      # a newer send() runs its own round
         if self._left:
-            self._left.pop(0)(self._value)
-            self._schedule(round_)
+            receiver = self._left.pop(0)
+            try:
+                receiver(self._value)
+            finally:
+                # A page that fails must not keep the others (and the archive store after them) waiting:
+                # the exception still reaches Qt's handler and the log, the round goes on.
+                self._schedule(round_)
             return
-        then, self._then = self._then, []
-        for callback in then:
-            callback()
+        while self._then:
+            self._then.pop(0)()

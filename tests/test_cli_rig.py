@@ -64,13 +64,22 @@ def test_start_hands_the_model_to_the_manager(capsys, fake_manager, argv, model)
     assert code == 0, err
     (_args, kwargs), = fake_manager.calls
     assert kwargs["model"] == model
-    assert json.loads(out)["extra"]["model"] == model
 
 
 def test_effects_with_the_nonlinear_model_is_an_error_not_silently_ignored(capsys, fake_manager):
     code, _, err = run(capsys, "rig", "start", "--model", "nonlinear", "--effects", "lr2")
     assert code == 2 and err.count("\n") == 1 and "--effects" in err and "linear model only" in err
     assert fake_manager.calls == []
+
+
+def test_a_running_rig_of_the_other_model_is_an_error_not_silently_reused(monkeypatch, tmp_path):
+    from instruments.rig import manager
+    state = type("State", (), {"extra": {"model": "linear"}})()
+    running = type("Handle", (), {"state": state, "already_running": True})()
+    monkeypatch.setattr(manager, "find_rig", lambda name, runtime_dir=None: running)
+    with pytest.raises(manager.RigError, match="already runs the linear model; stop it first"):
+        manager.start_rig("busy", runtime_dir=tmp_path, model="nonlinear")
+    assert manager.start_rig("busy", runtime_dir=tmp_path, model="linear") is running
 
 
 def test_the_cli_choices_are_the_servers():

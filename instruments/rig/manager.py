@@ -66,6 +66,10 @@ def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | No
     paths = RigPaths.for_name(name, runtime_dir)
     running = find_rig(name, runtime_dir)
     if running is not None:
+        running_model = running.state.extra.get("model", "linear")
+        if running_model != model:
+            raise RigError(f"rig {name!r} already runs the {running_model} model; stop it first "
+                           f"(linpar rig stop --name {name}) to start the {model} one")
         return running
     if pid_alive(read_pid(paths)):
         raise RigError(f"rig {name!r} is starting or stopping (pid {read_pid(paths)}); try again in a moment")

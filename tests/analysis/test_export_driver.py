@@ -40,10 +40,10 @@ PARSTATE = ("Znom Fs Pe SPL Re Le fLe KLe BL Xmax Xlim Cms Qms Qes Qts Rms Mms S
             "Basket Outer Vcd DVol VCCon c roo").split()
 WINISD_SPELLINGS = {8.81202645607949e-06: "8.81202645607949E-6", 1.59790990485196e-05: "0.0000159790990485196"}
 
-# Customary units to SI: a value read back in the documented unit must equal the SI value written.
-TO_SI = {"1": 1.0, "ohm": 1.0, "Hz": 1.0, "H": 1.0, "mH": 1e-3, "kg": 1.0, "g": 1e-3, "m^3": 1.0, "L": 1e-3,
-         "m^2": 1.0, "cm^2": 1e-4, "m": 1.0, "mm": 1e-3, "m/N": 1.0, "kg/s": 1.0, "T*m": 1.0, "dB": 1.0,
-         "H*Hz^0.5": 1.0, "m/s": 1.0, "kg/m^3": 1.0, "W": 1.0}
+# Every unit of the file is SI (UNITS): a value read back must equal the SI value written. The guard
+# against a customary unit slipping in (mH, g, litres) is the explicit checks of Le, Mms and Vas below.
+TO_SI = {unit: 1.0 for unit in ("1", "ohm", "Hz", "H", "kg", "m^3", "m^2", "m", "m/N", "kg/s", "T*m", "dB",
+                                "H*Hz^0.5", "m/s", "kg/m^3", "W")}
 # WinISD key -> linpar parameter: what the measurement states (E) and what are WinISD formulas of it (C).
 STATED = {"Fs": "fs", "Re": "RE", "BL": "Bl", "Cms": "Cms", "Qms": "Qms", "Qes": "Qes", "Rms": "Rms",
           "Mms": "Mms", "Vas": "Vas"}

@@ -30,3 +30,25 @@ def test_after_runs_at_once_when_nothing_is_on_its_way(qtbot):
     ran = []
     fan.after(lambda: ran.append(True))
     assert ran == [True]
+
+
+def test_a_receiver_that_fails_does_not_stop_the_others_or_the_callbacks(qtbot):
+    got, shown = [], []
+
+    def broken(value):
+        raise RuntimeError("a page failed")
+
+    fan = StagedFanOut([broken, got.append])
+    fan.send(7, then=lambda: shown.append(True))
+    with qtbot.captureExceptions() as exceptions:
+        qtbot.waitUntil(lambda: bool(shown), timeout=1000)
+    assert got == [7] and shown == [True]
+    assert [str(e[1]) for e in exceptions] == ["a page failed"]
+
+
+def test_a_callback_given_while_earlier_ones_wait_runs_after_them(qtbot):
+    order = []
+    fan = StagedFanOut([lambda v: fan.after(lambda: order.append("late"))])
+    fan.send(1, then=lambda: order.append("first"))
+    qtbot.waitUntil(lambda: len(order) == 2, timeout=1000)
+    assert order == ["first", "late"]
