@@ -27,7 +27,8 @@ A complete measurement is then stored in the measurement archive
 its id; with --json the printed object gets "archive": {"id", "root"}. When
 storing fails (a read-only or full disk ...), nothing is lost, since the
 recording is already written: a warning on stderr says why and how to store it
-later (``linpar archive store``), --json gets "archive": {"error", "root"},
+later (a ``linpar archive store`` command, shell-quoted, that keeps the time of
+measuring), --json gets "archive": {"error", "root"},
 and the exit code is 3 (EXIT_NOT_STORED): measured and analysed, not archived.
 """
 from __future__ import annotations
@@ -39,6 +40,7 @@ import shlex
 import sys
 import threading
 from contextlib import ExitStack
+from datetime import datetime, timezone
 from pathlib import Path
 
 from instruments.measurement.errors import MeasurementError
@@ -117,13 +119,15 @@ def run(args: argparse.Namespace) -> int:
         try:
             outcome = run_journaled(plan, audio, _laser_sensor(laser), args.out, name=args.name,
                                       cancel=cancel, progress=_Progress(), effects=effects)
+            # The recording carries no date, and a store later would be dated then (--measured-at).
+            measured_at = datetime.now(timezone.utc).isoformat(timespec="seconds")
         except KeyboardInterrupt:
             cancel.set()
             raise
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
             _say(f"wrote {path}")
-    archived = None if args.no_archive else _store(args, outcome, plan)
+    archived = None if args.no_archive else _store(args, outcome, plan, measured_at)
     result = outcome.result
     if args.json:
         doc = result_json(result)
@@ -135,11 +139,11 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
 
 
-def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan) -> dict:
+def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at: str) -> dict:
     """Store the measurement in the archive: {"id", "root"}, or {"error", "root"} and a warning (module doc)."""
     from analysis.archive import Archive, default_root
     root = Path(args.archive_root).expanduser() if args.archive_root else default_root()
-    meta = {"serial": args.serial, "operator": args.operator, "station": args.station,
+    meta = {"serial": args.serial, "operator": args.operator, "station": args.station, "measured_at": measured_at,
             "settings": {"template": plan.template, "rig": args.rig,
                          "laser": "serial" if outcome.raw_path is not None else (args.laser or LASER_ANALOG)}}
     archive = None
@@ -151,7 +155,7 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan) -> dict:
         why = " ".join(str(exc).split()) or type(exc).__name__
         why = why if known else f"internal error ({type(exc).__name__}: {why})"
         _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
-             f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root)}")
+             f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
         return {"error": why, "root": str(root)}
     finally:
         for note in archive.notes if archive is not None else ():
@@ -160,15 +164,15 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan) -> dict:
     return {"id": mid, "root": str(root)}
 
 
-def _store_later(args: argparse.Namespace, outcome, root: Path) -> str:
-    """The `linpar archive store` command that stores this measurement as this command would have."""
+def _store_later(args: argparse.Namespace, outcome, root: Path, measured_at: str) -> str:
+    """The `linpar archive store` command that stores this measurement as this command would have (shell-quoted)."""
     effects = ",".join(outcome.result.fit.model.effect_ids) or "none"
     command = ["linpar", "archive", "store", str(outcome.recording_path.with_suffix("")), "--model", effects]
     if outcome.raw_path is not None:
         command += ["--laser-stream", str(outcome.raw_path)]
     for key in ("serial", "operator", "station"):
         command += [f"--{key}", getattr(args, key)] if getattr(args, key) else []
-    return shlex.join(command + ["--root", str(root)])
+    return shlex.join(command + ["--measured-at", measured_at, "--root", str(root)])
 
 
 def _devices(args: argparse.Namespace, stack: ExitStack):

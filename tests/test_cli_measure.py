@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import shutil
+from datetime import datetime, timezone
 
 import pytest
 
@@ -91,13 +93,29 @@ def simulated_card(monkeypatch):
         SimulatedAudio(realtime=False, seed=1), None, {"name": "paper (simulated)", "sd_m2": 0.0133}))
 
 
-def measure(capsys, tmp_path, *extra):
-    code = main(["measure", "--out", str(tmp_path / "out"), "--name", "m", *SHORT, "--json", *extra])
+MEASURED = datetime(2024, 5, 1, 12, 0, 0, tzinfo=timezone.utc)
+
+
+@pytest.fixture
+def measured_on_may_1st(monkeypatch):
+    """`linpar measure`'s clock (only its own: the archive's stays true) says 2024-05-01 12:00 UTC."""
+    import app.cli_measure as cli_measure
+
+    class Clock(datetime):
+        @classmethod
+        def now(cls, tz=None):
+            return MEASURED.astimezone(tz)
+    monkeypatch.setattr(cli_measure, "datetime", Clock)
+
+
+def measure(capsys, tmp_path, *extra, out="out"):
+    code = main(["measure", "--out", str(tmp_path / out), "--name", "m", *SHORT, "--json", *extra])
     out, err = capsys.readouterr()
     return code, (json.loads(out) if out else None), err
 
 
-def test_a_measurement_is_stored_in_the_archive_with_its_id_printed(simulated_card, tmp_path, capsys):
+def test_a_measurement_is_stored_in_the_archive_with_its_id_printed(simulated_card, measured_on_may_1st,
+                                                                    tmp_path, capsys):
     from analysis.archive import Archive
     root = tmp_path / "qa-archive"
     code, printed, err = measure(capsys, tmp_path, "--archive-root", str(root), "--serial", "SN-7",
@@ -107,6 +125,7 @@ def test_a_measurement_is_stored_in_the_archive_with_its_id_printed(simulated_ca
     assert printed["archive"]["root"] == str(root) and f"stored in the archive {root} as {mid}" in err
     (entry,) = Archive(root).list()
     assert (entry.id, entry.serial, entry.operator, entry.driver) == (mid, "SN-7", "ana", "paper (simulated)")
+    assert entry.measured_at == "2024-05-01T12:00:00Z" != entry.stored_at     # when measured, not when stored
     m = Archive(root).get(mid)
     assert m.path("recording").read_bytes() == (tmp_path / "out" / "m.wav").read_bytes()
     assert m.result().parameters["fs"].value == pytest.approx(printed["parameters"]["fs"]["value"])
@@ -122,20 +141,25 @@ def test_the_default_archive_and_no_archive(simulated_card, tmp_path, capsys, ar
     assert [e.id for e in Archive(archive_root).list()] == [printed["archive"]["id"]]
 
 
-def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, tmp_path, capsys):
-    not_a_folder = tmp_path / "archive-is-a-file"
+def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, measured_on_may_1st, tmp_path,
+                                                               capsys):
+    not_a_folder = tmp_path / "archive is a file"
     not_a_folder.write_text("")
-    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(not_a_folder), "--serial", "SN-8")
+    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(not_a_folder), "--serial", "SN 8",
+                                 out="my out")
     assert code == 3, err
     assert printed["parameters"]["Bl"]["value"] > 0 and set(printed["archive"]) == {"error", "root"}
     assert "warning: not stored in the archive" in err and printed["archive"]["error"] in err
-    assert (tmp_path / "out" / "m.wav").is_file() and (tmp_path / "out" / "m.json").is_file()
-    # What the warning says to do stores it.
-    hint = err.split("store it later with: ")[1].split()
-    root = tmp_path / "later"
-    assert hint[:3] == ["linpar", "archive", "store"] and hint[-2] == "--root"
+    assert (tmp_path / "my out" / "m.wav").is_file() and (tmp_path / "my out" / "m.json").is_file()
+    # What the warning says to do, as a shell reads it (paths and texts with spaces), stores it.
+    hint = shlex.split(err.split("store it later with: ")[1].splitlines()[0])
+    root = tmp_path / "later on"
+    assert hint[:4] == ["linpar", "archive", "store", str(tmp_path / "my out" / "m")]
+    assert hint[-2:] == ["--root", str(not_a_folder)]
     assert "--model" in hint and main([*hint[1:-1], str(root)]) == 0
     assert capsys.readouterr().out.startswith("stored ")
     from analysis.archive import Archive
     (entry,) = Archive(root).list()
-    assert entry.serial == "SN-8" and entry.effects == tuple(printed["model"]["effects"])
+    assert entry.serial == "SN 8" and entry.effects == tuple(printed["model"]["effects"])
+    # Dated when it was measured, not when the command was run.
+    assert entry.measured_at == "2024-05-01T12:00:00Z" != entry.stored_at

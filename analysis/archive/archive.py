@@ -12,7 +12,8 @@
 
 A folder is written complete under a hidden temporary name and renamed into
 place, so the archive never holds half a measurement; only then is it added
-to the index. Nothing in a folder is code: JSON, WAV and the raw laser bytes.
+to the index (unless a listing meanwhile found the folder and added it).
+Nothing in a folder is code: JSON, WAV and the raw laser bytes.
 """
 from __future__ import annotations
 
@@ -250,8 +251,14 @@ class Archive:
             shutil.rmtree(tmp, ignore_errors=True)
             raise
         try:
-            with conn:   # a crash before this line is repaired by the next open (folders vs index)
-                insert(conn, record)
+            try:
+                with conn:   # a crash before this line is repaired by the next open (folders vs index)
+                    insert(conn, record)
+            except sqlite3.IntegrityError:
+                # A listing meanwhile (Index._sync, another thread or program) may have found the folder
+                # and indexed it: then the row is this one, and there is nothing left to do.
+                if conn.execute("SELECT folder FROM measurements WHERE id = ?", (mid,)).fetchone() != (name,):
+                    raise
         except sqlite3.Error as exc:
             # The folder is in place, so the measurement is stored: the next open adds it to the index.
             self._index.notes.append(f"stored {mid}, but the index {self._index.path} could not be updated "

@@ -7,7 +7,10 @@ that fails any check is renamed aside (index.sqlite.broken-<time>, kept for
 a look) and the index is rebuilt from the folders. Then the set of folders
 is compared with the set of indexed ones, so that a folder stored by a
 program that crashed before it reached the index, or one removed by hand,
-is picked up: the folders are the truth, the index only a cache.
+is picked up: the folders are the truth, the index only a cache. The index
+is compared again and changed under SQLite's write lock, so that a store
+running meanwhile (it renames its folder into place, then adds its row)
+never has its new row taken for that of a removed folder.
 
 A rebuild writes a new database next to the old one and renames it into
 place: readers see the old index or the new one.
@@ -178,12 +181,16 @@ class Index:
             return {e.name for e in it if e.is_dir(follow_symlinks=False) and not e.name.startswith(".")}
 
     def _sync(self, conn: sqlite3.Connection) -> None:
-        on_disk = self._folder_names()
-        indexed = {row[0] for row in conn.execute("SELECT folder FROM measurements")}
-        if on_disk == indexed:
-            return
-        added = skipped = 0
-        with conn:
+        if self._folder_names() == self._indexed(conn):
+            return          # the usual case, and a read-only archive's: no lock taken
+        # NB: stores in other threads and programs rename their folder into place, then insert its row. Under
+        # the write lock no row is inserted, so a row is deleted only when its folder was gone after the row was
+        # made; a folder found here before its store's insert is indexed here (the store takes that as done).
+        conn.execute("BEGIN IMMEDIATE")
+        try:
+            indexed = self._indexed(conn)
+            on_disk = self._folder_names()
+            added = skipped = 0
             for name in sorted(indexed - on_disk):
                 conn.execute("DELETE FROM measurements WHERE folder = ?", (name,))
             for name in sorted(on_disk - indexed):
@@ -192,9 +199,17 @@ class Index:
                     added += 1
                 except (ArchiveError, sqlite3.IntegrityError):
                     skipped += 1
+            conn.commit()
+        except BaseException:
+            conn.rollback()
+            raise
         if indexed - on_disk or added:
             self.notes.append(f"index brought up to date with the folders: {added} added, "
                               f"{len(indexed - on_disk)} removed" + (f", {skipped} unreadable" if skipped else ""))
+
+    @staticmethod
+    def _indexed(conn: sqlite3.Connection) -> set[str]:
+        return {row[0] for row in conn.execute("SELECT folder FROM measurements")}
 
     # --- rebuilding -----------------------------------------------------------
 

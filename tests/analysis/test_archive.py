@@ -1,6 +1,8 @@
 """The archive: folders + SQLite index; the index survives deletion, garbage, truncation and wrong schemas."""
+import errno
 import json
 import os
+import shutil
 import sqlite3
 import time
 
@@ -8,8 +10,10 @@ import pytest
 
 from analysis.archive import Archive, ArchiveError, compare
 from analysis.archive.archive import FOLDERS
-from analysis.archive.index import INDEX_FILE, Index
+from analysis.archive.index import INDEX_FILE, Index, insert
+from analysis.archive.leftovers import sweep
 from analysis.archive.names import folder_name, inside, safe_suffix, slug
+from analysis.archive.record import read_record
 from analysis.archive.results import StoredResult, results_document
 from analysis.archive.schema import CURRENT_VERSION, MIGRATIONS
 from analysis.pipeline import analyze_recording
@@ -304,6 +308,9 @@ def test_leftovers_of_interrupted_programs_are_removed_once_an_hour_old(tmp_path
     rebuild_tmp = tmp_path / f".{INDEX_FILE}.4242.1.tmp"
     rebuild_tmp.write_bytes(b"half an index")
     _age(rebuild_tmp, 2 * hour)
+    rebuild_journal = tmp_path / f".{INDEX_FILE}.4242.1.tmp-journal"     # SQLite's, of that half index
+    rebuild_journal.write_bytes(b"a journal")
+    _age(rebuild_journal, 2 * hour)
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     (elsewhere / "keep").write_text("not the archive's")
@@ -312,12 +319,132 @@ def test_leftovers_of_interrupted_programs_are_removed_once_an_hour_old(tmp_path
 
     opened = Archive(tmp_path)
     assert [e.id for e in opened.list()] == [mid]
-    assert not made["old"].exists() and not rebuild_tmp.exists()
+    assert not made["old"].exists() and not rebuild_tmp.exists() and not rebuild_journal.exists()
     assert made["fresh"].exists() and made["busy"].exists() and (elsewhere / "keep").exists()
-    assert any("removed 2 unfinished" in n for n in opened.notes), opened.notes
+    assert any("removed 3 unfinished" in n for n in opened.notes), opened.notes
+    assert not [p for p in folders.iterdir() if p.name.startswith((".removing-", ".clock-probe-"))]
     _age(made["fresh"], 2 * hour)
     Archive(tmp_path).rebuild()                                # a rebuild sweeps too
     assert not made["fresh"].exists() and made["busy"].exists()
+
+
+def _leftover(folders, name, age_s):
+    folder = folders / name
+    folder.mkdir(parents=True)
+    for file in ("recording.wav", "measurement.json"):
+        (folder / file).write_bytes(b"x")
+    _age(folder, age_s)
+    return folder
+
+
+def test_a_leftover_is_claimed_before_it_is_deleted_so_a_stalled_store_cannot_move_half_of_it_in(tmp_path,
+                                                                                                 monkeypatch):
+    folders = tmp_path / FOLDERS
+    incoming = _leftover(folders, ".incoming-stalled", 7200)
+    final = folders / "20240101-000000-abcdef"
+    real_rmtree, store = shutil.rmtree, []
+
+    def delete_while_the_store_wakes_up(path, *args, **kwargs):
+        next(iter(sorted(path.iterdir()))).unlink()          # the deletion has begun ...
+        try:
+            os.rename(incoming, final)                       # ... when the store renames its folder into place
+            store.append("renamed")
+        except FileNotFoundError:
+            store.append("failed")
+        real_rmtree(path, *args, **kwargs)
+    monkeypatch.setattr(shutil, "rmtree", delete_while_the_store_wakes_up)
+    removed = sweep(folders, tmp_path, INDEX_FILE)
+    monkeypatch.undo()
+    assert store == ["failed"] and not final.exists()        # the store failed rather than keep half a folder
+    assert removed == [".incoming-stalled"] and list(folders.iterdir()) == []
+
+
+def test_the_age_of_a_leftover_is_taken_on_the_file_systems_clock(tmp_path, monkeypatch):
+    folders = tmp_path / FOLDERS
+    old = _leftover(folders, ".incoming-old", 7200)
+    in_use = _leftover(folders, ".incoming-in-use", 0)
+    # This machine's clock two hours ahead of the file server's: to it, a folder written just now looks 2 h old.
+    real_time = time.time
+    monkeypatch.setattr(time, "time", lambda: real_time() + 7200)
+    removed = sweep(folders, tmp_path, INDEX_FILE)
+    monkeypatch.undo()
+    assert removed == [".incoming-old"] and not old.exists() and in_use.exists()
+
+
+def test_an_archive_where_nothing_can_be_written_is_not_swept(tmp_path, monkeypatch):
+    folders = tmp_path / FOLDERS
+    old = _leftover(folders, ".incoming-old", 7200)
+    real_open = os.open
+
+    def read_only(path, flags, *args, **kwargs):     # tests run as root: chmod cannot make a folder read-only
+        if flags & os.O_CREAT:
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(path))
+        return real_open(path, flags, *args, **kwargs)
+    monkeypatch.setattr(os, "open", read_only)
+    removed = sweep(folders, tmp_path, INDEX_FILE)
+    monkeypatch.undo()
+    assert removed == [] and sorted(p.name for p in old.iterdir()) == ["measurement.json", "recording.wav"]
+
+
+def test_what_an_interrupted_sweep_claimed_is_removed_a_minute_after_the_claim(tmp_path):
+    folders = tmp_path / FOLDERS
+    claimed = _leftover(folders, ".removing-0123abcd", 7200)   # old files, but renamed (claimed) just now
+    now = time.time()
+    assert sweep(folders, tmp_path, INDEX_FILE, now=now + 30) == [] and claimed.exists()
+    assert sweep(folders, tmp_path, INDEX_FILE, now=now + 90) == [".removing-0123abcd"]
+    assert not claimed.exists()
+
+
+def test_a_listing_between_a_stores_rename_and_its_index_insert_is_no_failure(tmp_path, measured, monkeypatch):
+    import analysis.archive.archive as archive_module
+    archive, (first,) = fill(tmp_path, measured, 1)
+    real_fsync_dir, listed = archive_module.fsync_dir, []
+
+    def then_a_listing(path):     # the store has just renamed its folder into place; a GUI listing runs now
+        real_fsync_dir(path)
+        listing = Archive(tmp_path)
+        listed.append(({e.id for e in listing.list()}, listing.notes))
+    monkeypatch.setattr(archive_module, "fsync_dir", then_a_listing)
+    second = archive.store(*measured, {"serial": "late"})
+    monkeypatch.undo()
+    assert listed == [({first, second}, ["index brought up to date with the folders: 1 added, 0 removed"])]
+    assert archive.notes == []                               # the listing indexed it: the store is complete
+    assert sorted(e.id for e in Archive(tmp_path).list()) == sorted([first, second])
+
+
+def test_a_row_of_another_folder_under_the_stores_id_is_still_reported(tmp_path, measured, monkeypatch):
+    import analysis.archive.archive as archive_module
+    archive, (first,) = fill(tmp_path, measured, 1)
+    real_fsync_dir = archive_module.fsync_dir
+
+    def then_a_row_elsewhere(path):
+        real_fsync_dir(path)
+        (new,) = [p for p in path.iterdir() if not p.name.startswith(".") and not p.name.startswith(first)]
+        with sqlite3.connect(tmp_path / INDEX_FILE) as conn:
+            insert(conn, {**read_record(new), "folder": "someone-elses"})
+    monkeypatch.setattr(archive_module, "fsync_dir", then_a_row_elsewhere)
+    archive.store(*measured, {"serial": "late"})
+    assert any("could not be updated (UNIQUE constraint failed" in n for n in archive.notes), archive.notes
+
+
+def test_a_store_during_a_listings_sync_keeps_its_index_row(tmp_path, measured, monkeypatch):
+    archive, (first,) = fill(tmp_path, measured, 1)
+    real_scan, armed, stored = Index._folder_names, [True], []
+
+    def scan_then_a_store(self):  # another thread stores a measurement just after this listing scanned the folders
+        names = real_scan(self)
+        if armed:
+            armed.clear()
+            stored.append(Archive(tmp_path).store(*measured, {"serial": "meanwhile"}))
+        return names
+    monkeypatch.setattr(Index, "_folder_names", scan_then_a_store)
+    listing = Archive(tmp_path)
+    listing.list()
+    monkeypatch.undo()
+    assert len(stored) == 1
+    with sqlite3.connect(tmp_path / INDEX_FILE) as conn:     # the new row was not taken for a removed folder
+        assert {row[0] for row in conn.execute("SELECT id FROM measurements")} == {first, *stored}
+    assert listing.notes == []
 
 
 @pytest.mark.parametrize("state", ["stale", "missing", "damaged"])
