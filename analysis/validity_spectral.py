@@ -67,16 +67,22 @@ _SENSOR_NONLINEAR = ("the current is clean, so this is the triangulation sensor'
 
 
 def pooled_mean(values: np.ndarray, window: int) -> np.ndarray:
-    """Centred moving mean over `window` (made odd) neighbours, the window shrinking at the ends."""
+    """Centred moving mean over `window` (made odd) neighbours, the window shrinking at the ends.
+
+    Each window is summed on its own (a convolution), not as a difference of running sums: the values
+    span many decades (a line's SNR as a power ratio, 10^2 to 10^30), and a difference of running sums
+    would lose every window after a large value to cancellation, or to inf - inf.
+    """
     window = max(1, int(window)) | 1
     if window == 1 or values.size < 2:
         return values
-    half = window // 2
-    total = np.concatenate(([0.0], np.cumsum(values)))      # O(n) whatever the window
-    index = np.arange(values.size)
-    lo = np.maximum(index - half, 0)
-    hi = np.minimum(index + half + 1, values.size)
-    return (total[hi] - total[lo]) / (hi - lo)
+    half, n = window // 2, values.size
+    kernel = np.ones(window)
+    # The full convolution's element i + half is the sum of the window centred on i ("same" would not do:
+    # it returns max(n, window) elements).
+    sums = np.convolve(values, kernel)[half:half + n]
+    counts = np.convolve(np.ones(n), kernel)[half:half + n]
+    return sums / counts
 
 
 def line_snr_db(lines: np.ndarray, var: np.ndarray, pool: int) -> np.ndarray:

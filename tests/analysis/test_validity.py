@@ -153,3 +153,29 @@ def test_the_reported_peak_is_that_of_the_recording():
     x = rec.periods("displacement").mean(axis=0)
     assert v.peak_displacement_m == pytest.approx(np.max(np.abs(x - x.mean())), rel=1e-12)
     assert v.as_json()["peak_displacement_m"] == pytest.approx(v.peak_displacement_m)
+
+
+def test_lines_without_any_noise_do_not_blind_the_laser_band_estimate():
+    # A laser whose held samples repeat exactly gives lines of infinite SNR (seen on the serial laser's live
+    # path); the pooled running sum must not turn every later line into NaN and cut the band short there.
+    from analysis.validity_spectral import _band_findings
+    freqs = np.geomspace(5.0, 10_000.0, 80)
+    snr = np.full(freqs.size, 60.0)
+    snr[40:45] = np.inf
+    measures = {}
+    with np.errstate(all="raise"):
+        findings = _band_findings(snr, freqs, DEFAULT_THRESHOLDS, measures)
+    assert measures["x_band_hz"] == freqs[-1]
+    assert measures["x_lines"] == freqs.size
+    assert not findings
+
+
+@pytest.mark.parametrize("n, window", [(1, 5), (2, 5), (3, 5), (4, 33), (40, 5), (40, 33), (200, 4)])
+def test_the_pooled_mean_is_each_centred_window_s_mean_even_around_huge_values(n, window):
+    from analysis.validity_spectral import pooled_mean
+    rng = np.random.default_rng(n)
+    values = rng.uniform(1.0, 2.0, n)
+    values[n // 2] = 1e30                    # a line far above the rest must not spoil the others
+    half = (window | 1) // 2
+    expected = [values[max(0, i - half):i + half + 1].mean() for i in range(n)]
+    np.testing.assert_allclose(pooled_mean(values, window), expected, rtol=1e-12)
