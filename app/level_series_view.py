@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QApplication, QHeaderView, QLa
 
 from analysis.level_series import TABLE_PARAMETERS, Level, LevelSeries, concise
 from app import style
+from app.grid_axis import show_grid
 from app.parameter_table import format_value
 
 FIXED_COLUMNS = ("Level (V RMS)", "Peak (mm)", "Small signal")
@@ -34,7 +35,7 @@ class LevelSeriesPlot(pg.PlotWidget):
     def __init__(self, parent=None):
         super().__init__(parent=parent)
         plot = self.getPlotItem()
-        plot.showGrid(x=True, y=True, alpha=0.25)
+        show_grid(plot)
         plot.setLabel("left", "fs (Hz)")
         plot.setLabel("bottom", "peak excursion (mm)")
         plot.setMenuEnabled(False)

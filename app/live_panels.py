@@ -23,6 +23,7 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 from analysis.live import DB_FLOOR, LiveFrame
 from analysis.recording import UNITS
 from app import style
+from app.grid_axis import show_grid
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
 from app.traffic_light import CHANNELS, ChannelLight
 
@@ -109,7 +110,7 @@ class LiveChannelPanel(QWidget):
         plot.setLogMode(x=True, y=False)
         # The axis' own horizontal grid costs ~10 ms a panel per repaint (the GIL held all along): the
         # horizontal lines are one item of our own instead, redrawn only when the range changes.
-        plot.showGrid(x=True, y=False, alpha=0.25)
+        show_grid(plot, x=True, y=False)
         plot.setMenuEnabled(False)
         plot.setMouseEnabled(x=False, y=False)
         plot.hideButtons()

@@ -11,6 +11,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
 from app import style
+from app.grid_axis import OpaqueGridAxis, show_grid
 from app.plots import LEFT_AXIS_WIDTH, RESIDUAL_MIN_RANGE, LogFrequencyAxis
 from app.result_curves import ChannelCurves, ResultCurves
 
@@ -41,7 +42,7 @@ class ResidualPlot(pg.PlotWidget):
         self.channel = channel
         plot = self.getPlotItem()
         plot.setLogMode(x=True, y=False)
-        plot.showGrid(x=True, y=True, alpha=0.25)
+        show_grid(plot)
         plot.setLabel("left", f"{CHANNEL_SHORT[channel]} residual (σ)")
         plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
         if bottom_label:
@@ -122,7 +123,7 @@ class ResidualPanel(QWidget):
         self.displacement.clear_curves()
 
 
-class VersionAxis(pg.AxisItem):
+class VersionAxis(OpaqueGridAxis):
     """Whole version numbers only, thinned out so that the labels never overlap."""
 
     def tickValues(self, minVal, maxVal, size):
@@ -138,7 +139,7 @@ class VersionAxis(pg.AxisItem):
         return [str(int(round(v))) for v in values]
 
 
-class DecadeAxis(pg.AxisItem):
+class DecadeAxis(OpaqueGridAxis):
     """A log axis labelled at whole decades only ("0.1", "1", "10", "10⁴").
 
     pyqtgraph's own labels every minor tick on a range of a decade or two,
@@ -187,7 +188,7 @@ class ChiSquareChart(QWidget):
         self.plot_widget = pg.PlotWidget(axisItems={"bottom": VersionAxis("bottom"), "left": DecadeAxis("left")})
         plot = self.plot = self.plot_widget.getPlotItem()
         plot.setLogMode(x=False, y=True)
-        plot.showGrid(x=False, y=True, alpha=0.25)
+        show_grid(plot, x=False, y=True)
         plot.setLabel("left", "reduced χ²")
         plot.setLabel("bottom", "model version")
         plot.setMenuEnabled(False)

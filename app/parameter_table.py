@@ -54,13 +54,34 @@ class ParameterModel(QAbstractTableModel):
         super().__init__(parent)
         self._rows: list[ParameterValue] = []
         self._descriptions: dict[str, str] = {}
+        self._cells: list[list[dict]] = []         # per row and column: role -> value
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
                        descriptions: Mapping[str, str] | None = None) -> None:
         self.beginResetModel()
         self._rows = list(parameters.values())
         self._descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
+        # Every role of every cell, worked out once: a view asks for each of them on every repaint
+        # (some 1,700 calls to show the table), and formatting them each time made up half of the
+        # Results page's repaint.
+        self._cells = [self._row_roles(p) for p in self._rows]
         self.endResetModel()
+
+    def _row_roles(self, p: ParameterValue) -> list[dict]:
+        tooltip = self._tooltip(p)
+        cells = []
+        for col in range(len(COLUMNS)):
+            roles = {Qt.DisplayRole: self._display(p, col), Qt.ToolTipRole: tooltip}
+            if p.value is None:
+                roles[Qt.ForegroundRole] = QBrush(QColor(style.MISSING_TEXT))
+            if col == NAME and p.fitted:
+                font = QFont()
+                font.setBold(True)      # fitted parameters stand out from the derived ones
+                roles[Qt.FontRole] = font
+            if col in (VALUE, STD) and p.value is not None:
+                roles[Qt.TextAlignmentRole] = int(Qt.AlignRight | Qt.AlignVCenter)
+            cells.append(roles)
+        return cells
 
     def parameter(self, row: int) -> ParameterValue:
         return self._rows[row]
@@ -85,21 +106,7 @@ class ParameterModel(QAbstractTableModel):
     def data(self, index: QModelIndex, role=Qt.DisplayRole):
         if not index.isValid():
             return None
-        p = self._rows[index.row()]
-        col = index.column()
-        if role == Qt.DisplayRole:
-            return self._display(p, col)
-        if role == Qt.ToolTipRole:
-            return self._tooltip(p)
-        if role == Qt.ForegroundRole and p.value is None:
-            return QBrush(QColor(style.MISSING_TEXT))
-        if role == Qt.FontRole and col == NAME and p.fitted:
-            font = QFont()
-            font.setBold(True)      # fitted parameters stand out from the derived ones
-            return font
-        if role == Qt.TextAlignmentRole and col in (VALUE, STD) and p.value is not None:
-            return int(Qt.AlignRight | Qt.AlignVCenter)
-        return None
+        return self._cells[index.row()][index.column()].get(role)
 
     def _display(self, p: ParameterValue, col: int) -> str:
         if col == NAME:

@@ -12,13 +12,14 @@ import pyqtgraph as pg
 from PySide6.QtCore import Qt
 
 from app import style
+from app.grid_axis import OpaqueGridAxis, show_grid
 
 LEFT_AXIS_WIDTH = 72          # the same on every row, so that the x axes line up
 RESIDUAL_MIN_RANGE = 4.0      # sigma: the +-3 guides always stay in view
 RESIDUAL_MAX_RANGE = 30.0     # beyond that, outliers are clipped so the rest stays readable
 
 
-class LogFrequencyAxis(pg.AxisItem):
+class LogFrequencyAxis(OpaqueGridAxis):
     """Frequency axis labelled at 1, 2 and 5 per decade ("20", "500", "2k").
 
     pyqtgraph's own log axis labels every minor tick as "5·10¹", which
@@ -49,8 +50,8 @@ class LogFrequencyAxis(pg.AxisItem):
 
 
 def style_plot(plot: pg.PlotItem, left: str, log_y: bool = False, bottom: str | None = None) -> None:
+    show_grid(plot)
     plot.setLogMode(x=True, y=log_y)
-    plot.showGrid(x=True, y=True, alpha=0.25)
     plot.setLabel("left", left)
     plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
     if bottom:

@@ -10,6 +10,7 @@ from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox
                                QVBoxLayout)
 
 from app import style
+from app.grid_axis import show_grid
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
 from app.wizard.calibration import Corrections
@@ -63,7 +64,7 @@ class CalibrationPage(WizardPage):
         self.phase = self.plot.addPlot(row=1, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
         for plot, label in ((self.magnitude, "|Z| / R − 1 (%)"), (self.phase, "phase (deg)")):
             plot.setLogMode(x=True, y=False)
-            plot.showGrid(x=True, y=True, alpha=0.25)
+            show_grid(plot)
             plot.setLabel("left", label)
             plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
             plot.getAxis("left").enableAutoSIPrefix(False)     # "(%) (x0.001)" reads as nonsense
