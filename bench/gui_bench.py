@@ -16,7 +16,9 @@ to run (the GIL held by the GUI or the measurement).
 
 Then a diagnosis in the Model lab of a recording whose laser lags by 100 us
 (every candidate refitted in worker processes, the table filled at the end):
-the longest stall from the click until the candidates are shown.
+the longest stall from the click until the candidates are shown. Last, how
+long a click from the Measure page to the Results page or the Model lab
+holds the GUI thread until the page is painted.
 """
 from __future__ import annotations
 
@@ -60,6 +62,7 @@ def run(workdir: Path) -> list[Row]:
         window.show()
         rows = _measuring(app, window, rig)
         rows += _diagnosing(app, window, folder)
+        rows += _switching(app, window)
         window.close()
     finally:
         if rig is not None:
@@ -282,6 +285,24 @@ def _diagnosing(app, window, folder: Path) -> list[Row]:
         return [Row("gui: the diagnosis did not finish in time", 0.0, "", "", False)]
     return [Row("gui: diagnosis in the Model lab, click to candidates shown", took, "s", "", None),
             at_most("gui: longest event-loop stall during the diagnosis", meter.stall_ms, "ms", STALL_LIMIT_MS)]
+
+
+def _switching(app, window) -> list[Row]:
+    """Clicking from the Measure page to a page of plots: the longest of three switches, painted."""
+    rows = []
+    for page, name in ((window.results, "Results"), (window.model_lab, "Model lab")):
+        took = []
+        for _ in range(3):
+            window.pages.setCurrentWidget(window.wizard)
+            _wait(app, lambda: False, 0.2)
+            started = time.perf_counter()
+            window.pages.setCurrentWidget(page)
+            window.repaint()                    # painted now, not in a later turn
+            app.processEvents()
+            took.append(1e3 * (time.perf_counter() - started))
+        rows.append(at_most(f"gui: showing the {name} page (longest of 3 switches)", max(took), "ms",
+                            STALL_LIMIT_MS))
+    return rows
 
 
 if __name__ == "__main__":
