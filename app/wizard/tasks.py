@@ -128,7 +128,8 @@ def run_measurement(request: MeasurementRequest, on_frame: FrameSink | None = No
     from instruments.measurement import MeasurementPlan
     hw = request.hardware
     plan = MeasurementPlan.from_template(request.template.key, level_v_rms=request.level_v,
-                                         driver=request.driver.as_json(), laser_rate_hz=hw.laser_rate_hz)
+                                         driver=request.driver.as_json(), laser_rate_hz=hw.laser_rate_hz,
+                                         calibration={"corrections": request.corrections.to_dict()})
     audio, laser = open_devices(hw, request.corrections)
     outcome = runner(plan, audio, laser, request.out_dir, name=recording_stem(request.driver),
                      listeners=[on_frame] if on_frame else (), cancel=cancel, progress=runner_progress(progress),

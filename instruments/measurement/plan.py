@@ -19,7 +19,7 @@ the audio round trip) rounded up to whole periods.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, is_dataclass, replace
 from typing import Any, Mapping
 
 SETTLE_SAMPLES = 65536 + 8192
@@ -66,6 +66,9 @@ class MeasurementPlan:
     on_xrun: str | None = None            # "end" | "restart" (while periods are kept; see runner.py);
                                           # None: end with a serial laser, else restart
     driver: Mapping[str, Any] = field(default_factory=dict)     # {"name": ..., "sd_m2": ...}
+    # What the caller knows of the chain's calibration (e.g. the wizard's reference-resistor corrections);
+    # written into the recording's sidecar as "calibration", with the sound card's constants added.
+    calibration: Mapping[str, Any] = field(default_factory=dict)
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -119,8 +122,16 @@ class MeasurementPlan:
         """Nominal time at the sound card: settle and averaged periods."""
         return (self.settle + self.n_periods) * self.period_samples / sample_rate
 
+    def sidecar_calibration(self, sound_card_constants) -> dict[str, Any]:
+        """The recording's "calibration": the caller's (corrections) and the sound card's constants."""
+        out = dict(self.calibration)
+        if is_dataclass(sound_card_constants):
+            out["sound_card"] = asdict(sound_card_constants)
+        return out
+
     def as_json(self) -> dict[str, Any]:
         d = asdict(self)
         d["driver"] = dict(self.driver)
+        d["calibration"] = dict(self.calibration)
         d["settle_periods"] = self.settle
         return d

@@ -196,6 +196,8 @@ def _recording_of(replay: _Replay, meta: dict):
         "displacement_source": ("serial laser" if "displacement" in signals and meta["serial_laser"] else
                                 "sound card (laser analog)" if "displacement" in signals else "none"),
         "laser": laser_info}, **extra}
+    if meta["plan"].get("calibration"):
+        extra["calibration"] = dict(meta["plan"]["calibration"])
     recording = make_recording(fs, signals, plan.period_samples, 0, tuple(int(b) for b in excited),
                                dict(plan.driver), extra)
     return recording, laser_info, blocks, starts

@@ -382,6 +382,9 @@ def _recording(captured: CapturedSignals, aligned: AlignedDisplacement | None, n
                             "sound card (laser analog)" if "displacement" in signals else "none"),
                         "laser": laser_info},
     }
+    calibration = plan.sidecar_calibration(getattr(audio, "calibration", None))
+    if calibration:
+        extra["calibration"] = calibration
     if aligned is not None:
         extra[DISPLACEMENT_MAX_KEY] = aligned.max_hz
         extra["laser_alignment"] = aligned.as_json(captured.sample_rate, plan.laser_rate_hz)

@@ -183,9 +183,13 @@ def test_cancel_keeps_what_was_captured(tmp_path):
 
 def test_without_a_serial_laser_the_analog_input_is_the_displacement(tmp_path):
     audio, _ = simulated(channel_map=RIG_CHANNEL_MAP, serial=False)
-    outcome = run_measurement(plan(), audio, None, tmp_path, name="m")
+    corrections = {"current_gain": 1.02, "current_delay_s": 3e-6, "source": "4 ohm"}
+    outcome = run_measurement(plan(calibration={"corrections": corrections}), audio, None, tmp_path, name="m")
     assert outcome.raw_path is None and not (tmp_path / "m.laser.npz").exists()
     sidecar = json.loads(outcome.sidecar_path.read_text())
+    # The calibration the measurement used is in the recording itself, not only in the program's settings.
+    assert sidecar["calibration"]["corrections"] == corrections
+    assert sidecar["calibration"]["sound_card"]["shunt_ohm"] == RIG_CALIBRATION.shunt_ohm
     assert "displacement_max_hz" not in sidecar
     assert sidecar["measurement"]["displacement_source"] == "sound card (laser analog)"
     assert outcome.result.model.effect_ids == ("lr2", "creep-log")
