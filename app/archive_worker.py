@@ -20,9 +20,9 @@ from PySide6.QtCore import QObject, Signal
 
 from app.job_book import JobBook
 from app.workers import one_line
+from instruments.measurement.raw_stream import raw_capture_path
 
 log = logging.getLogger(__name__)
-LASER_SUFFIX = ".laser.npz"     # instruments.measurement.raw_stream.SUFFIX: the raw laser stream beside NAME.wav
 
 
 class ArchiveCancelled(Exception):
@@ -66,7 +66,7 @@ def archive_error_text(exc: BaseException, root: Path) -> str | None:
 
 def laser_stream_of(recording: Path) -> Path | None:
     """NAME.laser.npz next to NAME.wav, written by the runner when a serial laser was read."""
-    path = recording.with_name(recording.stem + LASER_SUFFIX)
+    path = raw_capture_path(recording.with_suffix(""))
     return path if path.is_file() else None
 
 

@@ -11,7 +11,6 @@ which divide the virtual rig's 65,536-tap FIR so its steady state is exact.
 from __future__ import annotations
 
 import math
-import threading
 from dataclasses import asdict, dataclass
 
 from analysis.multitone import Multitone, design_multitone
@@ -121,22 +120,11 @@ def _templates() -> dict[str, Template]:
 
 TEMPLATES: dict[str, Template] = _templates()
 
-_designs: dict[tuple, Multitone] = {}
-_designs_lock = threading.Lock()
-
-
 def multitone_for(template: Template) -> Multitone:
-    """The template's multitone at 1 V rms, as the runner designs it; once (the crest-factor descent takes seconds)."""
+    """The template's multitone at 1 V rms, as the runner designs it (design_multitone remembers the design)."""
     f_min, f_max = template.band_hz
-    key = (template.sample_rate, template.period_samples, f_min, f_max, template.lines_per_octave)
-    with _designs_lock:
-        found = _designs.get(key)
-    if found is None:
-        found = design_multitone(template.sample_rate, template.period_samples, f_min, f_max,
-                                 lines_per_octave=template.lines_per_octave, rms=1.0, seed=0)
-        with _designs_lock:
-            _designs[key] = found
-    return found
+    return design_multitone(template.sample_rate, template.period_samples, f_min, f_max,
+                            lines_per_octave=template.lines_per_octave, rms=1.0, seed=0)
 
 
 def sd_from_diameter(diameter_m: float) -> float:

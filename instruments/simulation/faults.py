@@ -31,7 +31,6 @@ How a fault shows in the signals, and which check must catch it:
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 from typing import Mapping
 
 import numpy as np
@@ -66,7 +65,8 @@ class Bench:
     values: Mapping[str, float] = field(default_factory=lambda: dict(PAPER.parameters))
 
     def multitone(self) -> Multitone:
-        return _design(self.sample_rate, self.period_samples, self.f_min, self.f_max).scaled(rms=self.level_rms)
+        # design_multitone remembers the design: the crest-factor descent runs once for every fault.
+        return design_multitone(self.sample_rate, self.period_samples, self.f_min, self.f_max, rms=self.level_rms)
 
     @property
     def total_periods(self) -> int:
@@ -74,12 +74,6 @@ class Bench:
 
 
 DEFAULT_BENCH = Bench()
-
-
-@lru_cache(maxsize=8)
-def _design(sample_rate: int, period_samples: int, f_min: float, f_max: float) -> Multitone:
-    # The crest-factor descent costs ~1 s and is the same for every fault: designed once.
-    return design_multitone(sample_rate, period_samples, f_min, f_max, rms=1.0)
 
 
 # --- the faults ---------------------------------------------------------------------------------
