@@ -88,24 +88,13 @@ class SimulatedRig:
     """SimulatedAudio in real time and a SimulatedLaser on its cone, new for every measurement."""
 
     def devices(self):
-        import numpy as np
-
         from analysis.drivers import load_driver
-        from instruments.audio import SimulatedAudio
-        from instruments.audio.config import ChannelMap
-        from instruments.laser import SimulatedLaser
-        from instruments.rig.engine import RIG_CALIBRATION
-        from instruments.rig.laser_feed import DisplacementFeed
+        from instruments.rig.in_process import InProcessRig
         from instruments.simulation.linear_driver import LinearBlockDriver
         paper = load_driver("paper")
-        feed = DisplacementFeed(48000, settle_s=0.2)
         driver = LinearBlockDriver(paper.model(), dict(paper.parameters), 48000, fir_length=65536)
-        audio = SimulatedAudio(calibration=RIG_CALIBRATION, channel_map=ChannelMap(output=0, voltage=0, current=1),
-                               driver=driver, realtime=True, blocksize=2048, displacement_sinks=[feed.sink])
-        laser = SimulatedLaser(clock_ppm=37.0, start_latency_s=0.02)
-        model = laser.model
-        model.displacement = lambda t: -feed.at_host_times(model.t0 + np.asarray(t))
-        return audio, laser
+        rig = InProcessRig(driver, "simulated", ppm=37.0, start_latency_s=0.02)
+        return rig.audio, rig.laser
 
     def close(self):
         pass

@@ -8,15 +8,22 @@ response is the input of the next callback: one block of round-trip latency,
 as on a real card. So the capture path, queue, counters and calibration are
 the real ones; only the hardware is simulated.
 
-``realtime=True`` paces the thread at the sample rate (an xrun is reported
-when it falls more than a block behind, as PortAudio does); ``realtime=False``
-runs as fast as the consumer takes the blocks (it waits while the queue is
-full instead of dropping), for fast tests.
+``realtime=True`` runs the card on a clock of its own, a FrameClock from the
+moment it is made (instruments/rig/frame_clock.py): the block that starts
+at frame n is handed over, and the next one played, at the clock's host time
+of frame n, as a card's crystal would time it. A thread that wakes late
+(a busy machine) catches up: the hardware kept its time, so late hand-overs
+are not xruns; the only xruns are the ones asked for (``inject_xrun``). A
+DisplacementFeed given as ``feed`` takes the same clock, so a virtual laser
+that measures the cone does so on the audio's frame counter, never on when a
+thread woke up. ``realtime=False`` runs as fast as the consumer takes the
+blocks (it waits while the queue is full instead of dropping), for fast tests.
 """
 from __future__ import annotations
 
 import threading
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,9 +33,14 @@ from instruments.audio.errors import AudioError
 from instruments.audio.stream_core import (
     INPUT_OVERFLOW, OUTPUT_UNDERFLOW, DuplexCore, LoopedExcitation)
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP, RigEngine, RigFaults, RigNoise
+from instruments.rig.frame_clock import FrameClock
 from instruments.simulation.block_driver import BlockDriver
 
+if TYPE_CHECKING:      # the feed's module brings the pty emulator: not needed to run the card
+    from instruments.rig.laser_feed import DisplacementFeed
+
 SIMULATED_DEVICE = AudioDeviceChoice("simulated rig", "in-process")
+PRECISE_S = 0.0005       # the last stretch before a hand-over is waited out in short sleeps
 
 
 class SimulatedAudio(CoreBackedDevice):
@@ -43,7 +55,7 @@ class SimulatedAudio(CoreBackedDevice):
                  sample_rate: int = 48000, channel_map: ChannelMap = RIG_CHANNEL_MAP, *,
                  blocksize: int = 1024, queue_blocks: int = 256, driver: BlockDriver | None = None,
                  noise: RigNoise = RigNoise(), faults: RigFaults = RigFaults(), realtime: bool = True,
-                 seed: int | None = None, displacement_sinks=None):
+                 seed: int | None = None, feed: DisplacementFeed | None = None):
         self.device = device or SIMULATED_DEVICE
         self.calibration = calibration
         self.sample_rate = int(sample_rate)
@@ -56,7 +68,12 @@ class SimulatedAudio(CoreBackedDevice):
             driver, _ = default_driver("paper", self.sample_rate)
         if driver.sample_rate != self.sample_rate:
             raise ValueError(f"the driver runs at {driver.sample_rate} Hz, the sound card at {self.sample_rate} Hz")
-        self.engine = RigEngine(driver, calibration, noise, faults, displacement_sinks, seed)
+        # The card's crystal runs from now on, whether or not a stream is open.
+        self.clock = FrameClock(time.monotonic(), self.sample_rate)
+        self.engine = RigEngine(driver, calibration, noise, faults, None, seed)
+        if feed is not None:
+            self.engine.displacement_sinks.append(feed.use_clock(self.clock).sink)
+        self.first_frame = 0       # the clock's frame of the running stream's first output sample
         self._core: DuplexCore | None = None
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
@@ -91,6 +108,9 @@ class SimulatedAudio(CoreBackedDevice):
         cm = self.channel_map
         self._core = DuplexCore(excitation, cm.n_inputs, cm.n_outputs, cm.output, self.queue_blocks)
         self.engine.driver.reset()
+        # The stream starts at the next block boundary of the running clock (module doc).
+        self.first_frame = int(np.ceil(self.clock.frame_at(time.monotonic()) / self.blocksize)) * self.blocksize \
+            if self.realtime else 0
         self._stop.clear()
         self._delivering = True
         self._thread = threading.Thread(target=self._run, args=(self._core,), name="simulated-audio",
@@ -102,16 +122,16 @@ class SimulatedAudio(CoreBackedDevice):
         outdata = np.zeros((B, cm.n_outputs), dtype=np.float32)
         indata = np.zeros((B, cm.n_inputs), dtype=np.float32)   # the rig's answer to the previous block
         wired = cm.input_channels()
-        t0, n = time.monotonic(), 0
+        n = self.first_frame
         while not self._stop.is_set():
             if self.realtime:
-                lag = time.monotonic() - (t0 + (n + B) / self.sample_rate)
-                if lag < 0:
-                    self._stop.wait(-lag)
+                wait = float(self.clock.host_time(n)) - time.monotonic()
+                if wait > PRECISE_S:
+                    self._stop.wait(wait - PRECISE_S)
                     continue
-                if lag > B / self.sample_rate:       # more than a block late: an xrun, then carry on
-                    self._add_flags(INPUT_OVERFLOW | OUTPUT_UNDERFLOW)
-                    t0 = time.monotonic() - (n + B) / self.sample_rate
+                if wait > 0:      # the last stretch in short sleeps: a timed wait overshoots by ~0.1 ms
+                    time.sleep(0)
+                    continue
             elif core.blocks.full():
                 self._stop.wait(0.001)
                 continue
@@ -121,11 +141,19 @@ class SimulatedAudio(CoreBackedDevice):
             with self._flags_lock:
                 flags, self._pending_flags = self._pending_flags, 0
             core.process(indata, outdata, flags)
+            # The hardware's physics costs a real card no host time: let the host's threads take the block
+            # before the driver's FIR holds the interpreter.
+            time.sleep(0)
             answer = self.engine.process(outdata[:, cm.output], n)
             indata = np.zeros((B, cm.n_inputs), dtype=np.float32)
             for signal, channel in wired.items():
                 indata[:, channel] = getattr(answer, signal)
             n += B
+
+    def frame_of_input(self, index):
+        """The clock's frame whose answer is input sample ``index`` of the running stream: the first block
+        handed over is silence, the answer to output frame f comes a block later (one round trip)."""
+        return self.first_frame - self.blocksize + np.asarray(index)
 
     @property
     def running(self) -> bool:

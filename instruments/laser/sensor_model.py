@@ -5,7 +5,15 @@ Clocks: the sensor's crystal runs ``clock_ppm`` fast, so on the host clock it
 measures at ``rate_hz * (1 + ppm*1e-6)``. Sample k of a stream is taken at
 ``t0 + start_latency_s + k / host_rate`` (host time), where ``t0`` is the
 moment measurement output was switched on; its own time stamp advances by
-exactly 1/rate_hz per sample because it counts its own crystal.
+exactly 1/rate_hz per sample because it counts its own crystal. It reaches
+the host ``link_latency_s`` after it was taken (the sensor's processing, a
+USB adapter's latency timer): a latency no host time can see, only a
+calibration (the plan's ``laser_latency_s``) or the fit's delay-x.
+
+Host times here are the emulation's schedule, the audio frame counter's line
+when the displacement comes from a rig (instruments/rig/frame_clock.py):
+they say when a measurement is taken and when it is due, whatever the
+emulator's thread is doing.
 """
 
 from __future__ import annotations
@@ -48,12 +56,13 @@ class SensorModel:
                  rate_hz: float = 4000.0, clock_ppm: float = 0.0, start_latency_s: float = 0.0,
                  noise_m: float = 0.0, error_plan: ErrorPlan | None = None, *,
                  counter_start: int = 0, timestamp_start_s: float = 0.0,
-                 rest_distance_m: float | None = None) -> None:
+                 rest_distance_m: float | None = None, link_latency_s: float = 0.0) -> None:
         self.displacement = displacement or _at_rest
         self.measuring_range_m = measuring_range_mm / 1000.0
         self.rate_hz = float(rate_hz)
         self.clock_ppm = clock_ppm
         self.start_latency_s = start_latency_s
+        self.link_latency_s = link_latency_s
         self.noise_m = noise_m
         self.error_plan = error_plan or ErrorPlan()
         self.counter_start = counter_start
@@ -81,11 +90,15 @@ class SensorModel:
         """Host seconds after t0 at which samples k of this stream are taken."""
         return self.start_latency_s + np.asarray(k, dtype=np.float64) / self.host_rate_hz
 
+    def arrival_time(self, k) -> np.ndarray | float:
+        """Host time at which sample k reaches the host: taken, plus the link's latency."""
+        return self.t0 + self.sample_times(k) + self.link_latency_s
+
     def due(self, now: float) -> int:
-        """How many samples of this stream have been taken by host time now."""
+        """How many samples of this stream have reached the host by host time now."""
         if self.t0 is None:
             return 0
-        elapsed = now - self.t0 - self.start_latency_s
+        elapsed = now - self.t0 - self.start_latency_s - self.link_latency_s
         return 0 if elapsed < 0 else int(np.floor(elapsed * self.host_rate_hz)) + 1
 
     def words(self, k0: int, k1: int) -> dict[str, np.ndarray]:

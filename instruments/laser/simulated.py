@@ -31,12 +31,12 @@ class SimulatedLaser:
                  displacement: Displacement | None = None, measuring_range_mm: int = 10,
                  clock_ppm: float = 0.0, start_latency_s: float = 0.0, noise_m: float = 0.0,
                  error_plan: ErrorPlan | None = None, counter_start: int = 0,
-                 connected: bool = True) -> None:
+                 connected: bool = True, link_latency_s: float = 0.0) -> None:
         self._url = port
         self._baudrate = baudrate
         self._connected = connected
         self.model = SensorModel(displacement, measuring_range_mm, 4000.0, clock_ppm, start_latency_s,
-                                 noise_m, error_plan, counter_start=counter_start)
+                                 noise_m, error_plan, counter_start=counter_start, link_latency_s=link_latency_s)
         self._open = False
         self._slots = value_slots(DEFAULT_OUTPUTS)
         self._unwrapper = CounterUnwrapper()
@@ -96,7 +96,7 @@ class SimulatedLaser:
                 return None
             wake = deadline
             if self._started and self.model.t0 is not None:
-                wake = min(deadline, self.model.t0 + float(self.model.sample_times(wanted - 1)))
+                wake = min(deadline, float(self.model.arrival_time(wanted - 1)))
             time.sleep(max(0.0, wake - now) + 1e-4)  # the virtual sensor's own pace
 
     def stop(self) -> None:
@@ -133,7 +133,9 @@ class SimulatedLaser:
 
     def _block(self, k0: int, k1: int) -> LaserBlock:
         raw = RawMeasurements(self._slots, self.model.rows(k0, k1, self._slots))
-        host_time = self.model.t0 + float(self.model.sample_times(k1 - 1))
+        # When the block is due by the schedule, not when this thread got to it (frame_clock.py): the
+        # emulated device's latency is the link's, as chosen; the reader's own lateness is the host's.
+        host_time = float(self.model.arrival_time(k1 - 1))
         block = block_from_raw(raw, self.model.measuring_range_m, self._unwrapper, host_time)
         self._sent = k1
         self._tally.count(block)

@@ -1,28 +1,30 @@
 """The rig's serial laser: an ILD1420 emulator on a pseudo-terminal that measures the rig's own cone.
 
-    JACK callback ── RigEngine.displacement_sinks ──> DisplacementFeed.sink   (enqueue only)
+    audio thread ── RigEngine.displacement_sinks ──> DisplacementFeed.sink   (enqueue only)
                                                             │ SimpleQueue
     emulator thread ── displacement(host times) ──> DisplacementFeed.at_host_times
                                                      (drain into a ring buffer, interpolate)
 
-Time base. The rig is the hardware, so it defines when its cone was where:
-frame f of the rig's JACK clock is "taken" at host time
+Time base: one clock, the audio frame counter (frame_clock.py). Frame f of
+the rig's audio is "taken" at host time
 
-    H(f) = T0 + f / fs
+    H(f) = T0 + f / fs.
 
-where T0 is the least (cycle start - first frame of the cycle / fs) over the
-cycles of the first SETTLE_S seconds, then fixed. The dummy JACK backend schedules
-its cycles on the host's monotonic clock (measured: its schedule stays within
-~20 us of one line over 20 s), and wake-ups are only ever late, so that
-minimum is the schedule itself; fixed, it makes the time base one straight
-line, as a crystal's would be (a T0 that kept following new minima would
-warp the laser's time by microseconds, a fraction of a ppm). It starts again
-when the schedule has clearly moved: RESCHEDULE_CYCLES cycles in a row later
-than T0 by RESCHEDULE_S (JACK restarts its schedule after an xrun), or one
-cycle earlier than T0 by EARLY_S.
-``cycle_clock`` (the caller's) says when the current cycle started (on JACK:
-time.monotonic() minus frames_since_cycle_start / fs, which removes the time
-the callback spent before the sink ran).
+An emulated sound card (SimulatedAudio) runs on a FrameClock of its own and
+hands it over (``use_clock``): T0 is then exact, by construction. The JACK
+rig's clock has to be read off its cycles: T0 is the least (cycle start -
+first frame of the cycle / fs) over the cycles of the first SETTLE_S seconds,
+then fixed. The dummy JACK backend schedules its cycles on the host's
+monotonic clock (measured: its schedule stays within ~20 us of one line over
+20 s), and wake-ups are only ever late, so that minimum is the schedule
+itself; fixed, it makes the time base one straight line, as a crystal's
+would be (a T0 that kept following new minima would warp the laser's time by
+microseconds, a fraction of a ppm). It starts again when the schedule has
+clearly moved: RESCHEDULE_CYCLES cycles in a row later than T0 by
+RESCHEDULE_S (JACK restarts its schedule after an xrun), or one cycle earlier
+than T0 by EARLY_S. ``cycle_clock`` (the caller's) says when the current
+cycle started (on JACK: time.monotonic() minus frames_since_cycle_start / fs,
+which removes the time the callback spent before the sink ran).
 
 Why that is the instant the workstation sees: PortAudio's stream runs first in
 a JACK cycle and reads the rig's outputs of the previous cycle (the link that
@@ -30,17 +32,19 @@ closes the loop workstation -> rig -> workstation is JACK's "feedback" link), so
 the block the rig computes in the cycle that starts at H(n) reaches the
 workstation one cycle later, at H(n + period): exactly as if an ADC had
 sampled frames n .. n+period-1 during that cycle and delivered them at its end.
-``capture_delay_s`` shifts the whole time base, for a wiring where that is not
-so (SimulatedAudio: 0 as well, see tests/instruments/test_measure_simulated.py).
+SimulatedAudio keeps the same order (instruments/audio/simulated.py).
+``capture_delay_s`` shifts the whole time base, for a wiring where that is not so.
 
 A thread of the feed (``start``) moves the queued blocks into the ring every
 DRAIN_S, so the queue stays short whether or not the laser is streaming.
 
 The emulator asks for displacement at host times t0 + t (t0: when its output
-was switched on); frames not computed yet are waited for (up to WAIT_S, the
-emulator's thread may block), frames older than the history or never computed
-read as rest. Interpolation between the rig's samples is 4-point Lagrange
-(cubic): at 2 kHz, the top of a 4 kHz laser's band, it is exact to ~1e-5.
+was switched on). A frame the audio has not computed yet is waited for, as
+long as the audio is still running (a block came within QUIET_S) and at most
+MAX_WAIT_S: a busy machine delays the emulator's answer, it never turns the
+cone's motion into rest. Frames older than the history, or after the audio
+stopped, read as rest. Interpolation between the rig's samples is 4-point
+Lagrange (cubic): at 2 kHz, the top of a 4 kHz laser's band, it is exact to ~1e-5.
 
 Sign: the rig's laser looks at the front of the cone, so outward motion
 (positive displacement) brings the target closer: distance = rest - x.
@@ -55,9 +59,12 @@ from typing import Callable
 import numpy as np
 
 from instruments.laser.emulator import LaserEmulator
+from instruments.laser.sensor_model import SensorModel
+from instruments.rig.frame_clock import FrameClock
 
 HISTORY_FRAMES = 1 << 18          # 5.5 s at 48 kHz: far more than any laser latency
-WAIT_S = 0.05                     # longest the emulator waits for a frame the rig has not computed yet
+QUIET_S = 0.25                    # no block for this long: the audio stopped, frames to come will not come
+MAX_WAIT_S = 2.0                  # longest the emulator waits for a frame the rig has not computed yet
 DRAIN_S = 0.05                    # how often the feed's own thread empties the queue
 SETTLE_S = 2.0                    # the earliest cycle start of this long fixes T0
 RESCHEDULE_S = 0.0005             # cycles later than T0 by this ...
@@ -78,14 +85,30 @@ class DisplacementFeed:
         self.capture_delay_s = float(capture_delay_s)
         self._inbox: queue.SimpleQueue = queue.SimpleQueue()   # NB: audio thread puts, emulator thread gets
         self._ring = np.zeros(history_frames)
-        self._newest = -1                 # the last frame in the ring (frames are JACK's, from 0)
+        self._newest = -1                 # the last frame in the ring (frames are the audio's)
+        self._last_block_at = -np.inf     # host time the newest block was handed to the sink
         self._late_cycles = 0
         self._settled_at = 0              # the frame from which T0 is fixed
         self.restarts = 0                 # times T0 started again (the schedule moved), for the rig's status
         self._t0: float | None = None
+        self._fixed = False               # T0 given by an emulated sound card's own clock (use_clock)
         self._lock = threading.Lock()     # the ring and the time base: the drain thread and the emulator's
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
+
+    def use_clock(self, clock: FrameClock) -> DisplacementFeed:
+        """The frames' time base is this clock (an emulated sound card's): nothing is read off wake-ups."""
+        if clock.sample_rate != self.sample_rate:
+            raise ValueError(f"the clock runs at {clock.sample_rate} Hz, the feed at {self.sample_rate} Hz")
+        with self._lock:
+            self._t0, self._fixed = float(clock.t0), True
+        return self
+
+    @property
+    def clock(self) -> FrameClock | None:
+        """The time base (None until the first cycle of a JACK rig was seen)."""
+        t0 = self._t0
+        return None if t0 is None else FrameClock(t0 + self.capture_delay_s, self.sample_rate)
 
     def start(self) -> DisplacementFeed:
         """Keep the queue drained from a thread of its own (until ``close``)."""
@@ -105,7 +128,7 @@ class DisplacementFeed:
 
     # --- audio thread ---------------------------------------------------------------------------
     def sink(self, displacement: np.ndarray, frame: int) -> None:
-        """RigEngine's displacement sink: stamp and enqueue, nothing else (the JACK callback calls it)."""
+        """RigEngine's displacement sink: stamp and enqueue, nothing else (the audio thread calls it)."""
         self._inbox.put((int(frame), self.cycle_clock(), displacement))
 
     # --- emulator thread ------------------------------------------------------------------------
@@ -113,15 +136,26 @@ class DisplacementFeed:
         """Displacement (m, positive outward) at these host times (time.monotonic seconds)."""
         host_times = np.asarray(host_times, dtype=np.float64)
         self._drain()
-        if self._t0 is None or host_times.size == 0:
+        clock = self.clock
+        if clock is None or host_times.size == 0:
             return np.zeros(host_times.shape)
-        deadline = time.monotonic() + WAIT_S
-        while (host_times.max() - self._t0 - self.capture_delay_s) * self.sample_rate + 2 > self._newest \
-                and time.monotonic() < deadline:
+        return self.at_frames(clock.frame_at(host_times))
+
+    def at_frames(self, frames: np.ndarray) -> np.ndarray:
+        """Displacement (m, positive outward) at these (fractional) frames of the audio; waits for frames
+        still to be computed while the audio runs (module doc)."""
+        frames = np.asarray(frames, dtype=np.float64)
+        if frames.size == 0:
+            return np.zeros(frames.shape)
+        deadline = time.monotonic() + MAX_WAIT_S
+        while frames.max() + 2 > self._newest:
+            now = time.monotonic()
+            if now >= deadline or now - self._last_block_at > QUIET_S:
+                break
             time.sleep(0.002)      # the audio thread cannot notify (it must not take a lock): poll
             self._drain()
         with self._lock:
-            return self._interpolate((host_times - self._t0 - self.capture_delay_s) * self.sample_rate)
+            return self._interpolate(frames)
 
     def _drain(self) -> None:
         with self._lock:
@@ -131,7 +165,9 @@ class DisplacementFeed:
                 except queue.Empty:
                     return
                 self._store(frame, np.asarray(block, dtype=np.float64))
-                self._clock(frame, started)
+                self._last_block_at = max(self._last_block_at, started)
+                if not self._fixed:
+                    self._clock(frame, started)
 
     def _store(self, frame: int, block: np.ndarray) -> None:
         n, size = block.size, self._ring.size
@@ -183,14 +219,24 @@ class DisplacementFeed:
         return out
 
 
+def aim_at_cone(model: SensorModel, feed: DisplacementFeed) -> None:
+    """Point a virtual sensor at the front of the feed's cone: outward motion shortens the distance."""
+    model.displacement = lambda t: -feed.at_host_times(model.t0 + np.asarray(t))
+
+
+# What the rig's "laser" command may change (SensorModel attributes of the same names).
+CONFIGURABLE = ("clock_ppm", "start_latency_s", "noise_m", "link_latency_s")
+
+
 class RigLaser:
     """The ILD1420 emulator on the rig's pty, fed by a DisplacementFeed; unplug and plug it back."""
 
     def __init__(self, feed: DisplacementFeed, clock_ppm: float = 37.0, start_latency_s: float = 0.02,
-                 noise_m: float = 0.0, measuring_range_mm: int = 10):
+                 noise_m: float = 0.0, measuring_range_mm: int = 10, link_latency_s: float = 0.0):
         self.feed = feed.start()
         self.settings = {"clock_ppm": float(clock_ppm), "start_latency_s": float(start_latency_s),
-                         "noise_m": float(noise_m), "measuring_range_mm": int(measuring_range_mm)}
+                         "noise_m": float(noise_m), "link_latency_s": float(link_latency_s),
+                         "measuring_range_mm": int(measuring_range_mm)}
         self.emulator: LaserEmulator | None = None
         self._lock = threading.Lock()
 
@@ -206,10 +252,8 @@ class RigLaser:
                 self.emulator.close()
             s = self.settings
             emulator = LaserEmulator(None, s["measuring_range_mm"], 4000.0, s["clock_ppm"], s["start_latency_s"],
-                                     s["noise_m"])
-            model = emulator.model
-            # The front of the cone: outward motion shortens the distance (module doc).
-            model.displacement = lambda t: -self.feed.at_host_times(model.t0 + np.asarray(t))
+                                     s["noise_m"], link_latency_s=s["link_latency_s"])
+            aim_at_cone(emulator.model, self.feed)
             self.emulator = emulator.start()
             return emulator.port_path
 
@@ -221,19 +265,18 @@ class RigLaser:
             emulator.disconnect()
 
     def configure(self, **settings: float) -> dict:
-        """Change clock_ppm, start_latency_s, noise_m (from the next time its output is switched on)."""
-        unknown = sorted(set(settings) - {"clock_ppm", "start_latency_s", "noise_m"})
+        """Change clock_ppm, start_latency_s, noise_m, link_latency_s (from the next time its output is
+        switched on)."""
+        unknown = sorted(set(settings) - set(CONFIGURABLE))
         if unknown:
-            raise ValueError(f"laser: unknown setting(s) {', '.join(unknown)}; known: clock_ppm, start_latency_s, "
-                             f"noise_m")
+            raise ValueError(f"laser: unknown setting(s) {', '.join(unknown)}; known: {', '.join(CONFIGURABLE)}")
         with self._lock:
             for key, value in settings.items():
                 self.settings[key] = float(value)
             if self.emulator is not None:
                 model = self.emulator.model
-                model.clock_ppm = self.settings["clock_ppm"]
-                model.start_latency_s = self.settings["start_latency_s"]
-                model.noise_m = self.settings["noise_m"]
+                for key in CONFIGURABLE:
+                    setattr(model, key, self.settings[key])
             return dict(self.settings)
 
     def close(self) -> None:
