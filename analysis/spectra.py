@@ -142,14 +142,16 @@ def _pooled(var: np.ndarray, window: int) -> np.ndarray:
 
 
 def _transfer(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.ndarray,
-              bin_width: float) -> TransferFunction:
+              bin_width: float, noise_factor: float = 1.0) -> TransferFunction:
     """num / den at `bins` from per-period spectra (P x lines) with the propagated uncertainty.
 
     The variance of each line is estimated from only P periods. Its
     reciprocal (the fit's weight) is then biased: for a variance with nu
     degrees of freedom, E[1/var_hat] = nu/(nu-2) / var. Neighbouring lines
     are pooled until nu >= MIN_NOISE_DOF, and the rest of the bias is
-    removed, so that a right model gives a reduced chi^2 of 1.
+    removed, so that a right model gives a reduced chi^2 of 1. ``noise_factor``
+    scales the variance where samples missing from some periods were filled
+    with the mean of the others, which the scatter cannot see.
     """
     p = num.shape[0]
     num_mean = num.mean(axis=0)
@@ -161,8 +163,24 @@ def _transfer(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.n
         error = num - value * den          # per period: the part that is not the transfer function
         dev = error - error.mean(axis=0)
         var_error = _pooled((dev.real**2 + dev.imag**2).sum(axis=0) / (p * (p - 1)), window)
-        var = var_error * (nu / (nu - 2)) / np.abs(den_mean) ** 2
+        var = noise_factor * var_error * (nu / (nu - 2)) / np.abs(den_mean) ** 2
     return TransferFunction(name, unit, bins * bin_width, bins, value, np.sqrt(var))
+
+
+def _displacement_noise_factor(recording: Recording) -> float:
+    """How much the displacement's noise exceeds the scatter between periods, for the laser samples left
+    out of the average (capture.laser_gaps, instruments/measurement/laser_gaps.py); 1 without gaps."""
+    capture = recording.extra.get("capture") if recording.extra else None
+    gaps = capture.get("laser_gaps") if isinstance(capture, dict) else None
+    if gaps is None:
+        return 1.0
+    from analysis.validity_capture import CaptureInfoError, LaserGapInfo
+    try:
+        factor = LaserGapInfo.from_json(gaps).noise_factor
+    except CaptureInfoError as exc:
+        raise SpectrumError(f"sidecar key {exc}") from None
+    # Unknown (no point measured twice): the validity says so in red; the scatter is all there is.
+    return 1.0 if factor is None else max(float(factor), 1.0)
 
 
 def _displacement_max_hz(recording: Recording) -> float | None:
@@ -213,6 +231,6 @@ def estimate_spectra(recording: Recording) -> Spectra:
         x_lines = excited if max_hz is None else excited[excited * bin_width <= max_hz]
         in_band = np.isin(excited, x_lines)
         displacement = _transfer("displacement", "m/V", per_period["displacement"][:, x_lines],
-                                 u[:, in_band], x_lines, bin_width)
+                                 u[:, in_band], x_lines, bin_width, _displacement_noise_factor(recording))
     return Spectra(recording.sample_rate, n, recording.n_periods, excited, unexcited,
                    channels, impedance, displacement)

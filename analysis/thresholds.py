@@ -47,9 +47,19 @@ full_scale_red = 0.999, full_scale_yellow = 0.9
     A sample at full scale is a clipped sample. Above 90 % of full scale
     (< 1 dB headroom) the next level step will clip.
 laser_error_red_share = 0.01, out_of_range_red_share = 0.001
-    Error codes are not distances (spec/laser-ild1420.md): any is yellow,
-    1 % is red. Out of range means the cone left the measuring range at its
-    peaks, which clips the displacement: any is yellow, 0.1 % red.
+    Error codes are not distances (spec/laser-ild1420.md). When the recording
+    says what leaving them out cost (capture.laser_gaps), that decides (the
+    laser_gap_* below); otherwise any is yellow, 1 % is red. Out of range
+    means the cone left the measuring range at its peaks, which clips the
+    displacement: any is yellow, 0.1 % red.
+laser_gap_growth_yellow = 0.10, laser_gap_growth_red = 0.5, laser_gap_unseen_red_s = 0.0005
+    Missing laser samples are left out of the average; the result stays
+    unbiased and its uncertainty grows with what is missing. Yellow when the
+    displacement's standard uncertainty grew by 10 % (about a fifth of its
+    data lost), red at 50 % (more than half): the laser's setup is failing.
+    Red too when a stretch of the period longer than 0.5 ms (two samples at
+    4 kHz) was measured in no period: the spot was lost at the same point of
+    every period, and there the motion is only bridged, a guess.
 drift_*
     Line spectra of the first and the last drift_periods periods compared.
     A drift of 0.5 % is above the paper's repeatability (yellow), 2 % is a
@@ -95,6 +105,10 @@ class ValidityThresholds:
     full_scale_yellow: float = 0.9
     laser_error_red_share: float = 0.01
     out_of_range_red_share: float = 0.001
+    # Laser samples left out as missing data (capture.laser_gaps): what it cost the result.
+    laser_gap_growth_yellow: float = 0.10
+    laser_gap_growth_red: float = 0.5
+    laser_gap_unseen_red_s: float = 0.0005
     # Drift between the first and the last periods (relative change, fraction).
     drift_periods: int = 4
     drift_yellow: float = 0.005

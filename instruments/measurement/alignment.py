@@ -14,18 +14,26 @@ What is estimated from what (see clocks.py for the reasoning):
 4. The offset stays as the host times put it (less a known sensor latency):
    a periodic steady state cannot tell a delay from the driver's own phase.
 
-Error codes and lost measurements are not distances: they are excluded from
-the signal (the gap is bridged by straight lines between the valid
-neighbours on the laser's grid before the band-limited interpolation), and
-counted over the stretch that feeds the recording. Out-of-range distances
-(the sensor's reserves) are kept, and counted too. So are outliers, measured
-distances no smooth motion through their neighbours could give: the line has
-no checksum, and now and then line noise forges a whole measurement that the
-parser cannot tell from a real one (instruments/laser/frames.py). The cone's
-motion is smooth on the laser's grid (its content lies well below the
-laser's Nyquist frequency), so a measurement further from the cubic through
-its two neighbours on either side than OUTLIER_SIGMAS times the typical
-distance is one: it is bridged like an error and counted as filled in.
+Error codes and lost measurements are not distances: they are missing data
+(laser_gaps.py). They are first bridged by straight lines between the valid
+neighbours on the laser's grid, then, period after period, set to the mean
+of the periods that measured that point of the excitation, so that what is
+averaged and fitted rests on measured samples only; the sidecar says how
+many were missing, in how many periods, and how much that widens the
+displacement's noise (capture.laser_gaps). Out-of-range distances (the
+sensor's reserves) are kept, and counted. Outliers are missing data too:
+measured distances no smooth motion through their neighbours could give. The
+line has no checksum, and now and then line noise forges a whole measurement
+that the parser cannot tell from a real one (instruments/laser/frames.py).
+The cone's motion is smooth on the laser's grid (its content lies well below
+the laser's Nyquist frequency), so a measurement further from the cubic
+through its two neighbours on either side than OUTLIER_SIGMAS times the
+typical distance is one.
+
+The ratio's refinement sees the missing samples at the periodic mean of the
+current clock: they carry no phase of their own, so they neither pull nor
+push the drift it measures (a bridge across a flood did: it made the
+refinement miss by hundreds of ppm).
 
 Lines above PASSBAND x the laser rate (``max_hz``) carry nothing of the
 displacement after resampling: they are not measured and must not enter Hx.
@@ -43,9 +51,11 @@ import numpy as np
 from instruments.laser.sensor import NO_COUNTER, LaserBlock
 from instruments.measurement.clocks import (
     LaserClock, TimeLine, clock_from_host_times, lower_envelope, period_phase_drift)
-from instruments.measurement.resample import PASSBAND, covered, interpolate
+from instruments.measurement.laser_gaps import LaserGaps, gap_accounting, refill
+from instruments.measurement.resample import HALF_TAPS, PASSBAND, covered, interpolate
 
 REFINE_PASSES = 3
+REFILL_ROUNDS = 2       # EM rounds per pass (laser_gaps.py): each shrinks a fill's error by ~1/periods
 OUTLIER_SIGMAS = 12.0
 _CONVERGED = 1e-10      # a drift below this changes nothing measurable
 
@@ -97,13 +107,17 @@ class LaserCounts:
     errors_by_code: Mapping[int, int] = field(default_factory=dict)
     out_of_range: int = 0
     outliers: int = 0
+    gaps: LaserGaps | None = None
 
     def capture_json(self) -> dict:
-        """The laser's part of the sidecar's "capture" object (analysis.validity_capture)."""
-        return {"laser_samples": self.samples, "laser_error_counts": {str(c): n for c, n in
-                                                                      sorted(self.errors_by_code.items())},
-                "laser_out_of_range_share": self.out_of_range / self.samples if self.samples else 0.0,
-                "dropouts": {"displacement": self.lost + self.outliers}}
+        """The laser's part of the sidecar's "capture" object (analysis.validity_capture). Lost and forged
+        measurements are missing data like the error codes (laser_gaps), not dropouts of the sound card."""
+        out = {"laser_samples": self.samples, "laser_error_counts": {str(c): n for c, n in
+                                                                     sorted(self.errors_by_code.items())},
+               "laser_out_of_range_share": self.out_of_range / self.samples if self.samples else 0.0}
+        if self.gaps is not None:
+            out["laser_gaps"] = {**self.gaps.capture_json(), "lost": self.lost, "outliers": self.outliers}
+        return out
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -155,20 +169,36 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
     grid = (starts[:, None] + np.arange(period_samples)[None, :]).ravel()
     used = _used_laser_range(host_clock, grid, stream.n_samples)
     outliers = outlier_mask(stream.distance_m)
-    counts = _counts(stream, used, int(np.count_nonzero(outliers[used])))
+    missing = ~np.isfinite(stream.distance_m) | outliers
     filled = _bridged(np.where(outliers, np.nan, stream.distance_m))
     laser_rate = audio_rate / host_clock.ratio
     max_hz = PASSBAND * min(laser_rate, nominal_rate)
+    max_bin = int(np.floor(max_hz * period_samples / audio_rate))
     bins = np.asarray(excited_bins, dtype=np.int64)
-    bins = bins[bins * audio_rate / period_samples <= max_hz]
+    bins = bins[bins <= max_bin]
     clock, drift, lines, passes = host_clock, 0.0, 0, 0
     pivot = float(np.mean(stream.block_last))      # where the host times place the stream best
     # The drift is measured on every D-th audio sample: still above twice max_hz, D times less work.
     step = _decimation(audio_rate, max_hz, period_samples)
     coarse = (starts[:, None] + np.arange(0, period_samples, step)[None, :]).ravel()
+    # Only the missing samples the interpolation of the periods reaches are filled from the periods.
+    near = np.zeros(missing.size, dtype=bool)
+    near[max(used.start - HALF_TAPS, 0):used.stop + HALF_TAPS] = True
+    gaps = missing & near if n_periods >= 2 else np.zeros_like(missing)
+
+    def coarse_periods(stream_values: np.ndarray) -> np.ndarray:
+        return interpolate(stream_values, clock.laser_index(coarse)).reshape(n_periods, -1)
+
+    def refilled(stream_values: np.ndarray) -> np.ndarray:
+        for _ in range(REFILL_ROUNDS if np.any(gaps) else 0):
+            stream_values = refill(stream_values, gaps, coarse_periods(stream_values),
+                                   clock.laser_index(coarse).reshape(n_periods, -1), clock, int(starts[0]),
+                                   period_samples, max_bin)
+        return stream_values
+
     while refine and passes < REFINE_PASSES and n_periods >= 2:
-        x = interpolate(filled, clock.laser_index(coarse))
-        drift, lines = period_phase_drift(x.reshape(n_periods, -1), bins, period_samples)
+        filled = refilled(filled)
+        drift, lines = period_phase_drift(coarse_periods(filled), bins, period_samples)
         if lines == 0:
             break
         passes += 1
@@ -178,6 +208,10 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
         clock = moved
         if abs(drift) < _CONVERGED:
             break
+    filled = refilled(filled)
+    gap_cost = gap_accounting(missing, used, clock.laser_index(coarse).reshape(n_periods, -1), n_periods, step,
+                              audio_rate)
+    counts = _counts(stream, used, int(np.count_nonzero(outliers[used])), gap_cost)
     if quick:
         coarse_x = interpolate(filled, clock.laser_index(coarse)).reshape(n_periods, -1)
         spectra = np.fft.rfft(coarse_x, axis=1) * step          # the same lines at the full rate
@@ -221,11 +255,12 @@ def _used_laser_range(clock: LaserClock, grid: np.ndarray, n_samples: int) -> sl
     return slice(max(int(np.floor(k[0])), 0), min(int(np.ceil(k[1])) + 1, n_samples))
 
 
-def _counts(stream: LaserStream, used: slice, outliers: int) -> LaserCounts:
+def _counts(stream: LaserStream, used: slice, outliers: int, gaps: LaserGaps | None) -> LaserCounts:
     code = stream.error_code[used]
     errors = Counter(int(c) for c in code[code > 0])
     out_of_range = int(np.count_nonzero((code == 0) & ~stream.in_range[used]))
-    return LaserCounts(int(code.size), int(np.count_nonzero(code < 0)), dict(errors), out_of_range, outliers)
+    return LaserCounts(int(code.size), int(np.count_nonzero(code < 0)), dict(errors), out_of_range, outliers,
+                       gaps)
 
 
 def outlier_mask(distance: np.ndarray, passes: int = 3) -> np.ndarray:
@@ -246,7 +281,8 @@ def outlier_mask(distance: np.ndarray, passes: int = 3) -> np.ndarray:
         x = _bridged(np.where(outliers, np.nan, distance))
         r = np.zeros(x.size)
         r[2:-2] = x[2:-2] - (-x[:-4] + 4 * x[1:-3] + 4 * x[3:-1] - x[4:]) / 6.0
-        r[~np.isfinite(distance) | outliers] = 0.0
+        # A missing neighbour in the stencil is a bridge, not the motion: such a sample cannot be judged.
+        r[np.convolve(~np.isfinite(distance) | outliers, np.ones(5), mode="same") > 0] = 0.0
         sigma = max(1.4826 * float(np.median(np.abs(r[2:-2]))), quantum)
         big = np.abs(r) > OUTLIER_SIGMAS * sigma
         if not np.any(big):

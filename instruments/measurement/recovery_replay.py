@@ -182,9 +182,7 @@ def _recording_of(replay: _Replay, meta: dict):
             n = min(n, aligned.periods)
             signals = {s: v[:n * plan.period_samples] for s, v in signals.items()}
             signals["displacement"] = aligned.displacement[:n * plan.period_samples]
-            counts = aligned.counts.capture_json()
-            capture["dropouts"] = {**capture["dropouts"], **counts.pop("dropouts")}
-            capture.update(counts)
+            capture.update(aligned.counts.capture_json())
             from instruments.measurement.analysis_step import DISPLACEMENT_MAX_KEY
             extra[DISPLACEMENT_MAX_KEY] = aligned.max_hz
             extra["laser_alignment"] = aligned.as_json(fs, plan.laser_rate_hz)

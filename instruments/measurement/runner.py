@@ -371,9 +371,7 @@ def _recording(captured: CapturedSignals, aligned: AlignedDisplacement | None, n
     stats = captured.stats
     capture_info = stats.capture_info()
     if aligned is not None:
-        counts = aligned.counts.capture_json()
-        capture_info["dropouts"] = {**capture_info["dropouts"], **counts.pop("dropouts")}
-        capture_info.update(counts)
+        capture_info.update(aligned.counts.capture_json())
     extra: dict[str, Any] = {
         "capture": capture_info, "audio_capture": stats.as_dict(),
         "measurement": {"plan": plan.as_json(), "partial": ended_by != "complete", "ended_by": ended_by,

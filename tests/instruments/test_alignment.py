@@ -143,7 +143,7 @@ def test_an_uncorrected_offset_is_a_pure_delay_in_hx():
     assert np.max(np.abs(np.angle(corrected))[freqs < 100]) < np.radians(0.1)
 
 
-def test_error_codes_and_lost_measurements_are_bridged_and_counted_not_averaged():
+def test_error_codes_and_lost_measurements_are_missing_data_counted_not_averaged():
     scene = Scene(ppm=-80.0, error_every=97, lose_blocks=(1200, 1201, 1700))    # within the kept periods
     aligned = scene.align()
     counts = aligned.counts
@@ -151,11 +151,16 @@ def test_error_codes_and_lost_measurements_are_bridged_and_counted_not_averaged(
     assert counts.errors_by_code == {262076: pytest.approx(counts.samples / 97, abs=3)}
     doc = counts.capture_json()
     assert doc["laser_error_counts"] == {"262076": counts.errors_by_code[262076]}
-    assert doc["dropouts"] == {"displacement": 3 * LASER_BLOCK}
+    gaps = doc["laser_gaps"]
+    assert gaps["lost"] == 3 * LASER_BLOCK and gaps["samples"] == counts.errors_by_code[262076] + 3 * LASER_BLOCK
+    assert gaps["periods"] == N_PERIODS and gaps["longest_run"] == 2 * LASER_BLOCK and gaps["unseen_s"] == 0
+    # About 1 % of each period missing: the noise grows by about that much, not more.
+    assert 1.0 < gaps["noise_factor"] < 1.05
     freqs, ratio = scene.line_ratio(aligned)
     assert np.all(np.isfinite(aligned.displacement))
-    # Two lost blocks are 4.5 ms bridged by a straight line: the low lines barely notice.
-    assert np.max(np.abs(np.abs(ratio) - 1)[freqs < 100]) < 1e-2
+    # Two lost blocks in a row are 4.5 ms with no distance: filled from the other periods, not bridged by a
+    # straight line, the lines come out as well as without them (a bridge left 1e-2 at the low lines).
+    assert np.max(np.abs(np.abs(ratio) - 1)[freqs < 300]) < 3e-3
     only_errors = Scene(ppm=-80.0, error_every=97)
     freqs, ratio = only_errors.line_ratio(only_errors.align())
     assert np.max(np.abs(np.abs(ratio) - 1)[freqs < 300]) < 3e-3

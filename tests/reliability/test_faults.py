@@ -26,6 +26,10 @@ from tests.builders import PAPER
 from tests.reliability.simulated_rig import Rig, plan
 
 pytestmark = pytest.mark.timeout(90)
+# With the floods and cut frames below, Bl of these one-second measurements came out within 0.0015 % of the
+# truth in 36 runs, idle and with both cores busy (docs/timing.md; +0.15 to +1.2 % while the floods were
+# bridged); the bound leaves thirty times that.
+BL_SPREAD = 0.0005
 
 
 @pytest.fixture
@@ -75,17 +79,23 @@ def kept_partial(info, folder: Path, ended_by: str, *words: str) -> dict:
 
 # --- the serial line ------------------------------------------------------------------------------------
 
-def test_garbage_cut_frames_and_error_floods_on_the_serial_line_are_skipped_counted_and_judged(tmp_path, rigs):
+def test_garbage_cut_frames_and_error_floods_on_the_serial_line_are_skipped_counted_and_judged(tmp_path, rigs,
+                                                                                                  record_property):
     floods = {k: 262076 for start in range(2000, 12000, 1000) for k in range(start, start + 30)}
     rig = rigs("serial", ErrorPlan(garbage_every=40, garbage_bytes=24, truncate_every=97, codes_at=floods, seed=3))
     outcome = run_journaled(plan(), rig.audio, rig.laser, tmp_path, name="m")
     assert outcome.ended_by == "complete" and outcome.periods == 4
-    assert outcome.result.parameters["Bl"].value == pytest.approx(PAPER.parameters["Bl"], rel=0.01)
+    # The floods and cut frames are missing data, not bridged and averaged: no bias (it was +1 % with floods,
+    # by an amount that depended on where they fell); what is left is the fit's spread (BL_SPREAD).
+    record_property("bl_error", outcome.result.parameters["Bl"].value / PAPER.parameters["Bl"] - 1)
+    assert outcome.result.parameters["Bl"].value == pytest.approx(PAPER.parameters["Bl"], rel=BL_SPREAD)
     capture = sidecar(outcome.recording_path)["capture"]
-    assert capture["dropouts"]["displacement"] > 0          # the cut measurements, counted where validity looks
+    gaps = capture["laser_gaps"]
+    assert gaps["lost"] > 0                                   # the cut measurements, counted where validity looks
     assert 0 < capture["laser_error_counts"]["262076"] < 300      # the floods inside the recording, not averaged
-    codes = {f["code"] for f in outcome.result.validity["channels"]["displacement"]["findings"]}
-    assert {"laser-errors", "dropouts"} <= codes
+    assert gaps["samples"] >= gaps["lost"] + capture["laser_error_counts"]["262076"]
+    findings = {f["code"]: f for f in outcome.result.validity["channels"]["displacement"]["findings"]}
+    assert "lost on the line" in findings["laser-errors"]["message"] and "dropouts" not in findings
     assert rig.laser.stats.discarded_bytes > 0 and rig.laser.stats.incomplete_measurements > 0
     no_journal_and_no_litter(tmp_path)
     measure_again(rig, tmp_path)
