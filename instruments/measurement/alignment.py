@@ -55,7 +55,7 @@ from instruments.measurement.laser_gaps import LaserGaps, gap_accounting, refill
 from instruments.measurement.resample import HALF_TAPS, PASSBAND, covered, interpolate
 
 REFINE_PASSES = 3
-REFILL_ROUNDS = 2       # EM rounds per pass (laser_gaps.py): each shrinks a fill's error by ~1/periods
+REFILL_ROUNDS = 2       # EM rounds per pass of the refinement (laser_gaps.py): the second changes ~1e-3 of the first
 OUTLIER_SIGMAS = 12.0
 _CONVERGED = 1e-10      # a drift below this changes nothing measurable
 

@@ -15,8 +15,11 @@ filled with the current estimate of s at its place in the period, and the
 estimate is made again from the filled stream (``refill``). That is the EM
 algorithm for this model; its fixed point is exactly the mean over the
 measured periods, because a filled sample adds to its own mean only what
-the other periods say. It converges by a factor of about 1/P per round (P
-periods); two rounds per pass of the clock refinement are plenty.
+the other periods say. Taking each point's mean over the periods that
+measured it cleanly makes the fill nearly independent of itself, so a round
+or two per pass of the clock refinement converge (a plain mean over all
+periods shrank a fill's error only by half a round where every other period
+had lost the point).
 
 What the missing samples cost (``gap_accounting``): at audio sample m of the
 period, P_m of the P periods were measured. The mean of P_m noisy values has
