@@ -44,8 +44,6 @@ HX_MAX_OVER_FS = 4.0
 # this many lines per decade, each decade counts alike, as in a log-spaced
 # .zma (35 per octave is about 116 per decade).
 LINES_PER_DECADE = 100
-# A parameter this close (relative to its typical size) to a bound is "on" it.
-AT_BOUND_RELATIVE = 1e-6
 VALIDITY_NOTE = "imported curves: no per-line noise, no validity checks"
 UNCERTAINTY_NOTE = (f"imported curves carry no noise estimate: every line is weighted as if it had "
                     f"{100 * ASSUMED_RELATIVE_STD:g} % relative noise and the uncertainties are scaled by the "
@@ -189,8 +187,7 @@ def relative_residual(model_values: np.ndarray, tf: TransferFunction) -> list[np
 
 
 def at_bound(value: float, spec: ParamSpec) -> bool:
-    scale = max(abs(spec.default), abs(value), 1e-300)
-    return value - spec.min <= AT_BOUND_RELATIVE * scale or spec.max - value <= AT_BOUND_RELATIVE * scale
+    return spec.on_bound(value)
 
 
 def jacobian_covariance(residual: Callable[[dict], np.ndarray], values: Mapping[str, float],

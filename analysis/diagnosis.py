@@ -1,31 +1,41 @@
-"""Diagnosis: which physical effect does the model lack?
+"""Diagnosis: which physical effect does the model lack, and where is the physics missing?
 
 From a fitted model, every candidate (add an effect of a category the model
 does not have yet, or swap an effect for an alternative of its category) is
 refitted, warm-started from the current fit, and ranked by how much it
 lowers BIC. With honest per-line uncertainties BIC = chi^2 + k ln n, so an
-extra parameter must buy a chi^2 drop of ln n (about 7) to pay for itself:
-an effect that only fits noise raises BIC.
+extra parameter must buy a chi^2 drop of ln n (about 7) to pay for itself.
 
-The greedy path takes the best candidate while it lowers BIC by more than
-MIN_BIC_GAIN (10: "very strong" evidence on Kass and Raftery's scale) and
-stops when none does, so data with nothing missing end with nothing added.
+That alone is not enough far from the noise floor (at a reduced chi^2 of
+10^4 any flexible effect lowers BIC by thousands), so the greedy path takes
+the best-ranked candidate that passes the acceptance rule of
+analysis.acceptance: no flag, a gain at the misfit's own scale, and no more
+misfit left than a smooth correction at its site leaves. It stops when none
+does, or at the step cap. Then the site localisation (analysis.sites) says
+where the misfit that is left belongs, and the verdict says how much the
+catalogue explained.
 """
 from __future__ import annotations
 
+import dataclasses
 import threading
 from concurrent.futures import Executor
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable
 
+from analysis import acceptance, residuals
+from analysis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.effects import CATALOGUE, Effect
+from analysis.effects.base import Site
 from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
 from analysis.model import Model
-from analysis.startvalues import start_context
-from analysis import residuals
+from analysis.sites import SiteResult, fit_site, localise
+from analysis.startvalues import StartContext, phase_slope, start_context
 
-MIN_BIC_GAIN = 10.0
 MAX_STEPS = 6
+
+__all__ = ["MIN_BIC_GAIN", "MAX_STEPS", "Candidate", "Step", "Diagnosis", "candidate_models", "rank_candidates",
+           "diagnose", "explain"]
 
 
 @dataclass(frozen=True)
@@ -36,10 +46,16 @@ class Candidate:
     fit: FitResult | None        # None when the refit failed
     delta_bic: float             # BIC(candidate) - BIC(current); negative is better
     error: str | None = None
+    flags: tuple[Flag, ...] = ()
+    assessment: Assessment | None = None
 
     @property
     def effects(self) -> tuple[str, ...]:
         return self.fit.model.effect_ids if self.fit else ()
+
+    @property
+    def accepted(self) -> bool:
+        return self.assessment is not None and self.assessment.accepted
 
 
 @dataclass(frozen=True)
@@ -48,11 +64,14 @@ class Step:
     candidates: tuple[Candidate, ...]   # ranked, best first, from this step's model
     residual: str                       # where the residual sat before choosing
     chosen: Candidate | None
+    flags: tuple[Flag, ...] = ()        # of this step's model (and the step cap on the last one)
 
 
 @dataclass(frozen=True)
 class Diagnosis:
     steps: tuple[Step, ...]
+    sites: tuple[SiteResult, ...] = ()   # of the final model, best first
+    step_cap_reached: bool = False
 
     @property
     def start(self) -> FitResult:
@@ -66,13 +85,25 @@ class Diagnosis:
     def first_candidates(self) -> tuple[Candidate, ...]:
         return self.steps[0].candidates
 
+    @property
+    def steps_taken(self) -> int:
+        return sum(1 for step in self.steps if step.chosen is not None)
+
+    @property
+    def verdict(self) -> str:
+        return acceptance.verdict(self.start, self.final, self.steps_taken)
+
+    @property
+    def final_flags(self) -> tuple[Flag, ...]:
+        return self.steps[-1].flags
+
 
 def candidate_models(model: Model) -> list[tuple[str, Effect, Effect | None, Model]]:
     """Every model one move away: add an effect of a new category, or swap one within its category."""
     present = {e.category: e for e in model.effects}
     moves = []
     for effect in CATALOGUE.values():
-        if not model.with_displacement and effect.site.name == "DISPLACEMENT":
+        if not model.with_displacement and effect.site is Site.DISPLACEMENT:
             continue
         current = present.get(effect.category)
         if current is None:
@@ -95,13 +126,32 @@ def _run(calls, executor: Executor | None, cancel: threading.Event | None) -> li
     return [_outcome(lambda: fn(*args), cancel) for fn, args in calls]
 
 
-def _best_starts(data: FitData, current: FitResult, moves, executor, cancel) -> dict[int, dict]:
+def _outcome(call, cancel: threading.Event | None = None) -> tuple[FitResult | None, str | None]:
+    try:
+        return call(), None
+    except (FitError, ValueError, ArithmeticError) as exc:
+        if cancel is not None and cancel.is_set():
+            raise
+        return None, str(exc)
+
+
+def residual_context(data: FitData, current: FitResult) -> StartContext:
+    """The data's start context plus what the current fit leaves: the phase slopes where delays start."""
+    ctx = start_context(data.impedance)
+    slopes = {}
+    for name, field in (("impedance", "z_phase_slope"), ("displacement", "x_phase_slope")):
+        ch = current.channels.get(name)
+        if ch is not None and ch.has_phase:
+            slopes[field] = phase_slope(ch.freqs, ch.measured, ch.model, ch.std)
+    return dataclasses.replace(ctx, **slopes)
+
+
+def _best_starts(data: FitData, current: FitResult, moves, ctx, executor, cancel) -> dict[int, dict]:
     """For effects that ask for several start points (a narrow resonance), the most promising one.
 
     Each start is screened by a short fit of the new effect's parameters
     alone; only the best goes on to the full refit.
     """
-    ctx = start_context(data.impedance)
     calls, owners = [], []
     for index, (_, effect, _, model) in enumerate(moves):
         starts = effect.starts(ctx)
@@ -118,10 +168,14 @@ def _best_starts(data: FitData, current: FitResult, moves, executor, cancel) -> 
 
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
                     cancel: threading.Event | None = None) -> tuple[Candidate, ...]:
-    """Every candidate refitted, warm-started from `current`, ranked by delta BIC (best first)."""
+    """Every candidate refitted, warm-started from `current`, flagged and ranked by delta BIC (best first).
+
+    Their assessment applies rules 1 and 2 of the acceptance rule; rule 3
+    (the site's correction) is applied by the greedy path to those that pass.
+    """
     moves = candidate_models(current.model)
-    screened = _best_starts(data, current, moves, executor, cancel)
-    ctx = start_context(data.impedance)
+    ctx = residual_context(data, current)
+    screened = _best_starts(data, current, moves, ctx, executor, cancel)
     calls = []
     for index, (_, effect, _, model) in enumerate(moves):
         # The new effect starts from its guess; the rest from the current fit.
@@ -129,18 +183,42 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
         calls.append((_refit, (data, model, start, None if executor else cancel)))
     candidates = []
     for (action, effect, replaces, _), (fit, error) in zip(moves, _run(calls, executor, cancel)):
+        flags = acceptance.candidate_flags(current, fit, effect)
         candidates.append(Candidate(action, effect, replaces, fit,
-                                    (fit.bic - current.bic) if fit else float("inf"), error))
+                                    (fit.bic - current.bic) if fit else float("inf"), error, flags,
+                                    acceptance.assess(current, fit, effect, flags)))
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
 
 
-def _outcome(call, cancel: threading.Event | None = None) -> tuple[FitResult | None, str | None]:
-    try:
-        return call(), None
-    except (FitError, ValueError, ArithmeticError) as exc:
-        if cancel is not None and cancel.is_set():
-            raise
-        return None, str(exc)
+class _SiteFits:
+    """The site corrections of one model, each fitted once, on the pool when there is one."""
+
+    def __init__(self, data: FitData, fit: FitResult, executor: Executor | None):
+        self.data, self.fit, self.executor = data, fit, executor
+        self.done: dict[Site, SiteResult] = {}
+
+    def need(self, sites) -> None:
+        wanted = [s for s in dict.fromkeys(sites) if s not in self.done]
+        if self.executor is not None:
+            futures = [(s, self.executor.submit(fit_site, self.data, self.fit, s)) for s in wanted]
+            self.done.update((s, f.result()) for s, f in futures)
+        else:
+            self.done.update((s, fit_site(self.data, self.fit, s)) for s in wanted)
+
+
+def choose(data: FitData, current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
+           ) -> tuple[tuple[Candidate, ...], Candidate | None]:
+    """Rule 3 for the candidates that pass rules 1 and 2; the best accepted one (None: stop)."""
+    passing = [c for c in ranked if c.accepted]
+    sites.need(c.effect.site for c in passing)
+    judged = []
+    for c in ranked:
+        if c.accepted:
+            site = sites.done[c.effect.site]
+            c = dataclasses.replace(c, assessment=acceptance.assess(current, c.fit, c.effect, c.flags, site))
+        judged.append(c)
+    chosen = next((c for c in judged if c.accepted), None)
+    return tuple(judged), chosen
 
 
 def explain(current: FitResult, candidate: Candidate) -> str:
@@ -153,27 +231,49 @@ def explain(current: FitResult, candidate: Candidate) -> str:
     change = ", ".join(f"{ch} {before[ch]:.3g} -> {after[ch]:.3g}" for ch in before if ch in after)
     verb = f"replacing {candidate.replaces.id} by {effect.id}" if candidate.replaces else f"adding {effect.id}"
     head = f"{verb} ({effect.title}) changes the reduced chi^2 {change}, delta BIC {candidate.delta_bic:+.1f}."
-    if candidate.delta_bic > -MIN_BIC_GAIN:
+    assessment = candidate.assessment
+    if assessment is None or (not assessment.accepted and assessment.reason == acceptance.NO_GAIN
+                              and candidate.delta_bic > -MIN_BIC_GAIN):
         return head + " Not enough to pay for its parameters: the data do not ask for it."
+    if not assessment.accepted:
+        return f"{head} Not taken: {assessment.message}."
     return f"{head} It cures: {effect.signature} Physically: {effect.physics}"
 
 
 def diagnose(data: FitData, start_model: Model, executor: Executor | None = None,
              cancel: threading.Event | None = None, start_fit: FitResult | None = None,
-             progress: Callable[[str], None] | None = None, max_steps: int = MAX_STEPS) -> Diagnosis:
-    """Rank the candidates from `start_model`, then follow the greedy path."""
+             progress: Callable[[str], None] | None = None, max_steps: int = MAX_STEPS,
+             locate: bool = True) -> Diagnosis:
+    """Rank the candidates from `start_model`, follow the greedy path, then locate what is left.
+
+    max_steps=1 ranks the start model's candidates and adopts the best acceptable one (the
+    model lab's "Diagnose"); locate=False skips the site localisation of the final model.
+    """
     current = start_fit or fit_model(data, start_model, cancel=cancel)
     steps: list[Step] = []
+    capped = False
     while True:
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
         ranked = rank_candidates(data, current, executor, cancel)
-        best = ranked[0] if ranked and ranked[0].delta_bic < -MIN_BIC_GAIN else None
-        steps.append(Step(current, ranked, residuals.describe(current), best))
+        sites = _SiteFits(data, current, executor)
+        ranked, best = choose(data, current, ranked, sites)
+        step_flags = tuple(acceptance.parameter_flags(current) + acceptance.noise_flags(current))
+        steps.append(Step(current, ranked, residuals.describe(current), best, step_flags))
         if best is None:
             break
         current = best.fit
         if len(steps) == max_steps:   # out of steps: the last model, not ranked further
-            steps.append(Step(current, (), residuals.describe(current), None))
+            capped = True
+            cap = Flag(acceptance.STEP_CAP, f"the path stopped at its cap of {max_steps} step(s): the last model "
+                                            "was not ranked further")
+            sites = _SiteFits(data, current, executor)
+            steps.append(Step(current, (), residuals.describe(current), None,
+                              tuple(acceptance.parameter_flags(current) + acceptance.noise_flags(current)) + (cap,)))
             break
-    return Diagnosis(tuple(steps))
+    located: tuple[SiteResult, ...] = ()
+    if locate:
+        if progress:
+            progress("looking for the site of the misfit left")
+        located = localise(data, current, executor, known=sites.done)
+    return Diagnosis(tuple(steps), located, capped)

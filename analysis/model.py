@@ -3,11 +3,16 @@
     Ze(s) = RE + s*LE + sum(blocked effects)
     Y(s)  = s*CMES + 1/RES + 1/(s*LCES*c(s)) + sum(mechanical effects)   c(s): product of compliance factors
     ZR(s) = 1 / Y(s)
-    Z(s)  = (Ze + ZR) * prod(current-channel factors)
-    Hx(s) = ZR / (ZR + Ze) / (Bl*s) * prod(displacement-channel factors)
+    g(s)  = prod(force-factor effects)                                   1 without any
+    Zd(s) = Ze + g^2 * ZR                                                the driver's own impedance
+    Z(s)  = Zd * prod(current-channel factors)
+    Hx(s) = g * ZR / (Zd * Bl * s) * prod(displacement-channel factors)
 
 The motional branch is written as an admittance so that mechanical effects
-(which add to Zm, and Y = Zm / Bl^2) simply add. Bl only scales Hx.
+(which add to Zm, and Y = Zm / Bl^2) simply add. Bl only scales Hx. A
+force-factor effect multiplies Bl in the force and in the back-EMF alike
+(physics.md section 8: U = Ze*I + g*Bl*v, g*Bl*I = Zm*v), hence g^2 in Z and
+g in Hx; with g = 1 Hx is the textbook ZR / (ZR + Ze) / (Bl*s).
 """
 from __future__ import annotations
 
@@ -102,9 +107,25 @@ class Model:
             Y = Y + effect.response(s, p)
         return 1.0 / Y
 
+    def force_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray | None:
+        """g(s), the factor on Bl; None when no effect acts there (g = 1, nothing to multiply)."""
+        effects = self._site(Site.FORCE_FACTOR)
+        if not effects:
+            return None
+        g = np.ones_like(s)
+        for effect in effects:
+            g = g * effect.response(s, p)
+        return g
+
+    def driver_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        """Zd = Ze + g^2 * ZR: the driver's impedance, before the current channel sees it."""
+        ZR = self.motional_impedance(s, p)
+        g = self.force_factor(s, p)
+        return self.blocked_impedance(s, p) + (ZR if g is None else g * g * ZR)
+
     def impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
         """Z = U / I as the current channel measures it."""
-        Z = self.blocked_impedance(s, p) + self.motional_impedance(s, p)
+        Z = self.driver_impedance(s, p)
         for effect in self._site(Site.CURRENT):
             Z = Z * effect.response(s, p)
         return Z
@@ -113,7 +134,11 @@ class Model:
         """Hx = X / U as the displacement channel measures it."""
         Ze = self.blocked_impedance(s, p)
         ZR = self.motional_impedance(s, p)
-        Hx = ZR / (ZR + Ze) / (p["Bl"] * s)
+        g = self.force_factor(s, p)
+        if g is None:
+            Hx = ZR / (ZR + Ze) / (p["Bl"] * s)
+        else:
+            Hx = g * ZR / (Ze + g * g * ZR) / (p["Bl"] * s)
         for effect in self._site(Site.DISPLACEMENT):
             Hx = Hx * effect.response(s, p)
         return Hx

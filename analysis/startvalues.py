@@ -33,6 +33,10 @@ class StartContext:
     LE_high: float      # Im(Z) / w at the top lines
     f_min: float
     f_max: float
+    # The slope d(phase)/dw (s) of measured / model over the top octave, once a model has been
+    # fitted (analysis.diagnosis sets them): where a delay should start. 0 before any fit.
+    z_phase_slope: float = 0.0
+    x_phase_slope: float = 0.0
 
     @property
     def CMES(self) -> float:
@@ -108,3 +112,27 @@ def linear_gain(model_values: np.ndarray, measured: np.ndarray, std: np.ndarray)
     num = np.sum(w[ok] * (np.conj(model_values[ok]) * measured[ok]).real)
     den = np.sum(w[ok] * np.abs(model_values[ok]) ** 2)
     return float(num / den)
+
+
+TOP_BAND_RATIO = 2.0     # the top octave
+
+
+def phase_slope(freqs: np.ndarray, measured: np.ndarray, model_values: np.ndarray, std: np.ndarray) -> float:
+    """d(phase)/dw of measured / model over the top octave, weighted by each line's noise (s).
+
+    The phase is unwrapped from the lowest line up, so a delay whose phase
+    wraps at the top is followed as long as it moves less than half a turn
+    between neighbouring lines. A pure delay tau leaves exactly w*tau; a
+    model whose other parameters have bent to absorb some of it leaves less.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = measured / model_values
+        weight = (np.abs(measured) / np.maximum(std, 1e-300)) ** 2
+    ok = np.isfinite(ratio) & np.isfinite(weight) & (ratio != 0)
+    if ok.sum() < 2:
+        return 0.0
+    f, phase, weight = freqs[ok], np.unwrap(np.angle(ratio[ok])), weight[ok]
+    top = f >= f[-1] / TOP_BAND_RATIO
+    w = 2.0 * np.pi * f[top]
+    den = float(np.sum(weight[top] * w * w))
+    return float(np.sum(weight[top] * w * phase[top]) / den) if den > 0 else 0.0

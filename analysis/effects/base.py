@@ -17,13 +17,38 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 class Site(Enum):
-    """Where an effect's response enters the model (see analysis.model.evaluate)."""
+    """Where an effect's response enters the model (physics.md section 8; analysis.model composes them).
 
-    BLOCKED = "blocked electrical impedance"      # added to Ze = RE + s*LE
-    COMPLIANCE = "compliance"                     # multiplies Cms (so LCES) by a factor
+    The member's `key` is the site's name in files, JSON and on screen: the
+    same six names are the sites of the catalogue, of the site localisation
+    (analysis.sites) and of effects of the user's own.
+    """
+
+    BLOCKED = "blocked electrical impedance"      # added to Ze = RE + s*LE (ohm)
+    FORCE_FACTOR = "force factor"                 # multiplies Bl, in the force and the back-EMF alike
     MECHANICAL = "mechanical impedance"           # added to Zm / Bl^2 (the motional admittance)
+    COMPLIANCE = "compliance"                     # multiplies Cms (so LCES) by a factor
     CURRENT = "current channel"                   # multiplies the measured Z = U / I
     DISPLACEMENT = "displacement channel"         # multiplies the measured Hx = X / U
+
+    @property
+    def key(self) -> str:
+        return SITE_KEYS[self]
+
+    @classmethod
+    def from_key(cls, key: str) -> "Site":
+        for site, name in SITE_KEYS.items():
+            if name == key:
+                return site
+        raise KeyError(f"unknown site {key!r}; the sites are: {', '.join(SITE_KEYS.values())}")
+
+
+SITE_KEYS = {Site.BLOCKED: "electrical", Site.FORCE_FACTOR: "force-factor", Site.MECHANICAL: "mechanical",
+             Site.COMPLIANCE: "compliance", Site.CURRENT: "current", Site.DISPLACEMENT: "displacement"}
+
+
+# A parameter this close (relative to its size) to a bound is "on" it.
+AT_BOUND_RELATIVE = 1e-6
 
 
 @dataclass(frozen=True, slots=True)
@@ -38,6 +63,21 @@ class ParamSpec:
     max: float
     default: float             # start value when the data give no better guess
     description: str
+    # Where the value usually lies (SI); the diagnosis flags a fit that ends outside. None: no range.
+    typical: tuple[float, float] | None = None
+
+    def on_bound(self, value: float) -> bool:
+        """True when `value` sits on a bound (within AT_BOUND_RELATIVE of the value's size)."""
+        scale = max(abs(self.default), abs(value), 1e-300)
+        return value - self.min <= AT_BOUND_RELATIVE * scale or self.max - value <= AT_BOUND_RELATIVE * scale
+
+    def typical_text(self) -> str:
+        """'0.01 to 10 mH': the typical range in display units, for the catalogue and flags."""
+        if self.typical is None:
+            return ""
+        lo, hi = (v * self.display_scale for v in self.typical)
+        unit = "" if self.display_unit in ("-", "1") else f" {self.display_unit}"
+        return f"{lo:.3g} to {hi:.3g}{unit}"
 
 
 @dataclass(frozen=True)
@@ -84,9 +124,11 @@ class Effect:
             "category": self.category,
             "title": self.title,
             "acts_on": self.site.value,
+            "site": self.site.key,
             "parameters": [
                 {"name": p.name, "unit": p.unit, "display_unit": p.display_unit, "display_scale": p.display_scale,
-                 "min": p.min, "max": p.max, "default": p.default, "description": p.description}
+                 "min": p.min, "max": p.max, "default": p.default, "description": p.description,
+                 "typical": list(p.typical) if p.typical else None}
                 for p in self.params
             ],
             "physics": self.physics,

@@ -82,9 +82,11 @@ breakup = Breakup(
     category=CATEGORY,
     title="Cone breakup (a second mechanical mode)",
     site=Site.MECHANICAL,
-    params=(ParamSpec("f2", "Hz", "Hz", 1.0, 10.0, 1e5, 700.0, "resonance of the decoupling mass on its coupling"),
-            ParamSpec("Q2", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of the breakup mode"),
-            ParamSpec("mu2", "1", "%", 100.0, 1e-4, 0.95, START_MU2, "decoupling mass as a fraction of Mms")),
+    params=(ParamSpec("f2", "Hz", "Hz", 1.0, 10.0, 1e5, 700.0, "resonance of the decoupling mass on its coupling",
+                      typical=(150.0, 2e4)),
+            ParamSpec("Q2", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of the breakup mode", typical=(1.0, 50.0)),
+            ParamSpec("mu2", "1", "%", 100.0, 1e-4, 0.95, START_MU2, "decoupling mass as a fraction of Mms",
+                      typical=(0.01, 0.6))),
     physics=("Above some frequency the cone no longer moves as one piece: its outer part (a mass m2) swings "
              "on the cone's own bending stiffness. At that resonance it holds the coil nearly still, just "
              "above it cone and outer part move against each other, and above both the coil drives a "
@@ -133,8 +135,9 @@ breakup_spot = SpotMode(
     category=CATEGORY,
     title="Cone breakup seen at the laser spot only",
     site=Site.DISPLACEMENT,
-    params=(ParamSpec("f2x", "Hz", "Hz", 1.0, 10.0, 1e5, 2000.0, "resonance of the cone area under the laser spot"),
-            ParamSpec("Q2x", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of that local mode")),
+    params=(ParamSpec("f2x", "Hz", "Hz", 1.0, 10.0, 1e5, 2000.0, "resonance of the cone area under the laser spot",
+                      typical=(300.0, 2e4)),
+            ParamSpec("Q2x", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of that local mode", typical=(1.0, 50.0))),
     physics=("The laser measures one spot of the cone, not the coil. When the cone bends, that spot moves "
              "more than the coil near its local resonance and less above it, while the coil, and so the "
              "impedance, hardly notices: the mode's mass is small."),

@@ -18,7 +18,8 @@ from analysis.effects.base import Effect, ParamSpec, Site
 CURRENT_CATEGORY = "electrical-channel"
 DISPLACEMENT_CATEGORY = "displacement-sensor"
 
-FC_X = ParamSpec("fc_x", "Hz", "Hz", 1.0, 10.0, 1e6, 5e3, "corner frequency of the displacement sensor")
+FC_X = ParamSpec("fc_x", "Hz", "Hz", 1.0, 10.0, 1e6, 5e3, "corner frequency of the displacement sensor",
+                 typical=(200.0, 1e5))
 
 _CURRENT_GAIN_NOTE = (
     "A gain error g of the current sense (I_measured = g*I) is NOT identifiable and is deliberately not an "
@@ -27,6 +28,10 @@ _CURRENT_GAIN_NOTE = (
     "(ZR/(ZR + Ze) only depends on ratios of impedances). Bl comes out right, but Mms = CMES*Bl^2, "
     "Cms = LCES/Bl^2 and Rms = Bl^2/RES come out wrong by the factor g. Calibrate the current sense instead "
     "(a known resistor in place of the driver).")
+
+
+def _clipped(value: float, spec: ParamSpec) -> float:
+    return float(min(max(value, spec.min), spec.max))
 
 
 @dataclass(frozen=True)
@@ -42,7 +47,8 @@ class CurrentDelay(Effect):
         return np.exp(s * p["tau_i"])
 
     def guess(self, ctx):
-        return {"tau_i": 0.0}
+        # Z_measured / Z = exp(j*w*tau_i): the slope of the phase the current model leaves over.
+        return {"tau_i": _clipped(ctx.z_phase_slope, self.params[0])}
 
 
 delay_current = CurrentDelay(
@@ -51,7 +57,7 @@ delay_current = CurrentDelay(
     title="Delay of the current channel",
     site=Site.CURRENT,
     params=(ParamSpec("tau_i", "s", "us", 1e6, -1e-3, 1e-3, 0.0,
-                      "delay of the current channel after the voltage channel"),),
+                      "delay of the current channel after the voltage channel", typical=(-2e-4, 2e-4)),),
     physics=("The voltage and current are sampled through different paths (sense amplifier, converter "
              "channels, their filters): when one path is slower, the measured current is a delayed copy of the "
              "true one. That rotates the phase of Z in proportion to frequency without changing |Z|."),
@@ -60,9 +66,10 @@ delay_current = CurrentDelay(
     typical="|tau_i| 0 to 50 us (a sample at 48 kHz is 20.8 us)",
     reference=("R. Pintelon, J. Schoukens, 'System Identification: A Frequency Domain Approach', 2nd ed., "
                "Wiley-IEEE Press, 2012 (delays and calibration of the measurement channels)"),
-    notes=("The start of 0 converged in tests up to |tau_i| = 0.2 ms with lines from 5 Hz to 10 kHz (the "
-           "low lines lock the fit before the phase at the top wraps); at 0.3 ms it did not: larger delays "
-           "need a start from the slope of the phase. " + _CURRENT_GAIN_NOTE),
+    notes=("The fit starts from the slope of the phase that the current model leaves in Z over the top "
+           "octave (analysis.startvalues.phase_slope): a start of 0 can end in a local minimum when the "
+           "model is far from the data (a hidden -50 us did, at -7 us, with a reduced chi^2 of 3e8 to "
+           "start from). " + _CURRENT_GAIN_NOTE),
 )
 
 
@@ -89,7 +96,8 @@ lowpass_current = CurrentLowPass(
     title="Bandwidth of the current sense (first-order low-pass)",
     site=Site.CURRENT,
     params=(ParamSpec("fc_i", "Hz", "kHz", 1e-3, 100.0, 1e7, 50e3,
-                      "corner frequency of the current channel relative to the voltage channel"),),
+                      "corner frequency of the current channel relative to the voltage channel",
+                      typical=(1e3, 5e6)),),
     physics=("The current is sensed by a small shunt and an amplifier whose bandwidth, or an extra filter, "
              "is lower than the voltage path's: the measured current falls and lags at the top of the band, "
              "so the measured |Z| rises and its phase leads."),
@@ -113,7 +121,8 @@ class DisplacementDelay(Effect):
         return np.exp(-s * p["tau_x"])
 
     def guess(self, ctx):
-        return {"tau_x": 0.0}
+        # Hx_measured / Hx = exp(-j*w*tau_x): minus the slope of the phase left over.
+        return {"tau_x": _clipped(-ctx.x_phase_slope, self.params[0])}
 
 
 delay_x = DisplacementDelay(
@@ -122,7 +131,7 @@ delay_x = DisplacementDelay(
     title="Delay of the displacement channel",
     site=Site.DISPLACEMENT,
     params=(ParamSpec("tau_x", "s", "us", 1e6, -5e-3, 5e-3, 0.0,
-                      "delay of the displacement channel after the voltage channel"),),
+                      "delay of the displacement channel after the voltage channel", typical=(0.0, 2e-3)),),
     physics=("A triangulation laser computes each distance from a camera exposure, so its output comes a "
              "little late; a laser on its own clock is also aligned to the audio only to within some residual. "
              "Either way the measured displacement is a delayed copy of the true one."),
@@ -131,9 +140,10 @@ delay_x = DisplacementDelay(
     typical="0 to 1 ms (sensor latency of a few measuring periods; ILD1420 at 4 kHz: 0.25 ms each)",
     reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate and output latency); shared/spec/laser-ild1420.md",
     notes=("Below a low-pass's corner frequency a delay and a first-order low-pass look alike (a phase lag "
-           "proportional to f): lowpass-x is the alternative when |Hx| also drops at the top. The start "
-           "of 0 converged in tests up to |tau_x| = 0.3 ms with lines from 5 Hz to 10 kHz; larger delays "
-           "need a start from the slope of the phase of Hx (or a better alignment of the laser)."),
+           "proportional to f): lowpass-x is the alternative when |Hx| also drops at the top. The fit "
+           "starts from the slope of the phase that the current model leaves in Hx over the top octave "
+           "(unwrapped from the lowest line up), so delays are found as long as the phase moves less than "
+           "half a turn from one line to the next."),
 )
 
 
@@ -191,7 +201,7 @@ lowpass2_x = DisplacementLowPass2(
     title="Displacement sensor bandwidth (second-order low-pass)",
     site=Site.DISPLACEMENT,
     params=(FC_X, ParamSpec("Q_x", "1", "-", 1.0, 0.1, 20.0, 1.0 / np.sqrt(2.0),
-                            "quality factor of the sensor's low-pass")),
+                            "quality factor of the sensor's low-pass", typical=(0.3, 3.0))),
     physics=("A sensor whose output filter (or a velocity probe's mechanics) is second order: flat, then "
              "falling twice as steeply as an RC filter, possibly with a small peak before the fall."),
     signature=("Like lowpass-x but the top-band |Hx| falls as 1/f^2 and the phase lag reaches 90 degrees at "

@@ -21,7 +21,7 @@ from analysis.lumped import resonance_frequency
 
 CATEGORY = "creep"
 LAMBDA = ParamSpec("lambda", "1", "-", 1.0, -0.5, 2.0, 0.05,
-                   "relative change of the compliance per decade away from fs")
+                   "relative change of the compliance per decade away from fs", typical=(0.0, 1.0))
 # The retardation-spectrum law starts its creep this far above fs (Speakerbench's choice).
 RETARDATION_CORNER_OVER_FS = 1.5
 
@@ -124,8 +124,9 @@ creep_3p = CreepThreeParameter(
     title="Three-parameter creep (standard linear solid)",
     site=Site.COMPLIANCE,
     params=(ParamSpec("kappa", "1", "%", 100.0, 0.0, 10.0, 0.2,
-                      "extra compliance at DC, relative to the high-frequency compliance"),
-            ParamSpec("tau_r", "s", "ms", 1e3, 1e-5, 10.0, 5e-3, "retardation time of the creep")),
+                      "extra compliance at DC, relative to the high-frequency compliance", typical=(0.01, 3.0)),
+            ParamSpec("tau_r", "s", "ms", 1e3, 1e-5, 10.0, 5e-3, "retardation time of the creep",
+                      typical=(1e-4, 1.0))),
     physics=("The suspension is modelled as a spring in series with a second, damped spring: under a slow "
              "force the damped spring yields too, so below a transition frequency 1/(2*pi*tau_r) the "
              "compliance is (1 + kappa) times larger. Unlike the logarithmic laws it stays finite at DC."),
@@ -161,7 +162,8 @@ creep_fractional = CreepFractional(
     category=CATEGORY,
     title="Fractional-derivative creep (power law)",
     site=Site.COMPLIANCE,
-    params=(ParamSpec("beta", "1", "-", 1.0, -0.2, 0.5, 0.02, "order of the fractional stiffness"),),
+    params=(ParamSpec("beta", "1", "-", 1.0, -0.2, 0.5, 0.02, "order of the fractional stiffness",
+                      typical=(0.0, 0.3)),),
     physics=("The suspension's stiffness behaves between a spring (order 0) and a damper (order 1): it grows "
              "as a small power beta of frequency. The compliance then rises by a constant factor per decade "
              "towards low frequencies, with a loss that is the same at every frequency."),

@@ -17,8 +17,8 @@ from analysis.effects.base import Effect, ParamSpec, Site
 
 CATEGORY = "inductance"
 
-L2 = ParamSpec("L2", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "para-inductance")
-R2 = ParamSpec("R2", "ohm", "ohm", 1.0, 0.0, 1e4, 4.0, "eddy-current loss resistance")
+L2 = ParamSpec("L2", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "para-inductance", typical=(1e-5, 1e-2))
+R2 = ParamSpec("R2", "ohm", "ohm", 1.0, 0.0, 1e4, 4.0, "eddy-current loss resistance", typical=(0.1, 100.0))
 
 
 def _top_angular_frequency(ctx) -> float:
@@ -81,8 +81,9 @@ lr3 = LR3(
     title="LR-3 (two LR stages: L2||R2 and L3||R3)",
     site=Site.BLOCKED,
     params=(L2, R2,
-            ParamSpec("L3", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "second para-inductance"),
-            ParamSpec("R3", "ohm", "ohm", 1.0, 0.0, 1e4, 1.0, "second eddy-current loss resistance")),
+            ParamSpec("L3", "H", "mH", 1e3, 0.0, 1.0, 2e-4, "second para-inductance", typical=(1e-5, 1e-2)),
+            ParamSpec("R3", "ohm", "ohm", 1.0, 0.0, 1e4, 1.0, "second eddy-current loss resistance",
+                      typical=(0.05, 100.0))),
     physics=("Like LR-2, but the eddy currents are modelled by two shorted secondary windings with different "
              "corner frequencies (pole piece and front plate, or the skin depth changing with frequency): "
              "the inductance falls in two steps, which follows the slow, spread-out fall of real motors better."),
@@ -120,8 +121,9 @@ leach = Leach(
     category=CATEGORY,
     title="Leach semi-inductance K*(jw)^n",
     site=Site.BLOCKED,
-    params=(ParamSpec("K", "ohm*s^n", "ohm*s^n", 1.0, 0.0, 10.0, 5e-3, "semi-inductance coefficient"),
-            ParamSpec("n", "1", "-", 1.0, 0.01, 0.99, 0.6, "exponent of the semi-inductance")),
+    params=(ParamSpec("K", "ohm*s^n", "ohm*s^n", 1.0, 0.0, 10.0, 5e-3, "semi-inductance coefficient",
+                      typical=(1e-4, 0.2)),
+            ParamSpec("n", "1", "-", 1.0, 0.01, 0.99, 0.6, "exponent of the semi-inductance", typical=(0.3, 0.95))),
     physics=("Eddy currents diffuse into the iron: the deeper they reach at low frequencies, the more iron "
              "they see. The result behaves like something between a resistance and an inductance whose "
              "impedance grows as a power of frequency, with a fixed phase angle n*90 degrees."),
@@ -168,10 +170,10 @@ wright = Wright(
     category=CATEGORY,
     title="Wright empirical model Rw*(w/w_ref)^Er + j*Xw*(w/w_ref)^Ei",
     site=Site.BLOCKED,
-    params=(ParamSpec("Rw", "ohm", "ohm", 1.0, 0.0, 1e3, 1.0, "resistance the term adds at 1 kHz"),
-            ParamSpec("Er", "1", "-", 1.0, 0.01, 2.0, 0.7, "exponent of the resistance"),
-            ParamSpec("Xw", "ohm", "ohm", 1.0, 0.0, 1e3, 2.0, "reactance the term adds at 1 kHz"),
-            ParamSpec("Ei", "1", "-", 1.0, 0.01, 0.99, 0.7, "exponent of the reactance")),
+    params=(ParamSpec("Rw", "ohm", "ohm", 1.0, 0.0, 1e3, 1.0, "resistance the term adds at 1 kHz", typical=(0.01, 100.0)),
+            ParamSpec("Er", "1", "-", 1.0, 0.01, 2.0, 0.7, "exponent of the resistance", typical=(0.2, 1.5)),
+            ParamSpec("Xw", "ohm", "ohm", 1.0, 0.0, 1e3, 2.0, "reactance the term adds at 1 kHz", typical=(0.01, 100.0)),
+            ParamSpec("Ei", "1", "-", 1.0, 0.01, 0.99, 0.7, "exponent of the reactance", typical=(0.2, 0.95))),
     physics=("An empirical description of the lossy coil: the resistance and the reactance added by eddy "
              "currents each grow as their own power of frequency. It fits most motors well with four "
              "numbers, but it is a curve fit, not a circuit."),

@@ -1,0 +1,123 @@
+"""A smooth, flexible complex correction at one site of the model: what the site localisation fits.
+
+The correction is a complex function of frequency,
+
+    h(f) = sum_k (a_k + j*b_k) * B_k(ln f)
+
+with cubic B-splines B_k on knots evenly spaced in ln f over the measured
+band (KNOTS_PER_DECADE). It enters the model the way an effect at that site
+does (physics.md section 8), in a form that is smooth for the physics
+expected there:
+
+    electrical     Ze + RE0 * h          ohms added to the blocked impedance (RE0: RE of the fit it starts from)
+    force-factor   Bl * (1 + h)          in the force and the back-EMF alike
+    mechanical     Zm + Rms0 * h         kg/s added to the mechanical impedance (Y += h / RES0)
+    compliance     Cms * (1 + h)
+    current        the measured I * (1 + h)     so Z is divided by it
+    displacement   the measured X * (1 + h)     so Hx is multiplied by it
+
+It is an Effect like any other (its parameters are the a_k and b_k), so the
+model composes it with the catalogue's effects at the same sites.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from analysis.effects.base import Effect, ParamSpec, Site
+
+KNOTS_PER_DECADE = 6.0
+SPLINE_DEGREE = 3
+CATEGORY = "site-correction"
+COEFFICIENT_BOUND = 1e3
+
+
+def spline_knots(f_lo: float, f_hi: float, per_decade: float = KNOTS_PER_DECADE) -> np.ndarray:
+    """Clamped cubic B-spline knots in ln f, evenly spaced from f_lo to f_hi."""
+    lo, hi = np.log(f_lo), np.log(f_hi)
+    intervals = max(2, int(np.ceil((hi - lo) / np.log(10.0) * per_decade)))
+    inner = np.linspace(lo, hi, intervals + 1)
+    return np.concatenate([[lo] * SPLINE_DEGREE, inner, [hi] * SPLINE_DEGREE])
+
+
+def spline_design(knots: np.ndarray, freqs: np.ndarray) -> np.ndarray:
+    """(lines x basis functions) values of the B-splines at ln f, clipped to the knots' span."""
+    x = np.clip(np.log(freqs), knots[0], knots[-1])
+    return BSpline.design_matrix(x, knots, SPLINE_DEGREE).toarray()
+
+
+def coefficient_names(n: int) -> tuple[tuple[str, str], ...]:
+    return _NAMES[n]
+
+
+class _Names(dict):
+    def __missing__(self, n: int) -> tuple[tuple[str, str], ...]:
+        names = self[n] = tuple((f"h{k}_re", f"h{k}_im") for k in range(n))
+        return names
+
+
+_NAMES = _Names()
+
+
+@dataclass(frozen=True)
+class SiteCorrection(Effect):
+    """A smooth complex correction at one site; see the module docstring for how each site takes it."""
+
+    knots: np.ndarray = field(default_factory=lambda: np.zeros(0), compare=False)
+    scale: float = 1.0                   # RE0 (electrical) or 1/RES0 (mechanical); unused elsewhere
+    offset: float = 0.0                  # added to h at every line: how analysis.sites differentiates
+    _designs: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def n_basis(self) -> int:
+        return len(self.knots) - SPLINE_DEGREE - 1
+
+    def design(self, freqs: np.ndarray) -> np.ndarray:
+        key = (len(freqs), float(freqs[0]), float(freqs[-1]))    # the fit evaluates the same lines again and again
+        matrix = self._designs.get(key)
+        if matrix is None:
+            matrix = self._designs[key] = spline_design(self.knots, freqs)
+        return matrix
+
+    def h(self, freqs: np.ndarray, p) -> np.ndarray:
+        coef = np.array([p[re] for re, _ in self.pairs]) + 1j * np.array([p[im] for _, im in self.pairs])
+        return self.design(freqs) @ coef + self.offset
+
+    @property
+    def pairs(self) -> tuple[tuple[str, str], ...]:
+        return _NAMES[self.n_basis]
+
+    def response(self, s, p):
+        h = self.h(np.abs(s) / (2.0 * np.pi), p)
+        if self.site is Site.BLOCKED or self.site is Site.MECHANICAL:
+            return self.scale * h
+        if self.site is Site.CURRENT:
+            return 1.0 / (1.0 + h)       # the model's current-site factor multiplies Z = U / I
+        return 1.0 + h
+
+    def factor(self, freqs: np.ndarray, p, model_values: dict[str, np.ndarray] | None = None) -> np.ndarray:
+        """The correction as a factor on the site's own quantity (Ze, Bl, Zm, Cms, I or X).
+
+        For the additive sites the factor is (Ze + dZe) / Ze and (Zm + dZm) / Zm,
+        which needs the fitted model's Ze or Y at `freqs` (model_values).
+        """
+        h = self.h(freqs, p)
+        if self.site is Site.BLOCKED:
+            return 1.0 + self.scale * h / model_values["Ze"]
+        if self.site is Site.MECHANICAL:
+            return 1.0 + self.scale * h / model_values["Y"]
+        return 1.0 + h
+
+
+def site_correction(site: Site, f_lo: float, f_hi: float, scale: float = 1.0) -> SiteCorrection:
+    knots = spline_knots(f_lo, f_hi)
+    n = len(knots) - SPLINE_DEGREE - 1
+    params = tuple(ParamSpec(name, "1", "-", 1.0, -COEFFICIENT_BOUND, COEFFICIENT_BOUND, 0.0,
+                             f"spline coefficient of the {site.key} correction")
+                   for pair in coefficient_names(n) for name in pair)
+    return SiteCorrection(
+        id=f"correction-{site.key}", category=CATEGORY, title=f"Smooth correction at the {site.key} site",
+        site=site, params=params, physics="", signature="", typical="", reference="",
+        knots=knots, scale=scale)

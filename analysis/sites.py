@@ -1,0 +1,240 @@
+"""Where the physics is missing: the site localisation.
+
+For each of the six sites of physics.md section 8, the current model gets a
+smooth, flexible complex correction there (analysis.site_correction) and is
+refitted with it, its own parameters free. The sites are ranked by how much
+misfit their correction removes, paid for by its effective number of
+parameters:
+
+    delta_bic = chi^2(with the correction) - chi^2(current) + edf * ln n
+
+edf is the trace of the correction's hat matrix: a roughness penalty
+(second differences of the spline coefficients) and a small ridge keep the
+correction smooth and pull a coefficient the data do not see back to zero,
+so a site that cannot act on part of the band (the compliance far above fs)
+pays for less than its knots.
+
+Each line's model depends on the correction only through h at that line, so
+the Jacobian columns of all the spline coefficients come from one extra
+model evaluation (h shifted by a constant): a site fit costs about as much
+as one refit of the model.
+
+What Z and Hx can tell apart, and what they cannot, is in docs/diagnosis.md.
+"""
+from __future__ import annotations
+
+import dataclasses
+from concurrent.futures import Executor
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from analysis.effects.base import Site
+from analysis.fit import FitData, FitResult, _sigmas
+from analysis.lumped import resonance_frequency
+from analysis.model import Model
+from analysis.site_correction import SiteCorrection, coefficient_names, site_correction
+
+SITES = (Site.BLOCKED, Site.FORCE_FACTOR, Site.MECHANICAL, Site.COMPLIANCE, Site.CURRENT, Site.DISPLACEMENT)
+ROUGHNESS_WEIGHT = 1.0       # on second differences of the coefficients, in noise units per unit of h
+RIDGE_WEIGHT = 0.1           # on the coefficients themselves
+MAX_EVALUATIONS = 150        # Jacobians: each costs one model evaluation per parameter of the model, plus one
+CORRECTION_POINTS = 120      # where the correction is reported
+DERIVATIVE_STEP = 1e-7       # the shift of h (and the relative step of the model's parameters)
+COMPLIANCE_TOP_OVER_FS = 2.0
+TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a ranking needs no more
+# The correction replaces what the model already has at its site: the base elements there and the
+# effects there are held at the current fit (the correction can take on any change of theirs, and
+# left free they would trade against it with no end, which stalls the fit). The compliance's creep
+# law stays free: its correction is held constant above 2 fs, where the law goes on shaping it.
+SITE_ELEMENTS = {Site.BLOCKED: ("RE", "LE"), Site.FORCE_FACTOR: ("Bl",), Site.MECHANICAL: ("RES",),
+                 Site.COMPLIANCE: ("LCES",), Site.CURRENT: (), Site.DISPLACEMENT: ("Bl",)}
+
+
+@dataclass(frozen=True)
+class SiteResult:
+    site: Site
+    chi2: float
+    chi2_by_channel: dict[str, float]
+    chi2_red: dict[str, float]
+    delta_bic: float
+    edf: float
+    freqs: np.ndarray             # where the correction is given (log-spaced over the band)
+    factor: np.ndarray            # complex factor on the site's own quantity (Ze, Bl, Zm, Cms, I or X)
+    success: bool
+
+    @property
+    def key(self) -> str:
+        return self.site.key
+
+    def as_json(self) -> dict:
+        return {"site": self.key, "delta_bic": float(self.delta_bic), "edf": float(self.edf),
+                "chi2_red": {k: float(v) for k, v in self.chi2_red.items()},
+                "correction": {"f": self.freqs.tolist(), "magnitude": np.abs(self.factor).tolist(),
+                               "phase_deg": np.degrees(np.angle(self.factor)).tolist()}}
+
+
+def usable_sites(model: Model) -> tuple[Site, ...]:
+    """Without the laser, the displacement site has nothing to act on."""
+    return tuple(s for s in SITES if s is not Site.DISPLACEMENT or model.with_displacement)
+
+
+def _band(data: FitData) -> tuple[float, float]:
+    freqs = [data.impedance.freqs] + ([data.displacement.freqs] if data.displacement is not None else [])
+    return float(min(f.min() for f in freqs)), float(max(f.max() for f in freqs))
+
+
+class _SiteProblem:
+    """The least-squares problem of one site: the model's parameters (relative to the current fit) and the
+    correction's coefficients; residual in noise units, then the penalty rows."""
+
+    def __init__(self, data: FitData, current: FitResult, correction: SiteCorrection):
+        self.data = data
+        self.correction = correction
+        self.model = current.model.with_effects(current.model.effects + (correction,))
+        self.use_x = self.model.with_displacement
+        self.sigmas = _sigmas(data, self.use_x)
+        self.channels = [data.impedance] + ([data.displacement] if self.use_x else [])
+        self.s = [2j * np.pi * tf.freqs for tf in self.channels]
+        self.designs = [correction.design(tf.freqs) for tf in self.channels]
+        self.fixed = dict(current.values)
+        held = set(SITE_ELEMENTS[correction.site])
+        if correction.site is not Site.COMPLIANCE:     # its correction stops at 2 fs: the creep law goes on above
+            held |= {name for e in current.model.effects if e.site is correction.site for name in e.param_names}
+        self.names = [n for n in current.varying if n not in held]
+        # Each parameter moves from its current value in steps of its own size: p = p0 + x * |p0|.
+        self.origin = np.array([current.values[n] for n in self.names])
+        self.scale = np.maximum(np.abs(self.origin), 1e-30)
+        specs = {s.name: s for s in self.model.param_specs}
+        self.lower = (np.array([specs[n].min for n in self.names]) - self.origin) / self.scale
+        self.upper = (np.array([specs[n].max for n in self.names]) - self.origin) / self.scale
+        self.pairs = coefficient_names(correction.n_basis)
+        self.k = len(self.names)
+        self.n_basis = len(self.pairs)
+        d2 = np.diff(np.eye(self.n_basis), 2, axis=0)
+        self.penalty = np.vstack([ROUGHNESS_WEIGHT * d2, RIDGE_WEIGHT * np.eye(self.n_basis)])
+        self.n_data = sum((2 if tf.has_phase else 1) * len(tf.freqs) for tf in self.channels)
+
+    def values(self, x: np.ndarray) -> dict[str, float]:
+        p = dict(self.fixed)
+        # Levenberg-Marquardt knows no bounds: the model sees the parameters clipped to theirs.
+        p.update(zip(self.names, self.origin + np.clip(x[: self.k], self.lower, self.upper) * self.scale))
+        a, b = x[self.k: self.k + self.n_basis], x[self.k + self.n_basis:]
+        for (re, im), va, vb in zip(self.pairs, a, b):
+            p[re], p[im] = va, vb
+        return p
+
+    def predictions(self, p: dict[str, float], model: Model | None = None) -> list[np.ndarray]:
+        model = model or self.model
+        out = [model.impedance(self.s[0], p)]
+        if self.use_x:
+            out.append(model.displacement(self.s[1], p))
+        return out
+
+    def _data_residual(self, predictions: list[np.ndarray]) -> np.ndarray:
+        parts = []
+        for tf, pred, name in zip(self.channels, predictions, ("impedance", "displacement")):
+            sigma = self.sigmas[name]
+            if tf.has_phase:
+                r = (pred - tf.value) / sigma
+                parts += [r.real, r.imag]
+            else:
+                parts.append((np.abs(pred) - tf.value.real) / sigma)
+        r = np.concatenate(parts)
+        return np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
+
+    def residual(self, x: np.ndarray) -> np.ndarray:
+        coef = x[self.k:]
+        pen = np.concatenate([self.penalty @ coef[: self.n_basis], self.penalty @ coef[self.n_basis:]])
+        return np.concatenate([self._data_residual(self.predictions(self.values(x))), pen])
+
+    def jacobian(self, x: np.ndarray) -> np.ndarray:
+        p = self.values(x)
+        base = self.predictions(p)
+        r0 = self._data_residual(base)
+        J = np.zeros((len(r0) + 2 * len(self.penalty), len(x)))
+        for i in range(self.k):               # the model's parameters: forward differences
+            step = DERIVATIVE_STEP * max(abs(x[i]), 1.0)
+            xi = x.copy()
+            xi[i] += step
+            J[: len(r0), i] = (self._data_residual(self.predictions(self.values(xi))) - r0) / step
+        # The coefficients: d(prediction)/dh per line from one shifted evaluation, then through the splines.
+        shifted = self.model.with_effects(self.model.effects[:-1] + (
+            dataclasses.replace(self.correction, offset=DERIVATIVE_STEP),))
+        rows, start = [], 0
+        for tf, pred, moved, design, name in zip(self.channels, base, self.predictions(p, shifted), self.designs,
+                                                 ("impedance", "displacement")):
+            dh = ((moved - pred) / DERIVATIVE_STEP / self.sigmas[name])[:, None] * design
+            if tf.has_phase:
+                rows.append((np.hstack([dh.real, -dh.imag]), np.hstack([dh.imag, dh.real])))
+            else:
+                unit = np.conj(pred) / np.maximum(np.abs(pred), 1e-300)
+                rows.append((np.hstack([(unit[:, None] * dh).real, (1j * unit[:, None] * dh).real]),))
+        J[: len(r0), self.k:] = np.nan_to_num(np.vstack([part for parts in rows for part in parts]))
+        n_pen = len(self.penalty)
+        J[len(r0): len(r0) + n_pen, self.k: self.k + self.n_basis] = self.penalty
+        J[len(r0) + n_pen:, self.k + self.n_basis:] = self.penalty
+        return J
+
+
+def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
+    """The current model with a smooth correction at `site`, refitted with its own parameters free."""
+    f_lo, f_hi = _band(data)
+    values = current.values
+    scale = values["RE"] if site is Site.BLOCKED else (1.0 / values["RES"] if site is Site.MECHANICAL else 1.0)
+    if site is Site.COMPLIANCE:
+        # Above a few fs the stiffness is spent (at 2 fs it is a quarter of the mass's reactance): a
+        # compliance that changes there cannot show, so its correction is held constant above.
+        f_hi = float(np.clip(COMPLIANCE_TOP_OVER_FS * resonance_frequency(values), 2.0 * f_lo, f_hi))
+    problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale))
+    x0 = np.zeros(problem.k + 2 * problem.n_basis)
+    # MINPACK's Levenberg-Marquardt: its own QR, no threaded LAPACK call per step (on a busy machine
+    # OpenBLAS threads made 'trf' 15x slower), and like lmfit's fits it starts from the current fit.
+    result = least_squares(problem.residual, x0, jac=problem.jacobian, method="lm", x_scale="jac",
+                           ftol=TOLERANCE, xtol=TOLERANCE, max_nfev=MAX_EVALUATIONS)
+    p = problem.values(result.x)
+    predictions = problem.predictions(p)
+    chi2_by_channel = {}
+    for tf, pred, name in zip(problem.channels, predictions, ("impedance", "displacement")):
+        r = (pred - tf.value) / problem.sigmas[name] if tf.has_phase else \
+            (np.abs(pred) - tf.value.real) / problem.sigmas[name]
+        chi2_by_channel[name] = (float(np.sum(np.abs(r) ** 2)), (2 if tf.has_phase else 1) * len(tf.freqs))
+    chi2 = sum(c for c, _ in chi2_by_channel.values())
+    edf = _effective_dof(result.jac, problem.k, problem.n_data)
+    n = problem.n_data
+    k = problem.k + edf
+    chi2_red = {name: c / max(m - k * m / n, 1.0) for name, (c, m) in chi2_by_channel.items()}
+    freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
+    s = 2j * np.pi * freqs
+    factor = problem.correction.factor(freqs, p, {"Ze": problem.model.blocked_impedance(s, p),
+                                                  "Y": 1.0 / problem.model.motional_impedance(s, p)})
+    return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
+                      chi2 - current.chi2 + edf * np.log(n), edf, freqs, factor,
+                      bool(result.status > 0))
+
+
+def _effective_dof(jac: np.ndarray, n_model: int, n_data: int) -> float:
+    """Trace of the correction's hat matrix: tr((J'J + P'P)^-1 J_d'J_d) over all parameters, less the model's own."""
+    J = np.asarray(jac)
+    total = J.T @ J
+    seen = J[:n_data].T @ J[:n_data]
+    hat = np.linalg.lstsq(total, seen, rcond=None)[0]
+    return float(max(np.trace(hat) - n_model, 0.0))
+
+
+def localise(data: FitData, current: FitResult, executor: Executor | None = None,
+             sites: tuple[Site, ...] | None = None, known: dict[Site, SiteResult] | None = None
+             ) -> tuple[SiteResult, ...]:
+    """The sites' corrections (every usable site by default), best (lowest delta BIC) first.
+
+    `known`: results already computed for `current` (the diagnosis computes some on its way).
+    """
+    wanted = [s for s in (sites or usable_sites(current.model)) if not known or s not in known]
+    if executor is not None:
+        futures = [executor.submit(fit_site, data, current, site) for site in wanted]
+        fitted = [f.result() for f in futures]
+    else:
+        fitted = [fit_site(data, current, site) for site in wanted]
+    results = list((known or {}).values()) + fitted
+    return tuple(sorted(results, key=lambda r: r.delta_bic))
