@@ -13,13 +13,14 @@ frequency range (FitRange):
   while Bl, which Hx is there to give, is fixed by the lines around and
   below fs.
 
-Imported curves carry no per-line noise estimate: every line is weighted as
-if it had ASSUMED_RELATIVE_STD relative noise, and the parameter
-uncertainties are scaled by the scatter of the residual (reduced chi^2). They
-say how well the data pin the parameters down *given the model*; a model
-that does not fit (large reduced chi^2) makes them optimistic about the
-truth. Magnitude-only curves (no phase) work the same way, with one real
-number per line instead of two.
+Imported curves carry no per-line noise estimate of their own: each line's
+noise is estimated from the curve's local scatter (analysis.curve_noise, on
+every line of the file, before the lines are thinned), so that chi^2 is in
+units of that noise as for a recording, and the reduced chi^2, BIC, the
+diagnosis's verdict and its sites mean the same. The parameter
+uncertainties are scaled by sqrt(reduced chi^2) when it exceeds 1 (the
+Birge ratio), as for recordings. Magnitude-only curves (no phase) work the
+same way, with one real number per line instead of two.
 """
 from __future__ import annotations
 
@@ -32,7 +33,8 @@ import numpy as np
 from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
-from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, fit_model
+from analysis.curve_noise import describe_noise, with_estimated_noise
+from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
 from analysis.model import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
@@ -44,10 +46,14 @@ HX_MAX_OVER_FS = 4.0
 # this many lines per decade, each decade counts alike, as in a log-spaced
 # .zma (35 per octave is about 116 per decade).
 LINES_PER_DECADE = 100
-VALIDITY_NOTE = "imported curves: no per-line noise, no validity checks"
-UNCERTAINTY_NOTE = (f"imported curves carry no noise estimate: every line is weighted as if it had "
-                    f"{100 * ASSUMED_RELATIVE_STD:g} % relative noise and the uncertainties are scaled by the "
-                    "residual scatter (sqrt of the reduced chi^2); they are honest only where the model fits")
+VALIDITY_NOTE = "imported curves: no per-line noise of their own, no validity checks"
+UNCERTAINTY_NOTE = ("imported curves carry no noise estimate of their own: each line's noise is estimated from the "
+                    "curve's local scatter (a quadratic in log f over 7 lines, pooled over 15), and the "
+                    "uncertainties are scaled by sqrt(reduced chi^2) where the model misses by more than that noise; "
+                    "a curve smoothed by the tool that exported it looks less noisy than it was")
+# Below this many lines per decade a curve changes too much from line to line for its local scatter
+# to be its noise: the estimate is then too high (an upper bound), and the notes say so.
+MIN_LINES_PER_DECADE_FOR_NOISE = 60
 
 
 class CurveFitError(ValueError):
@@ -127,11 +133,12 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
 
 def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
                f_range: FitRange | None = None, notes: Sequence[str] = ()) -> tuple[FitData, list[str]]:
-    """The lines of imported curves that the fit sees, and notes on how they were chosen."""
+    """The lines of imported curves that the fit sees, with each line's noise, and notes on how they were chosen."""
     f_range = f_range or FitRange()
+    notes = list(notes)
+    impedance, hx = (None if tf is None else _with_noise(tf, notes) for tf in (impedance, hx))
     z = f_range.select(impedance, None)
     x = None
-    notes = list(notes)
     if hx is not None:
         hx_max = f_range.hx_f_max
         if hx_max is None:
@@ -143,6 +150,31 @@ def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
     return FitData(z, x), notes
 
 
+def _with_noise(tf: TransferFunction, notes: list[str]) -> TransferFunction:
+    if tf.noise_known:
+        return tf
+    out = with_estimated_noise(tf)
+    decades = np.log10(tf.freqs[-1] / tf.freqs[0]) if len(tf.freqs) > 1 else 0.0
+    note = f"noise from the local scatter: {describe_noise(out)}"
+    if decades > 0 and len(tf.freqs) / decades < MIN_LINES_PER_DECADE_FOR_NOISE:
+        note += (f" ({len(tf.freqs) / decades:.0f} lines per decade: too coarse for the local scatter to be "
+                 "the noise alone, so this is an upper bound)")
+    notes.append(note)
+    return out
+
+
+def rms_relative_residual(fit: FitResult) -> dict[str, float]:
+    """sqrt(mean(|model - measured|^2 / |measured|^2)) per channel: how far the model misses, in words of %."""
+    out = {}
+    for name, ch in fit.channels.items():
+        model = ch.model if ch.has_phase else np.abs(ch.model)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rel = np.abs(model - ch.measured) ** 2 / np.abs(ch.measured) ** 2
+        rel = rel[np.isfinite(rel)]
+        out[name] = float(np.sqrt(np.mean(rel))) if rel.size else float("nan")
+    return out
+
+
 def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
                    curves: Sequence[TransferFunction], notes: Sequence[str]) -> dict:
     """The 'validity' object for imported curves: nothing checked, and how far to trust the numbers."""
@@ -150,9 +182,7 @@ def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
         "overall": "unknown",
         "note": VALIDITY_NOTE,
         "uncertainties": UNCERTAINTY_NOTE,
-        # With relative weights, sqrt(reduced chi^2) is the rms relative misfit: what "fits" means here.
-        "rms_relative_residual": {name: float(np.sqrt(max(c, 0.0)) * ASSUMED_RELATIVE_STD)
-                                  for name, c in fit.chi2_red_by_channel().items()},
+        "rms_relative_residual": rms_relative_residual(fit),
         "magnitude_only": [tf.name for tf in curves if not tf.has_phase],
         "ranges_hz": {name: list(r) for name, r in ranges.items()},
         "notes": list(notes),
@@ -169,16 +199,23 @@ def curve_json(result: CurveAnalysis) -> dict:
 
 
 def weighted_residual(model: Model, values: Mapping[str, float], data: FitData) -> np.ndarray:
-    """The fit's residual for curves without noise estimate (relative weights), as analysis.fit builds it."""
+    """The fit's residual, each line in units of its noise, as analysis.fit builds it."""
     parts = []
     for tf, evaluate in ((data.impedance, model.impedance), (data.displacement, model.displacement)):
         if tf is None or (tf is data.displacement and not model.with_displacement):
             continue
-        parts += relative_residual(evaluate(2j * np.pi * tf.freqs, values), tf)
+        predicted = evaluate(2j * np.pi * tf.freqs, values)
+        sigma = component_sigma(tf)
+        if not tf.has_phase:
+            parts.append((np.abs(predicted) - tf.value.real) / sigma)
+        else:
+            r = (predicted - tf.value) / sigma
+            parts += [r.real, r.imag]
     return np.concatenate(parts)
 
 
 def relative_residual(model_values: np.ndarray, tf: TransferFunction) -> list[np.ndarray]:
+    """The residual with relative weights (ASSUMED_RELATIVE_STD per line): the added-mass fits use it."""
     sigma = ASSUMED_RELATIVE_STD * np.abs(tf.value) / np.sqrt(2.0)
     if not tf.has_phase:
         return [(np.abs(model_values) - tf.value.real) / sigma]
@@ -191,12 +228,14 @@ def at_bound(value: float, spec: ParamSpec) -> bool:
 
 
 def jacobian_covariance(residual: Callable[[dict], np.ndarray], values: Mapping[str, float],
-                        names: Sequence[str], specs: Mapping[str, ParamSpec]) -> np.ndarray | None:
+                        names: Sequence[str], specs: Mapping[str, ParamSpec], noise_known: bool = False
+                        ) -> np.ndarray | None:
     """Covariance of `names` from a central-difference Jacobian, scaled by the reduced chi^2.
 
-    The scaling is lmfit's scale_covar: right for relative weights, whose
-    absolute size is unknown. None when the Jacobian is rank deficient (a
-    parameter the data do not determine).
+    The scaling is lmfit's scale_covar, right for relative weights whose
+    absolute size is unknown; with known (or estimated) noise it is the
+    Birge ratio, never below 1, as analysis.fit does. None when the Jacobian
+    is rank deficient (a parameter the data do not determine).
     """
     base = dict(values)
     r0 = residual(base)
@@ -211,6 +250,8 @@ def jacobian_covariance(residual: Callable[[dict], np.ndarray], values: Mapping[
     J = np.column_stack(columns)
     dof = max(len(r0) - len(names), 1)
     chi2_red = float(r0 @ r0) / dof
+    if noise_known:
+        chi2_red = max(chi2_red, 1.0)
     # Parameters span twenty decades (CMES ~1e-4 F, RES ~1e2 ohm): scale each
     # column to unit norm so that the condition number speaks of the data only.
     norms = np.linalg.norm(J, axis=0)
@@ -238,7 +279,7 @@ def covariance_with_bounds(fit: FitResult, residual: Callable[[dict], np.ndarray
     specs = {s.name: s for s in fit.model.param_specs}
     held = [n for n in fit.varying if at_bound(fit.values[n], specs[n])]
     free = [n for n in fit.varying if n not in held]
-    sub = jacobian_covariance(residual, fit.values, free, specs) if free else None
+    sub = jacobian_covariance(residual, fit.values, free, specs, fit.noise_known) if free else None
     if sub is None:
         return fit, held
     index = [fit.varying.index(n) for n in free]

@@ -143,13 +143,14 @@ class FitResult:
             return self.covar / np.outer(d, d)
 
 
-# Curves imported without a noise estimate are weighted relatively: every
-# line as if it carried this relative uncertainty. Their parameter
-# uncertainties are then scaled by the scatter of the residual.
+# Curves without a noise estimate (imported ones get one from their local
+# scatter, analysis.curve_noise; the added-mass fits do without) are weighted
+# relatively: every line as if it carried this relative uncertainty. Their
+# parameter uncertainties are then scaled by the scatter of the residual.
 ASSUMED_RELATIVE_STD = 0.01
 
 
-def _sigma(tf: TransferFunction) -> np.ndarray:
+def component_sigma(tf: TransferFunction) -> np.ndarray:
     """Standard deviation of each real component (real, imaginary or magnitude) of a line."""
     if not tf.noise_known:
         return ASSUMED_RELATIVE_STD * np.abs(tf.value) / np.sqrt(2.0)
@@ -229,12 +230,12 @@ def start_values(model: Model, data: FitData) -> dict[str, float]:
     return values
 
 
-def _sigmas(data: FitData, use_x: bool) -> dict[str, np.ndarray]:
+def channel_sigmas(data: FitData, use_x: bool) -> dict[str, np.ndarray]:
     if use_x and data.displacement is None:
         raise FitError("the model needs Hx but the data have no displacement channel")
-    sigmas = {"impedance": _sigma(data.impedance)}
+    sigmas = {"impedance": component_sigma(data.impedance)}
     if use_x:
-        sigmas["displacement"] = _sigma(data.displacement)
+        sigmas["displacement"] = component_sigma(data.displacement)
     return sigmas
 
 
@@ -242,7 +243,7 @@ def screen_fit(data: FitData, model: Model, start: Mapping[str, float], vary: se
                per_parameter: int = 20) -> FitResult:
     """A short fit of `vary` alone, the rest held at `start`: ranks start points cheaply."""
     use_x = model.with_displacement
-    sigmas = _sigmas(data, use_x)
+    sigmas = channel_sigmas(data, use_x)
     values = {**start_values(model, data), **{k: v for k, v in start.items()}}
     values = {spec.name: values[spec.name] for spec in model.param_specs}
     result = _minimize(model, _params(model, values, set(values) - vary), data, use_x, sigmas, None, per_parameter)
@@ -253,7 +254,7 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
               cancel: threading.Event | None = None) -> FitResult:
     """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values."""
     use_x = model.with_displacement
-    sigmas = _sigmas(data, use_x)
+    sigmas = channel_sigmas(data, use_x)
 
     values = start_values(model, data)
     warm = dict(start or {})

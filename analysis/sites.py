@@ -31,7 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from analysis.effects.base import Site
-from analysis.fit import FitData, FitResult, _sigmas
+from analysis.fit import FitData, FitResult, channel_sigmas
 from analysis.lumped import resonance_frequency
 from analysis.model import Model
 from analysis.site_correction import SiteCorrection, coefficient_names, site_correction
@@ -94,7 +94,7 @@ class _SiteProblem:
         self.correction = correction
         self.model = current.model.with_effects(current.model.effects + (correction,))
         self.use_x = self.model.with_displacement
-        self.sigmas = _sigmas(data, self.use_x)
+        self.sigmas = channel_sigmas(data, self.use_x)
         self.channels = [data.impedance] + ([data.displacement] if self.use_x else [])
         self.s = [2j * np.pi * tf.freqs for tf in self.channels]
         self.designs = [correction.design(tf.freqs) for tf in self.channels]

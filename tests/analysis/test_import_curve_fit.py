@@ -4,11 +4,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from analysis.curve_fit import (FitRange, CurveFitError, covariance_with_bounds, curve_json, fit_curves,
-                                log_thinned, weighted_residual)
+from analysis.curve_fit import (FitRange, CurveFitError, covariance_with_bounds, curve_data, curve_json,
+                                fit_curves, log_thinned, weighted_residual)
 from analysis.derived import parameter_table
 from analysis.effects import parse_effects
-from analysis.fit import FitData
 from analysis.importers import read_curve
 from analysis.model import Model
 from analysis.spectra import TransferFunction
@@ -73,10 +72,10 @@ def test_uncertainties_come_from_the_scatter_and_cover_the_truth():
     for seed in range(4):
         r = fit_curves(curve(values, "impedance", noise=0.01, seed=seed),
                        curve(values, "displacement", noise=0.01, seed=seed + 100), "lr2,creep-log")
-        assert r.fit.chi2_red == pytest.approx(1.0, abs=0.15)      # 1 % noise, weighted as 1 %
+        assert r.fit.chi2_red == pytest.approx(1.0, abs=0.15)      # 1 % noise, estimated from the local scatter
         pulls.append((r.fit.values["Bl"] - values["Bl"]) / r.fit.stderr["Bl"])
     assert np.all(np.abs(pulls) < 4)
-    assert "residual scatter" in r.validity["uncertainties"]
+    assert "local scatter" in r.validity["uncertainties"]
 
 
 def test_ranges_limit_each_channel_and_hx_defaults_to_four_fs():
@@ -102,7 +101,7 @@ def test_a_parameter_on_its_bound_is_held_and_the_others_get_uncertainties():
     values = dict(PAPER.parameters)
     z, x = curve(values, "impedance", noise=0.005), curve(values, "displacement", noise=0.005, seed=1)
     fit = fit_curves(z, x, "lr2,creep-log", None, FitRange(hx_f_max=1e5)).fit
-    data = FitData(z, x)
+    data, _ = curve_data(z, x, FitRange(hx_f_max=1e5))          # the lines and noise the fit saw
     residual = lambda v: weighted_residual(fit.model, v, data)    # noqa: E731
     no_covar = dataclasses.replace(fit, covar=None, stderr={n: None for n in fit.values})
     again, held = covariance_with_bounds(no_covar, residual)      # the Jacobian's covariance is lmfit's
@@ -118,7 +117,8 @@ def test_a_parameter_on_its_bound_is_held_and_the_others_get_uncertainties():
 def test_covariance_with_bounds_leaves_a_complete_fit_alone():
     z = curve(PAPER.parameters, "impedance", noise=0.01)
     r = fit_curves(z, None, "lr2,creep-log")
-    same, held = covariance_with_bounds(r.fit, lambda v: weighted_residual(r.fit.model, v, FitData(z)))
+    data, _ = curve_data(z)
+    same, held = covariance_with_bounds(r.fit, lambda v: weighted_residual(r.fit.model, v, data))
     assert same is r.fit and held == []
 
 

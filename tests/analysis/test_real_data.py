@@ -117,7 +117,8 @@ def test_dayton_added_mass(dayton):
 def test_dayton_half_hertz_data_in_radians_fit_well_and_not_as_degrees(dayton):
     free = dayton[0].transfer
     good = fit_curves(free, None, "leach,creep-log-causal")
-    assert good.validity["rms_relative_residual"]["impedance"] < 0.05
+    # Each line weighted by the noise of its local scatter (2.5 % at the median): the quiet lines lead.
+    assert good.validity["rms_relative_residual"]["impedance"] < 0.08
     assert good.fit.n_data < 0.1 * 2 * len(free.freqs)            # thinned to ~100 lines per decade
     as_degrees = read_curve(DAYTON / "test_impedance.txt", phase="deg")
     assert any("overrides" in n for n in as_degrees.notes) and any("+-pi" in n for n in as_degrees.notes)
