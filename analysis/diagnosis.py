@@ -33,6 +33,9 @@ from analysis.sites import SiteResult, fit_site, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
+# Far from the data (reduced chi^2 above this) the current fit's parameters are bent: effects that bend
+# every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.
+FAR_CHI2 = 100.0
 
 __all__ = ["MIN_BIC_GAIN", "MAX_STEPS", "Candidate", "Step", "Diagnosis", "candidate_models", "rank_candidates",
            "diagnose", "explain"]
@@ -176,13 +179,24 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     moves = candidate_models(current.model)
     ctx = residual_context(data, current)
     screened = _best_starts(data, current, moves, ctx, executor, cancel)
-    calls = []
+    calls, owners = [], []
+    far = current.chi2_red > FAR_CHI2
     for index, (_, effect, _, model) in enumerate(moves):
         # The new effect starts from its guess; the rest from the current fit.
         start = screened.get(index) or {**current.values, **effect.guess(ctx)}
         calls.append((_refit, (data, model, start, None if executor else cancel)))
+        owners.append(index)
+        if far and effect.cold_start:
+            calls.append((_refit, (data, model, effect.guess(ctx), None if executor else cancel)))
+            owners.append(index)
+    outcomes: dict[int, tuple[FitResult | None, str | None]] = {}
+    for index, (fit, error) in zip(owners, _run(calls, executor, cancel)):
+        kept = outcomes.get(index)
+        if kept is None or kept[0] is None or (fit is not None and fit.chi2 < kept[0].chi2):
+            outcomes[index] = (fit, error)
     candidates = []
-    for (action, effect, replaces, _), (fit, error) in zip(moves, _run(calls, executor, cancel)):
+    for index, (action, effect, replaces, _) in enumerate(moves):
+        fit, error = outcomes[index]
         flags = acceptance.candidate_flags(current, fit, effect)
         candidates.append(Candidate(action, effect, replaces, fit,
                                     (fit.bic - current.bic) if fit else float("inf"), error, flags,

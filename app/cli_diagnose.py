@@ -1,11 +1,14 @@
-"""`linpar diagnose`: rank the effects the model may lack and follow the greedy path."""
+"""`linpar diagnose`: rank the effects the model may lack, follow the greedy path, say what is missing and where."""
 from __future__ import annotations
 
 import argparse
 import json
 
+from analysis import acceptance
 from analysis.derived import parameter_table
-from analysis.diagnosis import Candidate, Diagnosis, diagnose, explain
+from analysis.diagnosis import Candidate, Diagnosis, Step, diagnose, explain
+from analysis.diagnosis_words import (VERDICT_TITLES, chi2_words, drift_from_validity, residual_json, sites_json,
+                                      tied_sites, verdict_text)
 from analysis.effects import parse_effects
 from analysis.fit import FitData, FitResult
 from analysis.model import Model, ModelError
@@ -13,31 +16,33 @@ from analysis.parallel import fit_executor
 from analysis.pipeline import resolve_sd
 from analysis.recording import read_recording
 from analysis.spectra import estimate_spectra
+from analysis.validity import assess
 
 
-def _data(args: argparse.Namespace) -> tuple[FitData, float | None]:
-    """The lines to diagnose: from a recording, or from imported curves."""
+def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
+    """The lines to diagnose (from a recording, or from imported curves), Sd, and the recording's drift finding."""
     from app import cli_import
     if cli_import.wants_curves(args):
         from analysis.curve_fit import curve_data
         z, hx, notes = cli_import.load_curves(args)
         data, _ = curve_data(z, hx, cli_import.fit_range(args, args.hx_fmax), notes)
-        return data, args.sd
+        return data, args.sd, None
     recording = read_recording(args.path)
-    return FitData.from_spectra(estimate_spectra(recording)), resolve_sd(recording, args.sd)
+    spectra = estimate_spectra(recording)
+    drift = drift_from_validity(assess(recording, spectra).as_json())
+    return FitData.from_spectra(spectra), resolve_sd(recording, args.sd), drift
 
 
 def run_diagnosis(args: argparse.Namespace):
-    data, sd = _data(args)
-    start = args.start
+    data, sd, drift = _data(args)
     try:
-        effects = parse_effects(start)
+        effects = parse_effects(args.start)
     except KeyError as exc:
         raise ModelError(f"--from: {exc.args[0]}") from None
     model = Model(effects, with_displacement=data.displacement is not None)
     with fit_executor() as executor:
         result = diagnose(data, model, executor=executor)
-    return result, sd
+    return result, sd, drift
 
 
 def _fit_summary(fit: FitResult) -> dict:
@@ -49,47 +54,82 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
         "action": c.action,
         "effect": c.effect.id,
         "category": c.effect.category,
+        "site": c.effect.site.key,
         "replaces": c.replaces.id if c.replaces else None,
         "chi2_red": c.fit.chi2_red_by_channel() if c.fit else None,
         "delta_bic": c.delta_bic if c.fit else None,
+        "accepted": c.accepted,
+        "assessment": c.assessment.as_json() if c.assessment else None,
+        "flags": acceptance.flags_json(c.flags),
         "explanation": explain(current, c),
     }
 
 
-def diagnosis_json(result: Diagnosis, sd_m2: float | None) -> dict:
+def _step_json(step: Step) -> dict:
+    return {**_fit_summary(step.fit), "chosen": step.chosen.effect.id if step.chosen else None,
+            "flags": acceptance.flags_json(step.flags)}
+
+
+def diagnosis_json(result: Diagnosis, sd_m2: float | None, drift: str | None = None) -> dict:
     final = result.final
     return {
+        "verdict": result.verdict,
+        "verdict_text": verdict_text(result, drift),
+        "step_cap_reached": result.step_cap_reached,
         "start": _fit_summary(result.start),
         "residual": result.steps[0].residual,
         "candidates": [_candidate_json(result.start, c) for c in result.first_candidates],
-        "steps": [_fit_summary(step.fit) for step in result.steps],
+        "steps": [_step_json(step) for step in result.steps],
         "final": {**_fit_summary(final),
-                  "parameters": {n: p.as_json() for n, p in parameter_table(final, sd_m2).items()}},
+                  "parameters": {n: p.as_json() for n, p in parameter_table(final, sd_m2).items()},
+                  "residual": residual_json(final),
+                  "flags": acceptance.flags_json(result.final_flags)},
+        "sites": sites_json(result.sites),
     }
 
 
-def format_diagnosis(result: Diagnosis) -> str:
-    lines = [f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", "",
-             f"{'rank':<5}{'move':<34}{'delta BIC':>12}  reduced chi^2"]
+def _flags_text(flags) -> str:
+    return "; ".join(f"{f.code}: {f.message}" for f in flags)
+
+
+def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
+    lines = [f"verdict: {VERDICT_TITLES[result.verdict]}", "  " + verdict_text(result, drift), "",
+             f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", "",
+             f"{'rank':<5}{'move':<34}{'delta BIC':>12}  {'taken?':<12} reduced chi^2"]
     for rank, c in enumerate(result.first_candidates, 1):
         move = f"{c.action} {c.effect.id}" + (f" (for {c.replaces.id})" if c.replaces else "")
-        chi = ", ".join(f"{k} {v:.3g}" for k, v in c.fit.chi2_red_by_channel().items()) if c.fit else c.error
+        chi = chi2_words(c.fit.chi2_red_by_channel()) if c.fit else c.error
         dbic = f"{c.delta_bic:+.1f}" if c.fit else "failed"
-        lines.append(f"{rank:<5}{move:<34}{dbic:>12}  {chi}")
+        taken = "yes" if c.accepted else (c.assessment.reason if c.assessment else "")
+        lines.append(f"{rank:<5}{move:<34}{dbic:>12}  {taken:<12} {chi}")
     if result.first_candidates:
         lines += ["", "why: " + explain(result.start, result.first_candidates[0])]
     lines += ["", "path:"]
+    previous = None
     for i, step in enumerate(result.steps):
-        chi = ", ".join(f"{k} {v:.3g}" for k, v in step.fit.chi2_red_by_channel().items())
-        lines.append(f"  {i}: {step.fit.model.describe():<40} BIC {step.fit.bic:12.1f}   reduced chi^2 {chi}")
+        lines.append(f"  {i}: {step.fit.model.describe():<40} BIC {step.fit.bic:12.1f}   reduced chi^2 "
+                     f"{chi2_words(step.fit.chi2_red_by_channel())}")
+        if previous is not None and previous.chosen is not None:
+            c = previous.chosen
+            move = f"replaced {c.replaces.id} by {c.effect.id}" if c.replaces else f"added {c.effect.id}"
+            lines.append(f"     {move}" + (f", taken with flags: {_flags_text(c.flags)}" if c.flags else ""))
+        if step.flags:
+            lines.append(f"     flags of this model: {_flags_text(step.flags)}")
+        previous = step
     lines.append(f"final residual: {result.steps[-1].residual}")
+    if result.sites:
+        tied = {s.site for s in tied_sites(result.sites)}
+        lines += ["", f"{'site':<14}{'delta BIC':>14}  reduced chi^2 with a smooth correction there"]
+        for s in result.sites:
+            mark = "  (the data cannot tell it from the first)" if s.site in tied else ""
+            lines.append(f"{s.key:<14}{s.delta_bic:>14.1f}  {chi2_words(s.chi2_red)}{mark}")
     return "\n".join(lines)
 
 
 def cmd_diagnose(args: argparse.Namespace) -> int:
-    result, sd = run_diagnosis(args)
+    result, sd, drift = run_diagnosis(args)
     if args.json:
-        print(json.dumps(diagnosis_json(result, sd), allow_nan=False, default=lambda _: None))
+        print(json.dumps(diagnosis_json(result, sd, drift), allow_nan=False, default=lambda _: None))
     else:
-        print(format_diagnosis(result))
+        print(format_diagnosis(result, drift))
     return 0

@@ -113,6 +113,46 @@ def test_diagnose_json_finds_the_missing_creep(capsys, rec_path):
     assert doc["final"]["effects"][:1] == ["lr2"] and any("creep" in e for e in doc["final"]["effects"])
     assert doc["final"]["chi2_red"]["displacement"] < 2
     assert len(doc["steps"]) >= 2
+    assert doc["verdict"] == "explained" and doc["step_cap_reached"] is False
+    assert doc["final"]["residual"] == [] and isinstance(doc["final"]["flags"], list)
+    assert doc["steps"][0]["chosen"] == doc["candidates"][0]["effect"] and doc["candidates"][0]["accepted"]
+    assert [s["site"] for s in doc["sites"]] and all(s["delta_bic"] > 0 for s in doc["sites"])
+
+
+@pytest.fixture(scope="module")
+def odd_mechanical_path(tmp_path_factory):
+    from tests.odd_physics import odd_recording
+    path = tmp_path_factory.mktemp("rec") / "odd-mechanical"
+    write_recording(path, odd_recording("mechanical"))
+    return path
+
+
+def test_diagnose_json_says_what_it_cannot_explain_and_where(capsys, odd_mechanical_path):
+    code, out, err = run(capsys, "diagnose", str(odd_mechanical_path), "--from", "lr2,creep-log", "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["verdict"] == "unexplained" and "mechanical site" in doc["verdict_text"]
+    assert doc["final"]["effects"] == ["lr2", "creep-log"] and doc["steps"][0]["chosen"] is None
+    first = doc["final"]["residual"][0]
+    assert set(first) == {"channel", "f_lo", "f_hi", "kind", "sign", "size_sigma", "share"}
+    assert first["size_sigma"] > 100 and 0 < first["share"] <= 1 and first["f_lo"] < first["f_hi"]
+    sites = doc["sites"]
+    assert sites[0]["site"] == "mechanical" and len(sites) == 6
+    assert [s["delta_bic"] for s in sites] == sorted(s["delta_bic"] for s in sites)
+    correction = sites[0]["correction"]
+    assert len(correction["f"]) == len(correction["magnitude"]) == len(correction["phase_deg"]) > 50
+    assert max(sites[0]["chi2_red"].values()) < 2 < min(doc["final"]["chi2_red"].values())
+    flagged = [c for c in doc["candidates"] if c["flags"]]
+    assert flagged and all(not c["accepted"] for c in doc["candidates"])
+    assert {"code", "parameter", "channel", "message"} <= set(flagged[0]["flags"][0])
+
+
+def test_diagnose_text_states_the_verdict_and_the_site(capsys, odd_mechanical_path):
+    code, out, _ = run(capsys, "diagnose", str(odd_mechanical_path), "--from", "lr2,creep-log")
+    assert code == 0
+    assert out.splitlines()[0] == "verdict: Unexplained"
+    assert "mechanical site" in out and "effect of your own" in out
+    assert "site" in out and "delta BIC" in out
 
 
 def test_the_effects_catalogue_is_listed(capsys):

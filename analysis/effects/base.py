@@ -101,6 +101,10 @@ class Effect:
     notes: str = ""
     # Effects whose parameters this one needs (e.g. creep needs fs): none by default.
     requires: tuple[str, ...] = field(default=())
+    # True when a model that lacks this effect bends every other parameter to imitate it (a channel
+    # delay): far from the data, the diagnosis then also refits it from the data's own start values,
+    # not only from the bent fit, and keeps the better.
+    cold_start: bool = False
 
     @property
     def param_names(self) -> tuple[str, ...]:

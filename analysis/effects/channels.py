@@ -69,7 +69,10 @@ delay_current = CurrentDelay(
     notes=("The fit starts from the slope of the phase that the current model leaves in Z over the top "
            "octave (analysis.startvalues.phase_slope): a start of 0 can end in a local minimum when the "
            "model is far from the data (a hidden -50 us did, at -7 us, with a reduced chi^2 of 3e8 to "
-           "start from). " + _CURRENT_GAIN_NOTE),
+           "start from), and far from the data the diagnosis also refits it from the data's own start values "
+           "(the bent fit's other parameters can hold it in a local minimum even when it starts at the true "
+           "delay). " + _CURRENT_GAIN_NOTE),
+    cold_start=True,
 )
 
 
@@ -143,7 +146,9 @@ delay_x = DisplacementDelay(
            "proportional to f): lowpass-x is the alternative when |Hx| also drops at the top. The fit "
            "starts from the slope of the phase that the current model leaves in Hx over the top octave "
            "(unwrapped from the lowest line up), so delays are found as long as the phase moves less than "
-           "half a turn from one line to the next."),
+           "half a turn from one line to the next; far from the data the diagnosis also refits it from the "
+           "data's own start values."),
+    cold_start=True,
 )
 
 

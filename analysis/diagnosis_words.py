@@ -1,0 +1,138 @@
+"""A diagnosis said in plain words and as data: the verdict, where the misfit is, its site, what to do next.
+
+The CLI's text, its JSON and the model lab all say it from here, so they
+say the same thing.
+"""
+from __future__ import annotations
+
+from typing import Iterable
+
+from analysis import acceptance, residuals
+from analysis.diagnosis import Diagnosis
+from analysis.effects.base import Site
+from analysis.fit import FitResult
+from analysis.sites import SiteResult
+
+CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
+# Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)
+# explain the data equally well: the data cannot tell them apart.
+TIE_CHI2 = 10.0
+SITE_WORDS = {
+    Site.BLOCKED: ("electrical", "ohms added to the blocked impedance Ze (the voice coil and what is in series "
+                                 "with it)"),
+    Site.FORCE_FACTOR: ("force-factor", "a factor on Bl, in the force and the back-EMF alike"),
+    Site.MECHANICAL: ("mechanical", "kg/s added to the mechanical impedance Zm (losses, air load, a box, modes)"),
+    Site.COMPLIANCE: ("compliance", "a factor on the suspension's compliance (how it yields with frequency)"),
+    Site.CURRENT: ("current", "a factor on the measured current (the current sense)"),
+    Site.DISPLACEMENT: ("displacement", "a factor on the measured displacement (the laser)"),
+}
+VERDICT_TITLES = {
+    acceptance.NOTHING_MISSING: "Nothing missing",
+    acceptance.EXPLAINED: "Explained",
+    acceptance.PARTLY_EXPLAINED: "Partly explained",
+    acceptance.UNEXPLAINED: "Unexplained",
+}
+
+
+def chi2_words(chi2_red: dict[str, float]) -> str:
+    return ", ".join(f"{CHANNEL_SHORT.get(k, k)} {v:.3g}" for k, v in chi2_red.items())
+
+
+def residual_json(fit: FitResult) -> list[dict]:
+    """Where the residual sits, as data: the words of analysis.residuals.describe."""
+    return [{"channel": f.channel, "f_lo": f.f_low, "f_hi": f.f_high, "kind": f.part, "sign": f.sign,
+             "size_sigma": f.peak_sigma, "share": f.share} for f in residuals.findings(fit)]
+
+
+def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:
+    """The sites (after the best) whose correction explains the data as well as the best one's does."""
+    if not sites:
+        return []
+    best = sites[0]
+    scale = max(1.0, max(best.chi2_red.values(), default=1.0))
+    return [s for s in sites[1:] if s.chi2 - best.chi2 <= TIE_CHI2 * scale]
+
+
+def sites_json(sites: tuple[SiteResult, ...]) -> list[dict]:
+    tied = {s.site for s in tied_sites(sites)}
+    return [{**s.as_json(), "indistinguishable_from_best": s.site in tied} for s in sites]
+
+
+def _site_sentence(fit: FitResult, sites: tuple[SiteResult, ...]) -> str:
+    best = sites[0]
+    if best.delta_bic >= -acceptance.MIN_BIC_GAIN:
+        return ("No single site's smooth correction explains it either: the misfit is spread over several sites, "
+                "or too sharp for a smooth correction (a narrow mode).")
+    name, what = SITE_WORDS[best.site]
+    text = (f"It belongs most likely at the {name} site: a smooth correction there ({what}) takes the reduced "
+            f"χ² from {chi2_words(fit.chi2_red_by_channel())} to {chi2_words(best.chi2_red)}.")
+    tied = [SITE_WORDS[s.site][0] for s in tied_sites(sites)]
+    if tied:
+        text += f" The data cannot tell it from the {' or the '.join(tied)} site."
+    return text
+
+
+def drift_from_validity(validity: dict | None) -> str | None:
+    """The validity check's drift findings (its JSON form), in one sentence; None when there are none."""
+    channels = (validity or {}).get("channels") or {}
+    found = [f"{name}: {f['message']}" for name, ch in channels.items() for f in (ch or {}).get("findings", [])
+             if f.get("code") == "drift"]
+    return "; ".join(found) or None
+
+
+def _next_step(sites: tuple[SiteResult, ...]) -> str:
+    name, what = SITE_WORDS[sites[0].site]
+    return (f"Next: write an effect of your own at the {name} site ({what}) that follows the correction's "
+            "shape, and fit it.")
+
+
+def _flag_sentence(flags: Iterable[acceptance.Flag]) -> str:
+    messages = [f.message for f in flags]
+    return ("Flags: " + "; ".join(messages) + ".") if messages else ""
+
+
+def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
+    """The verdict in plain words, with where the misfit is, its site and what to do next.
+
+    `drift`: the validity check's drift finding, when the recording has one (said with an inflated noise).
+    """
+    verdict = result.verdict
+    start, final = result.start, result.final
+    taken = [step.chosen for step in result.steps if step.chosen is not None]
+    moves = ", ".join(("replacing " + c.replaces.id + " by " if c.replaces else "adding ") + c.effect.id
+                      for c in taken)
+    parts = []
+    if verdict == acceptance.NOTHING_MISSING:
+        parts.append(f"Nothing missing: the model explains the measurement down to its noise (reduced χ² "
+                     f"{chi2_words(start.chi2_red_by_channel())}); no effect of the catalogue is needed.")
+    elif verdict == acceptance.EXPLAINED:
+        parts.append(f"Explained: {moves} brings the model to its noise floor (reduced χ² "
+                     f"{chi2_words(start.chi2_red_by_channel())} → {chi2_words(final.chi2_red_by_channel())}).")
+    elif verdict == acceptance.PARTLY_EXPLAINED:
+        parts.append(f"Partly explained: {moves} helps (reduced χ² {chi2_words(start.chi2_red_by_channel())} → "
+                     f"{chi2_words(final.chi2_red_by_channel())}), but misfit is left that no effect of the "
+                     "catalogue explains.")
+    else:
+        parts.append(f"Unexplained: no effect of the catalogue explains the misfit (reduced χ² "
+                     f"{chi2_words(start.chi2_red_by_channel())}); none was added.")
+    if verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED):
+        parts.append(f"Where: {residuals.describe(final)}.")
+        if result.sites:
+            parts.append(_site_sentence(final, result.sites))
+            if result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
+                parts.append(_next_step(result.sites))
+    if result.step_cap_reached:
+        parts.append(f"The path stopped at its cap of {len(result.steps) - 1} steps: diagnose again from the "
+                     "last model to go on.")
+    inflated = [f for f in result.final_flags if f.code == acceptance.NOISE_INFLATED]
+    if inflated:
+        parts.append("But the reduced χ² is far below 1 (" + ", ".join(
+            f"{CHANNEL_SHORT.get(f.channel, f.channel)} {final.channels[f.channel].chi2_red:.2g}" for f in inflated)
+            + "): the noise estimate is inflated, not met. The scatter between periods is larger than what the "
+              "model leaves, as when the driver drifts during the measurement (a voice coil warming up): see "
+              "the drift finding of the validity check." + (f" It reports: {drift}" if drift else ""))
+    others = [f for f in result.final_flags if f.code not in (acceptance.NOISE_INFLATED, acceptance.STEP_CAP)]
+    flags = _flag_sentence(others)
+    if flags:
+        parts.append(flags)
+    return " ".join(parts)
