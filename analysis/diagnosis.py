@@ -29,7 +29,7 @@ from analysis.effects import CATALOGUE, Effect
 from analysis.effects.base import Site
 from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
 from analysis.model import Model
-from analysis.sites import SiteResult, fit_site, localise
+from analysis.sites import SiteResult, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
@@ -82,7 +82,9 @@ class Diagnosis:
 
     @property
     def final(self) -> FitResult:
-        return self.steps[-1].fit
+        """Where the diagnosis ends: the last model of the path, or the candidate a ranking would take."""
+        last = self.steps[-1]
+        return last.chosen.fit if last.chosen is not None else last.fit
 
     @property
     def first_candidates(self) -> tuple[Candidate, ...]:
@@ -212,12 +214,9 @@ class _SiteFits:
         self.done: dict[Site, SiteResult] = {}
 
     def need(self, sites) -> None:
-        wanted = [s for s in dict.fromkeys(sites) if s not in self.done]
-        if self.executor is not None:
-            futures = [(s, self.executor.submit(fit_site, self.data, self.fit, s)) for s in wanted]
-            self.done.update((s, f.result()) for s, f in futures)
-        else:
-            self.done.update((s, fit_site(self.data, self.fit, s)) for s in wanted)
+        wanted = tuple(s for s in dict.fromkeys(sites) if s not in self.done)
+        if wanted:
+            self.done.update((r.site, r) for r in localise(self.data, self.fit, self.executor, sites=wanted))
 
 
 def choose(data: FitData, current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
@@ -257,11 +256,12 @@ def explain(current: FitResult, candidate: Candidate) -> str:
 def diagnose(data: FitData, start_model: Model, executor: Executor | None = None,
              cancel: threading.Event | None = None, start_fit: FitResult | None = None,
              progress: Callable[[str], None] | None = None, max_steps: int = MAX_STEPS,
-             locate: bool = True) -> Diagnosis:
+             locate: bool = True, follow: bool = True) -> Diagnosis:
     """Rank the candidates from `start_model`, follow the greedy path, then locate what is left.
 
-    max_steps=1 ranks the start model's candidates and adopts the best acceptable one (the
-    model lab's "Diagnose"); locate=False skips the site localisation of the final model.
+    follow=False ranks the start model's candidates only (the model lab's "Diagnose"): the
+    diagnosis then ends at the candidate the path would take (Diagnosis.final), nothing is
+    adopted. locate=False skips the site localisation of the final model.
     """
     current = start_fit or fit_model(data, start_model, cancel=cancel)
     steps: list[Step] = []
@@ -272,9 +272,8 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
         ranked = rank_candidates(data, current, executor, cancel)
         sites = _SiteFits(data, current, executor)
         ranked, best = choose(data, current, ranked, sites)
-        step_flags = tuple(acceptance.parameter_flags(current) + acceptance.noise_flags(current))
-        steps.append(Step(current, ranked, residuals.describe(current), best, step_flags))
-        if best is None:
+        steps.append(Step(current, ranked, residuals.describe(current), best, _model_flags(current)))
+        if best is None or not follow:
             break
         current = best.fit
         if len(steps) == max_steps:   # out of steps: the last model, not ranked further
@@ -282,12 +281,17 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
             cap = Flag(acceptance.STEP_CAP, f"the path stopped at its cap of {max_steps} step(s): the last model "
                                             "was not ranked further")
             sites = _SiteFits(data, current, executor)
-            steps.append(Step(current, (), residuals.describe(current), None,
-                              tuple(acceptance.parameter_flags(current) + acceptance.noise_flags(current)) + (cap,)))
+            steps.append(Step(current, (), residuals.describe(current), None, _model_flags(current) + (cap,)))
             break
-    located: tuple[SiteResult, ...] = ()
-    if locate:
-        if progress:
-            progress("looking for the site of the misfit left")
-        located = localise(data, current, executor, known=sites.done)
-    return Diagnosis(tuple(steps), located, capped)
+    result = Diagnosis(tuple(steps), (), capped)
+    if not locate:
+        return result
+    if progress:
+        progress("looking for the site of the misfit left")
+    final = result.final
+    known = sites.done if final is sites.fit else None
+    return dataclasses.replace(result, sites=localise(data, final, executor, known=known, cancel=cancel))
+
+
+def _model_flags(fit: FitResult) -> tuple[Flag, ...]:
+    return tuple(acceptance.parameter_flags(fit) + acceptance.noise_flags(fit))

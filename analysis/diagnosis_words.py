@@ -45,10 +45,17 @@ def residual_json(fit: FitResult) -> list[dict]:
 
 
 def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:
-    """The sites (after the best) whose correction explains the data as well as the best one's does."""
+    """The sites (after the best) whose correction explains the data as well as the best one's does.
+
+    With the impedance alone every site but the displacement acts on Z only, and any of them can
+    make Z anything: they are all tied, whatever their chi^2 (which differs by how smoothly each
+    correction follows the misfit, not by what the data say).
+    """
     if not sites:
         return []
     best = sites[0]
+    if "displacement" not in best.chi2_red:
+        return list(sites[1:])
     scale = max(1.0, max(best.chi2_red.values(), default=1.0))
     return [s for s in sites[1:] if s.chi2 - best.chi2 <= TIE_CHI2 * scale]
 
@@ -67,7 +74,10 @@ def _site_sentence(fit: FitResult, sites: tuple[SiteResult, ...]) -> str:
     text = (f"It belongs most likely at the {name} site: a smooth correction there ({what}) takes the reduced "
             f"χ² from {chi2_words(fit.chi2_red_by_channel())} to {chi2_words(best.chi2_red)}.")
     tied = [SITE_WORDS[s.site][0] for s in tied_sites(sites)]
-    if tied:
+    if "displacement" not in best.chi2_red:
+        text += (" But with the impedance alone every site acts on Z only: the data cannot tell the sites apart "
+                 "(a laser's Hx would).")
+    elif tied:
         text += f" The data cannot tell it from the {' or the '.join(tied)} site."
     return text
 
@@ -89,6 +99,26 @@ def _next_step(sites: tuple[SiteResult, ...]) -> str:
 def _flag_sentence(flags: Iterable[acceptance.Flag]) -> str:
     messages = [f.message for f in flags]
     return ("Flags: " + "; ".join(messages) + ".") if messages else ""
+
+
+def verdict_headline(result: Diagnosis) -> str:
+    """The verdict in one short sentence (verdict_text says it all)."""
+    verdict = result.verdict
+    moves = ", ".join(c.effect.id for c in (step.chosen for step in result.steps) if c is not None)
+    site = ""
+    if result.sites and result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
+        site = SITE_WORDS[result.sites[0].site][0]
+    if verdict == acceptance.NOTHING_MISSING:
+        text = "the model reaches the noise floor; nothing is missing."
+    elif verdict == acceptance.EXPLAINED:
+        text = f"{moves} brings the model to the noise floor."
+    elif verdict == acceptance.PARTLY_EXPLAINED:
+        text = f"{moves} helps; " + (f"the rest belongs at the {site} site." if site else "misfit is left.")
+    else:
+        text = "no effect of the catalogue explains the misfit" + (f"; look at the {site} site." if site else ".")
+    if any(f.code == acceptance.NOISE_INFLATED for f in result.final_flags):
+        text += " But χ² is far below 1: the noise estimate is inflated (drift?)."
+    return text[:1].upper() + text[1:]
 
 
 def verdict_text(result: Diagnosis, drift: str | None = None) -> str:

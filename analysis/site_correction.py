@@ -97,18 +97,26 @@ class SiteCorrection(Effect):
             return 1.0 / (1.0 + h)       # the model's current-site factor multiplies Z = U / I
         return 1.0 + h
 
-    def factor(self, freqs: np.ndarray, p, model_values: dict[str, np.ndarray] | None = None) -> np.ndarray:
-        """The correction as a factor on the site's own quantity (Ze, Bl, Zm, Cms, I or X).
+    def shown(self, freqs: np.ndarray, p) -> tuple[np.ndarray, str, str, float]:
+        """(values, unit, what they are, scale): the correction as the site takes it.
 
-        For the additive sites the factor is (Ze + dZe) / Ze and (Zm + dZm) / Zm,
-        which needs the fitted model's Ze or Y at `freqs` (model_values).
+        The additive sites give what they add, in ohm (Ze) or kg/s (Zm; in units
+        of Rms without the laser, which alone gives Bl); the others the factor.
+        The values are 1 + h (a factor) or scale * h (what is added).
         """
         h = self.h(freqs, p)
         if self.site is Site.BLOCKED:
-            return 1.0 + self.scale * h / model_values["Ze"]
+            return self.scale * h, "ohm", "added to the blocked impedance Ze", self.scale
         if self.site is Site.MECHANICAL:
-            return 1.0 + self.scale * h / model_values["Y"]
-        return 1.0 + h
+            if "Bl" in p:       # Y = Zm / Bl^2, and the correction adds scale * h to Y
+                kg_per_s = self.scale * p["Bl"] ** 2
+                return kg_per_s * h, "kg/s", "added to the mechanical impedance Zm", kg_per_s
+            return h, "Rms", "added to the mechanical impedance Zm, in units of Rms", 1.0
+        return 1.0 + h, "1", FACTOR_WORDS[self.site], 1.0
+
+
+FACTOR_WORDS = {Site.FORCE_FACTOR: "factor on Bl", Site.COMPLIANCE: "factor on the compliance",
+                Site.CURRENT: "factor on the measured current", Site.DISPLACEMENT: "factor on the measured displacement"}
 
 
 def site_correction(site: Site, f_lo: float, f_hi: float, scale: float = 1.0) -> SiteCorrection:

@@ -24,6 +24,7 @@ What Z and Hx can tell apart, and what they cannot, is in docs/diagnosis.md.
 from __future__ import annotations
 
 import dataclasses
+import threading
 from concurrent.futures import Executor
 from dataclasses import dataclass
 
@@ -31,18 +32,19 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from analysis.effects.base import Site
-from analysis.fit import FitData, FitResult, channel_sigmas
+from analysis.fit import FitCancelled, FitData, FitResult, channel_sigmas
 from analysis.lumped import resonance_frequency
 from analysis.model import Model
 from analysis.site_correction import SiteCorrection, coefficient_names, site_correction
 
 SITES = (Site.BLOCKED, Site.FORCE_FACTOR, Site.MECHANICAL, Site.COMPLIANCE, Site.CURRENT, Site.DISPLACEMENT)
 ROUGHNESS_WEIGHT = 1.0       # on second differences of the coefficients, in noise units per unit of h
-RIDGE_WEIGHT = 0.1           # on the coefficients themselves
+RIDGE_WEIGHT = 3.0           # on the coefficients themselves
 MAX_EVALUATIONS = 150        # Jacobians: each costs one model evaluation per parameter of the model, plus one
 CORRECTION_POINTS = 120      # where the correction is reported
 DERIVATIVE_STEP = 1e-7       # the shift of h (and the relative step of the model's parameters)
 COMPLIANCE_TOP_OVER_FS = 2.0
+DETERMINED_RATIO = 3.0
 TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a ranking needs no more
 # The correction replaces what the model already has at its site: the base elements there and the
 # effects there are held at the current fit (the correction can take on any change of theirs, and
@@ -61,8 +63,21 @@ class SiteResult:
     delta_bic: float
     edf: float
     freqs: np.ndarray             # where the correction is given (log-spaced over the band)
-    factor: np.ndarray            # complex factor on the site's own quantity (Ze, Bl, Zm, Cms, I or X)
+    correction: np.ndarray        # complex: what it adds (electrical, mechanical) or the factor (the others)
+    unit: str                     # "ohm", "kg/s" (or "Rms" without the laser's Bl), "1" for a factor
+    acts_as: str                  # what the values are, in words ("added to the blocked impedance Ze", ...)
     success: bool
+    # The standard error of the correction at each of `freqs` (of its real and of its imaginary part):
+    # where it is large, the data do not see the correction and its shape there means nothing.
+    correction_std: np.ndarray | None = None
+
+    @property
+    def determined(self) -> np.ndarray:
+        """Where the data determine the correction: its standard error below a third of its size there."""
+        if self.correction_std is None:
+            return np.ones(len(self.freqs), dtype=bool)
+        size = np.abs(self.correction - (1.0 if self.unit == "1" else 0.0))
+        return self.correction_std < np.maximum(size / DETERMINED_RATIO, 1e-300)
 
     @property
     def key(self) -> str:
@@ -71,8 +86,10 @@ class SiteResult:
     def as_json(self) -> dict:
         return {"site": self.key, "delta_bic": float(self.delta_bic), "edf": float(self.edf),
                 "chi2_red": {k: float(v) for k, v in self.chi2_red.items()},
-                "correction": {"f": self.freqs.tolist(), "magnitude": np.abs(self.factor).tolist(),
-                               "phase_deg": np.degrees(np.angle(self.factor)).tolist()}}
+                "correction": {"f": self.freqs.tolist(), "magnitude": np.abs(self.correction).tolist(),
+                               "phase_deg": np.degrees(np.angle(self.correction)).tolist(),
+                               "unit": self.unit, "acts_as": self.acts_as,
+                               "determined": self.determined.tolist()}}
 
 
 def usable_sites(model: Model) -> tuple[Site, ...]:
@@ -206,12 +223,27 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
     k = problem.k + edf
     chi2_red = {name: c / max(m - k * m / n, 1.0) for name, (c, m) in chi2_by_channel.items()}
     freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
-    s = 2j * np.pi * freqs
-    factor = problem.correction.factor(freqs, p, {"Ze": problem.model.blocked_impedance(s, p),
-                                                  "Y": 1.0 / problem.model.motional_impedance(s, p)})
+    shown, unit, acts_as, scale = problem.correction.shown(freqs, p)
+    std = scale * _h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
     return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
-                      chi2 - current.chi2 + edf * np.log(n), edf, freqs, factor,
-                      bool(result.status > 0))
+                      chi2 - current.chi2 + edf * np.log(n), edf, freqs, shown, unit, acts_as, bool(result.status > 0),
+                      std)
+
+
+def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:
+    """Standard error of h (the larger of its real and imaginary part's) at `freqs`, the model's parameters held.
+
+    Held, because the question is whether the data see the correction at a
+    frequency at all; how it shares a smooth trend with Mms or Cms (which it
+    can imitate) is another matter, and would make every point look unseen.
+    """
+    k, m = problem.k, problem.n_basis
+    J = np.asarray(jac)[:, k:]
+    covariance = np.linalg.pinv(J.T @ J) * birge
+    design = problem.correction.design(freqs)
+    var_re = np.einsum("ij,jk,ik->i", design, covariance[:m, :m], design)
+    var_im = np.einsum("ij,jk,ik->i", design, covariance[m:, m:], design)
+    return np.sqrt(np.maximum(np.maximum(var_re, var_im), 0.0))
 
 
 def _effective_dof(jac: np.ndarray, n_model: int, n_data: int) -> float:
@@ -224,17 +256,21 @@ def _effective_dof(jac: np.ndarray, n_model: int, n_data: int) -> float:
 
 
 def localise(data: FitData, current: FitResult, executor: Executor | None = None,
-             sites: tuple[Site, ...] | None = None, known: dict[Site, SiteResult] | None = None
-             ) -> tuple[SiteResult, ...]:
+             sites: tuple[Site, ...] | None = None, known: dict[Site, SiteResult] | None = None,
+             cancel: threading.Event | None = None) -> tuple[SiteResult, ...]:
     """The sites' corrections (every usable site by default), best (lowest delta BIC) first.
 
     `known`: results already computed for `current` (the diagnosis computes some on its way).
     """
-    wanted = [s for s in (sites or usable_sites(current.model)) if not known or s not in known]
+    known = known or {}
+    wanted = [s for s in (sites or usable_sites(current.model)) if s not in known]
     if executor is not None:
         futures = [executor.submit(fit_site, data, current, site) for site in wanted]
         fitted = [f.result() for f in futures]
     else:
-        fitted = [fit_site(data, current, site) for site in wanted]
-    results = list((known or {}).values()) + fitted
-    return tuple(sorted(results, key=lambda r: r.delta_bic))
+        fitted = []
+        for site in wanted:
+            if cancel is not None and cancel.is_set():
+                raise FitCancelled("site localisation cancelled")
+            fitted.append(fit_site(data, current, site))
+    return tuple(sorted(list(known.values()) + fitted, key=lambda r: r.delta_bic))

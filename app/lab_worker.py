@@ -19,9 +19,12 @@ from typing import Callable
 from PySide6.QtCore import QObject, Signal
 
 from analysis import residuals
+from analysis.acceptance import Flag
 from analysis.derived import parameter_table
-from analysis.diagnosis import MAX_STEPS, Candidate, diagnose, explain
+from analysis.diagnosis import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
+from analysis.diagnosis_words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
+from analysis.sites import SiteResult
 from analysis.fit import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.parallel import fit_executor
@@ -65,6 +68,9 @@ class CandidateRow:
     explanation: str                # analysis.diagnosis.explain
     fitted: LabFit | None           # None when the refit failed
     error: str | None = None
+    flags: tuple[Flag, ...] = ()
+    accepted: bool = False          # the acceptance rule would take it (analysis.acceptance)
+    judgement: str = ""             # why (not): the assessment's reason code
 
     @property
     def chi2_red(self) -> dict[str, float]:
@@ -83,11 +89,35 @@ class DiagnosisOutcome:
     candidates: tuple[CandidateRow, ...]    # best first
     path: tuple[LabFit, ...]                # greedy path: the models taken, in order (empty: ranking only)
     residual: str                           # where the residual of ranked_from sits
+    verdict: str = ""                       # analysis.acceptance's four verdicts
+    verdict_text: str = ""                  # the verdict in plain words, with the site and what to do next
+    sites: tuple[SiteResult, ...] = ()      # where the misfit left belongs, best first
+    step_cap_reached: bool = False
+    verdict_headline: str = ""              # the verdict in one short sentence
+
+    @property
+    def chosen(self) -> CandidateRow | None:
+        """The candidate the acceptance rule takes (None: none would be taken)."""
+        return next((c for c in self.candidates if c.accepted), None)
 
 
 def _row(base: AnalysisResult, ranked_from: FitResult, c: Candidate) -> CandidateRow:
     return CandidateRow(c.action, c.effect, c.replaces, c.delta_bic, explain(ranked_from, c),
-                        lab_fit(base, c.fit) if c.fit is not None else None, c.error)
+                        lab_fit(base, c.fit) if c.fit is not None else None, c.error, c.flags, c.accepted,
+                        c.assessment.reason if c.assessment else "")
+
+
+def diagnosis_outcome(base: AnalysisResult, result: Diagnosis, follow: bool) -> DiagnosisOutcome:
+    """What the lab shows of a diagnosis: the last ranking, the path taken, the verdict and the sites."""
+    if follow:
+        last = result.steps[-1]
+        path = tuple(lab_fit(base, step.fit) for step in result.steps[1:])
+    else:
+        last, path = result.steps[0], ()
+    rows = tuple(_row(base, last.fit, c) for c in last.candidates)
+    drift = drift_from_validity(base.validity)
+    return DiagnosisOutcome(last.fit, rows, path, last.residual, result.verdict, verdict_text(result, drift),
+                            result.sites, result.step_cap_reached, verdict_headline(result))
 
 
 class DiagnosisCancelled(Exception):
@@ -186,35 +216,34 @@ class DiagnoseJob(LabJob):
     """Rank the candidates from `start` (follow=False) or follow the greedy path from it (follow=True).
 
     `taken`, when known, is the candidate a previous ranking of `start` chose:
-    the greedy path then goes on from it instead of ranking `start` again.
+    the greedy path then goes on from it instead of ranking `start` again
+    (it still counts as the path's first step, for the verdict).
     """
 
     kind = "diagnosis"
 
-    def __init__(self, job, worker, base, data, start: FitResult, follow: bool, taken: LabFit | None = None):
+    def __init__(self, job, worker, base, data, start: FitResult, follow: bool, taken: CandidateRow | None = None):
         super().__init__(job, worker, base, data)
         self.start = start
         self.follow = follow
         self.taken = taken
 
     def run(self) -> None:
-        begin = self.taken.fit if self.taken is not None else self.start
+        begin = self.taken.fitted.fit if self.taken is not None else self.start
         progress: Callable[[str], None] = lambda text: self._worker.progress.emit(self.id, text)
         with fit_executor() as pool:
             executor = None if pool is None else _CancellableExecutor(pool, self.cancel_event)
             result = diagnose(self.data, begin.model, executor=executor, cancel=self.cancel_event,
-                              start_fit=begin, progress=progress, max_steps=MAX_STEPS if self.follow else 1)
+                              start_fit=begin, progress=progress, max_steps=MAX_STEPS, follow=self.follow)
         if self.cancel_event.is_set():
             raise DiagnosisCancelled("cancelled after the diagnosis")
-        if self.follow:
-            steps = result.steps
-            last = steps[-1]
-            path = ((self.taken,) if self.taken is not None else ()) + tuple(
-                lab_fit(self.base, step.fit) for step in steps[1:])
-        else:
-            last, path = result.steps[0], ()
-        rows = tuple(_row(self.base, last.fit, c) for c in last.candidates)
-        self._worker.diagnosis_finished.emit(self.id, DiagnosisOutcome(last.fit, rows, path, last.residual))
+        if self.taken is not None:
+            t = self.taken
+            first = Step(self.start, (), residuals.describe(self.start),
+                         Candidate(t.action, t.effect, t.replaces, t.fitted.fit, t.delta_bic, t.error, t.flags))
+            result = dataclasses.replace(result, steps=(first,) + result.steps)
+        outcome = diagnosis_outcome(self.base, result, self.follow)
+        self._worker.diagnosis_finished.emit(self.id, outcome)
 
 
 class LabWorker(QObject, JobBook):
@@ -232,7 +261,7 @@ class LabWorker(QObject, JobBook):
         return self._start(RefitJob(self._next_id(), self, base, data, model, dict(start)))
 
     def diagnose(self, base: AnalysisResult, data: FitData, start: FitResult, follow: bool = False,
-                 taken: LabFit | None = None) -> LabJob:
+                 taken: CandidateRow | None = None) -> LabJob:
         return self._start(DiagnoseJob(self._next_id(), self, base, data, start, follow, taken))
 
 

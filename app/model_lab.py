@@ -12,70 +12,30 @@ from __future__ import annotations
 
 import dataclasses
 import html
-from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import (QHBoxLayout, QLabel, QProgressBar, QPushButton, QSplitter, QStackedWidget,
-                               QVBoxLayout, QWidget)
+                               QTabWidget, QVBoxLayout, QWidget)
 
-from analysis import residuals
+from analysis import acceptance, residuals
 from analysis.derived import parameter_table
-from analysis.diagnosis import MIN_BIC_GAIN
-from analysis.effects import get_effect
 from analysis.fit import FitData
-from analysis.model import Model, ModelError
+from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult
 from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
 from app.layout_room import keep_room_when_hidden
 from app.model_lab_candidates import CandidatesPanel
 from app.model_lab_catalogue import EffectCatalogue
 from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
+from app.model_lab_sites import SitePanel
+from app.model_lab_versions import LabVersion, changed_model, move_text
 from app.parameter_table import titled_parameter_table
 from app.result_curves import result_curves
 from app.workers import AnalysisOutcome
 
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")
-
-
-@dataclass(frozen=True, slots=True)
-class LabVersion:
-    number: int          # 1, 2, ...: the x axis of the chi^2 chart
-    fitted: LabFit
-    how: str             # how it came about, for the chart's tooltip and the header
-
-    @property
-    def effects(self) -> str:
-        return ", ".join(self.fitted.fit.model.effect_ids) or "textbook"
-
-
-def move_text(old: Model, new: Model) -> str:
-    """What changed from `old` to `new`, in the words of the catalogue: 'added delay-x; removed lr2'."""
-    before = {e.category: e for e in old.effects}
-    after = {e.category: e for e in new.effects}
-    moves = []
-    for category, effect in before.items():
-        if category not in after:
-            moves.append(f"removed {effect.id}")
-        elif after[category].id != effect.id:
-            moves.append(f"replaced {effect.id} by {after[category].id}")
-    moves += [f"added {e.id}" for c, e in after.items() if c not in before]
-    return "; ".join(moves) or "refitted"
-
-
-def changed_model(current: Model, checked: tuple[str, ...]) -> Model:
-    """The current model with the checked effects: kept in place, swapped in place, new ones at the end."""
-    chosen = {}
-    for effect_id in checked:
-        effect = get_effect(effect_id)
-        chosen[effect.category] = effect
-    effects = []
-    for effect in current.effects:
-        new = chosen.pop(effect.category, None)
-        if new is not None:
-            effects.append(new)
-    return current.with_effects(effects + list(chosen.values()))
 
 
 class ModelLab(QWidget):
@@ -122,6 +82,10 @@ class ModelLab(QWidget):
         self.residual_panel = ResidualPanel()
         self.candidates = CandidatesPanel()
         self.chart = ChiSquareChart()
+        self.site_panel = SitePanel()
+        self.views = QTabWidget()          # reduced chi^2 by version, or where the physics is missing
+        self.views.addTab(self.chart, "Reduced χ²")
+        self.views.addTab(self.site_panel, "Missing physics")
         table_box, self.parameter_table = titled_parameter_table("<b>Parameters</b> of the current version (bold: fitted)")
 
         middle = QSplitter(Qt.Vertical)
@@ -129,9 +93,9 @@ class ModelLab(QWidget):
         middle.addWidget(self.candidates)
         middle.setSizes([440, 360])
         right = QSplitter(Qt.Vertical)
-        right.addWidget(self.chart)
+        right.addWidget(self.views)
         right.addWidget(table_box)
-        right.setSizes([330, 470])
+        right.setSizes([420, 380])
         splitter = QSplitter(Qt.Horizontal)
         splitter.addWidget(self.catalogue)
         splitter.addWidget(middle)
@@ -187,6 +151,8 @@ class ModelLab(QWidget):
         self.versions = []
         self.diagnosis, self.diagnosis_version = None, 0
         self.candidates.set_outcome(None)
+        self.site_panel.set_sites(())
+        self.views.setCurrentWidget(self.chart)
         self.catalogue.set_displacement_available(result.fit.model.with_displacement)
         # Curves and the residual in words take well under a millisecond: no worker needed.
         first = LabFit(result, result_curves(result), residuals.describe(result.fit))
@@ -221,6 +187,7 @@ class ModelLab(QWidget):
         self._show_current()
         if self.diagnosis is not None and self.diagnosis_version != version.number:
             self.candidates.mark_stale(version.number)
+            self.site_panel.mark_stale(version.number)
         if adopt and announce:
             result = version.fitted.result
             self.model_adopted.emit(AnalysisOutcome(version.number, result.source or Path(), result,
@@ -313,10 +280,8 @@ class ModelLab(QWidget):
         if self.current is None or self.busy:
             return
         taken = None
-        if self.diagnosis is not None and self.diagnosis_version == self.current.number and self.diagnosis.candidates:
-            best = self.diagnosis.candidates[0]
-            if best.fitted is not None and best.delta_bic < -MIN_BIC_GAIN:
-                taken = best.fitted       # ranked already: the path goes on from there
+        if self.diagnosis is not None and self.diagnosis_version == self.current.number:
+            taken = self.diagnosis.chosen     # ranked already: the path goes on from the one it would take
         self.job = self.worker.diagnose(self.base, self.data, self.current.fitted.fit, follow=True, taken=taken)
         self._set_busy(True, f"Following the greedy path from version {self.current.number}…")
 
@@ -328,7 +293,9 @@ class ModelLab(QWidget):
         old = self.current
         self._add_version(row.fitted, f"{move_text(old.fitted.fit.model, row.fitted.fit.model)} "
                                       f"from the diagnosis of version {old.number}")
-        self.status_label.setText(f"Applied: {row.move} (ΔBIC {row.delta_bic:+.4g})")
+        # Applying a candidate the diagnosis would not take is the user's call, never a silent one.
+        caveat = "" if row.accepted else f"; not one the diagnosis would take ({row.judgement})"
+        self.status_label.setText(f"Applied: {row.move} (ΔBIC {row.delta_bic:+.4g}){caveat}")
 
     @Slot()
     def on_candidate_selected(self) -> None:
@@ -371,11 +338,13 @@ class ModelLab(QWidget):
                                       f"{move_text(previous, fitted.fit.model)}", announce=last)
         self.diagnosis, self.diagnosis_version = outcome, self.current.number
         self.candidates.set_outcome(outcome, self.current.number, self.current.effects)
+        self.site_panel.set_sites(outcome.sites)
+        if outcome.verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED) and self.site_panel.shown_site:
+            self.views.setCurrentWidget(self.site_panel)     # the misfit left: where it belongs
         if outcome.path:
             self.status_label.setText(f"Greedy path: {len(outcome.path)} step(s), now version {self.current.number}")
         elif getattr(finished, "follow", False):
-            self.status_label.setText(f"The greedy path stops at once: no candidate lowers BIC by more than "
-                                      f"{MIN_BIC_GAIN:g}")
+            self.status_label.setText("The greedy path stops at once: no candidate explains the misfit it removes")
         else:
             self.status_label.setText(f"Diagnosed version {self.current.number}: {len(outcome.candidates)} "
                                       f"candidates")

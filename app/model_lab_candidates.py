@@ -10,15 +10,31 @@ from PySide6.QtGui import QFont
 from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QTableWidget,
                                QTableWidgetItem, QTextBrowser, QVBoxLayout, QWidget)
 
-from analysis.diagnosis import MIN_BIC_GAIN
+from analysis import acceptance
+from analysis.diagnosis_words import VERDICT_TITLES
 from app.lab_worker import CandidateRow, DiagnosisOutcome
 from app.model_lab_catalogue import category_title
 
-COLUMNS = ("#", "Action", "Effect", "Category", "ΔBIC", "χ²ᵣ Z", "χ²ᵣ Hx")
-RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, CHI2_Z, CHI2_X = range(len(COLUMNS))
+COLUMNS = ("#", "Action", "Effect", "Category", "ΔBIC", "χ²ᵣ Z", "χ²ᵣ Hx", "Acceptable")
+RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, CHI2_Z, CHI2_X, JUDGED = range(len(COLUMNS))
 CHI2_COLUMNS = {"impedance": CHI2_Z, "displacement": CHI2_X}
 NO_DIAGNOSIS = ("Diagnose tries every effect one move away from the current model (add one of a new category, "
-                "or swap one for an alternative), refits each and ranks them by how much they lower BIC.")
+                "or swap one for an alternative), refits each and ranks them by how much they lower BIC. An effect "
+                "is taken only when it also explains the misfit it removes; when none does, the diagnosis says "
+                "where the physics is missing.")
+JUDGEMENT_WORDS = {acceptance.ACCEPTED: "yes", acceptance.FLAGGED: "no: flagged", acceptance.NO_GAIN: "no: no gain",
+                   acceptance.MISFIT_LEFT: "no: misfit left", acceptance.FAILED: "refit failed"}
+JUDGEMENT_TIPS = {
+    acceptance.ACCEPTED: "it pays for its parameters and explains the misfit it removes; the greedy path takes "
+                         "the best of these",
+    acceptance.FLAGGED: "a parameter ended on a bound, outside its typical range or undetermined, or a channel "
+                        "got worse",
+    acceptance.NO_GAIN: "it does not lower the misfit enough to pay for its parameters",
+    acceptance.MISFIT_LEFT: "it removes only part of what a smooth correction at its site removes: it absorbs a "
+                            "misfit it does not explain",
+}
+VERDICT_COLOURS = {acceptance.NOTHING_MISSING: "#2e7d32", acceptance.EXPLAINED: "#2e7d32",
+                   acceptance.PARTLY_EXPLAINED: "#b26a00", acceptance.UNEXPLAINED: "#8e1b1b"}
 
 
 def bic_text(delta_bic: float) -> str:
@@ -40,8 +56,8 @@ class CandidatesPanel(QWidget):
         self.apply_button = QPushButton("Apply")
         self.apply_button.setToolTip("Adopt the selected candidate: its fit is already computed")
         self.follow_button = QPushButton("Follow the greedy path")
-        self.follow_button.setToolTip(f"Take the best candidate while it lowers BIC by more than "
-                                      f"{MIN_BIC_GAIN:g}, then stop; every step becomes a version")
+        self.follow_button.setToolTip("Take the best candidate that explains the misfit it removes, again and "
+                                      "again, then stop; every step becomes a version")
         buttons = QHBoxLayout()
         buttons.setContentsMargins(0, 0, 0, 0)
         for button in (self.diagnose_button, self.apply_button, self.follow_button):
@@ -50,6 +66,11 @@ class CandidatesPanel(QWidget):
         self.title = QLabel("<b>Diagnosis</b>")
         self.title.setTextFormat(Qt.RichText)
         self.title.setWordWrap(True)
+        self.verdict = QLabel()
+        self.verdict.setTextFormat(Qt.RichText)
+        self.verdict.setWordWrap(True)
+        self.verdict.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.verdict.hide()
 
         self.table = QTableWidget(0, len(COLUMNS))
         self.table.setHorizontalHeaderLabels(COLUMNS)
@@ -72,6 +93,7 @@ class CandidatesPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addLayout(buttons)
+        layout.addWidget(self.verdict)
         layout.addWidget(self.title)
         layout.addWidget(self.table, 3)
         layout.addWidget(self.explanation, 2)
@@ -81,6 +103,7 @@ class CandidatesPanel(QWidget):
         self.stale = False
         self.table.clearSelection()
         self.rows = outcome.candidates if outcome is not None else ()
+        chosen = outcome.chosen if outcome is not None else None
         self.table.setRowCount(len(self.rows))
         for r, row in enumerate(self.rows):
             # Read across, "replace lr2 by" + "lr3" is the move; the effect column stays a plain id.
@@ -90,31 +113,50 @@ class CandidatesPanel(QWidget):
             for channel, column in CHI2_COLUMNS.items():
                 value = row.chi2_red.get(channel)
                 cells[column] = f"{value:.3g}" if value is not None else ("–" if row.fitted else "failed")
+            cells[JUDGED] = JUDGEMENT_WORDS.get(row.judgement, row.judgement)
+            if row is chosen:
+                cells[JUDGED] = "yes: the best"
             for column, text in cells.items():
                 item = QTableWidgetItem(text)
                 if column in (RANK, DELTA_BIC, CHI2_Z, CHI2_X):
                     item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
                 if column == EFFECT:
                     item.setToolTip(row.effect.title)
-                if column == DELTA_BIC and row.delta_bic < -MIN_BIC_GAIN:
+                if column == JUDGED:
+                    item.setToolTip(JUDGEMENT_TIPS.get(row.judgement, ""))
+                if row.accepted and column in (DELTA_BIC, JUDGED):
                     font = QFont()
-                    font.setBold(True)     # the data ask for it: it pays for its parameters
+                    font.setBold(True)     # the acceptance rule would take it
                     item.setFont(font)
-                    item.setToolTip(f"lowers BIC by more than {MIN_BIC_GAIN:g}: strong evidence")
                 self.table.setItem(r, column, item)
         if outcome is None:
             self._heading = "<b>Diagnosis</b>"
             self.title.setText(self._heading)
+            self.verdict.hide()
             self.explanation.setHtml(f"<p>{html.escape(NO_DIAGNOSIS)}</p>")
         else:
             self._heading = f"<b>Diagnosis</b> of version {version} ({html.escape(effects)})"
             self.title.setText(f"{self._heading}: {len(self.rows)} candidates, best first")
-            if self.rows:
-                self.table.selectRow(0)
-            else:
-                self.explanation.setHtml("<p>No candidate was ranked from this model: Diagnose to rank "
-                                         "from it.</p>")
+            self.show_verdict(outcome)
+            chosen = next((i for i, row in enumerate(self.rows) if row.accepted), None)
+            if chosen is not None:
+                self.table.selectRow(chosen)      # the one the diagnosis would take
+            else:                                 # none would be taken: nothing to offer first
+                self.explanation.setHtml(f"<p>{html.escape(outcome.verdict_text)}</p>" if outcome.verdict_text
+                                         else "<p>No candidate was ranked from this model: Diagnose to rank "
+                                              "from it.</p>")
         self.selected_changed.emit()
+
+    def show_verdict(self, outcome: DiagnosisOutcome) -> None:
+        if not outcome.verdict:
+            self.verdict.hide()
+            return
+        colour = VERDICT_COLOURS.get(outcome.verdict, "#333")
+        # One short sentence here; the whole verdict (where, the site, what next) below and in the tooltip.
+        self.verdict.setText(f"<span style='color:{colour}'><b>{html.escape(VERDICT_TITLES[outcome.verdict])}"
+                             f"</b></span> · {html.escape(outcome.verdict_headline)}")
+        self.verdict.setToolTip(outcome.verdict_text)
+        self.verdict.show()
 
     def mark_stale(self, version: int) -> None:
         """The model changed since the diagnosis: its candidates are one move from an older version."""
@@ -137,6 +179,8 @@ class CandidatesPanel(QWidget):
     def on_selection_changed(self) -> None:
         row = self.selected()
         if row is not None:
+            flags = "".join(f"<li>{html.escape(f.message)}</li>" for f in row.flags)
             self.explanation.setHtml(f"<p><b>{html.escape(row.move)}</b> ({html.escape(row.effect.title)}): "
-                                     f"{html.escape(row.explanation)}</p>")
+                                     f"{html.escape(row.explanation)}</p>"
+                                     + (f"<p>Flags:</p><ul>{flags}</ul>" if flags else ""))
         self.selected_changed.emit()

@@ -5,7 +5,11 @@
 Writes results.png (and one PNG per Results plot tab and per other page) to
 docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
 model-lab-after.png: a recording whose laser lags by 100 us, diagnosed in the
-Model lab, before and after applying the top candidate; then wizard-1-driver.png
+Model lab, before and after applying the top candidate;
+model-lab-unexplained-1280x720.png and -1920x1080.png: a recording with
+damping the catalogue lacks, the greedy path ending "unexplained" with the
+mechanical site's correction plotted (--only model-lab: just the Model lab's
+screenshots); then wizard-1-driver.png
 .. wizard-6-results.png: the measurement wizard run on the in-process
 simulator, live-panels.png: the live panels in the middle of a real-time
 measurement, and qa-measured.png, qa-limits.png, qa-invalid.png: the QA page on
@@ -39,6 +43,7 @@ from analysis.recording import write_recording  # noqa: E402
 from analysis.synthesis import ChannelNoise, synthesize_recording  # noqa: E402
 
 SIZE = (1400, 900)
+SMALL_AND_LARGE = ((1280, 720), (1920, 1080))     # a laptop and a desktop screen
 ANALYSIS_TIMEOUT_S = 120
 HIDDEN_DELAY_S = 100e-6     # the laser's latency the default model does not know about
 
@@ -92,6 +97,39 @@ def model_lab_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     lab.candidates.apply_button.click()
     settle(app)
     window.grab().save(str(written[1]))
+    return written
+
+
+def odd_mechanical_recording(folder: Path) -> Path:
+    """The paper's driver with a hump of damping at 250 Hz that no catalogue holds (tests/odd_physics.py)."""
+    from tests.odd_physics import odd_recording
+    wav, _ = write_recording(folder / "paper-odd-damping", odd_recording("mechanical"))
+    return wav
+
+
+def model_lab_unexplained_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Model lab following the greedy path on physics the catalogue lacks: it ends "unexplained", pointing
+    at the mechanical site, with that site's correction plotted; at 1280x720 and at 1920x1080."""
+    window.open_path(odd_mechanical_recording(folder))
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the odd-damping recording was not analysed in time", file=sys.stderr)
+        return []
+    lab = window.model_lab
+    window.pages.setCurrentWidget(lab)
+    settle(app)
+    lab.candidates.follow_button.click()
+    if not wait_for(lab.diagnosis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the diagnosis of the odd-damping recording did not finish in time", file=sys.stderr)
+        return []
+    written = []
+    for width, height in SMALL_AND_LARGE:
+        window.resize(width, height)
+        settle(app, 600)
+        path = out / f"model-lab-unexplained-{width}x{height}.png"
+        window.grab().save(str(path))
+        written.append(path)
+    window.resize(*SIZE)
+    settle(app)
     return written
 
 
@@ -259,6 +297,21 @@ def archive_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
     return written
 
 
+def model_lab_only(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """--only model-lab: the lab's page as the Results page hands it over, then its two diagnosis sessions."""
+    window.open_path(synthetic_recording(folder))
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the synthetic recording was not analysed in time", file=sys.stderr)
+        return []
+    window.pages.setCurrentWidget(window.model_lab)
+    settle(app)
+    written = [out / "model-lab.png"]
+    window.grab().save(str(written[0]))
+    written += model_lab_screenshots(app, window, folder, out)
+    written += model_lab_unexplained_screenshots(app, window, folder, out)
+    return written
+
+
 def wait_for_click(button, busy_changed, timeout_s: float = ANALYSIS_TIMEOUT_S) -> bool:
     """Click `button` and wait until the job it starts is over (busy_changed(False))."""
     loop = QEventLoop()
@@ -299,8 +352,8 @@ def main(argv: list[str]) -> int:
         at = argv.index("--only")
         only = argv[at + 1] if at + 1 < len(argv) else ""
         argv = argv[:at] + argv[at + 2:]
-        if only != "archive":
-            print("screenshots: --only takes 'archive'", file=sys.stderr)
+        if only not in ("archive", "model-lab"):
+            print("screenshots: --only takes 'archive' or 'model-lab'", file=sys.stderr)
             return 2
     out = Path(argv[1]) if len(argv) > 1 else ROOT / "docs" / "screenshots"
     out.mkdir(parents=True, exist_ok=True)
@@ -315,8 +368,8 @@ def main(argv: list[str]) -> int:
         window.archive.set_root(folder / "archive")      # the wizard's measurement is stored there too
         window.resize(*SIZE)
         window.show()
-        if only == "archive":
-            written = archive_screenshots(app, window, folder, out)
+        if only in ("archive", "model-lab"):
+            written = (archive_screenshots if only == "archive" else model_lab_only)(app, window, folder, out)
             window.close()
             for path in written:
                 print(path)
@@ -354,6 +407,7 @@ def main(argv: list[str]) -> int:
             window.grab().save(str(path))
             written.append(path)
         written += model_lab_screenshots(app, window, folder, out)
+        written += model_lab_unexplained_screenshots(app, window, folder, out)
         written += measure_screenshots(app, window, folder, out)
         written += series_screenshots(app, window, folder, out)
         written += archive_screenshots(app, window, folder, out)

@@ -24,7 +24,7 @@ from analysis.recording import read_recording
 from app import style
 from app.model_lab import ModelLab
 from app.model_lab_catalogue import EFFECT_ROLE
-from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT
+from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
 from app.parameter_table import VALUE
 
 from .conftest import ANALYSIS_TIMEOUT_MS, PAPER, open_and_wait
@@ -286,3 +286,45 @@ def test_the_main_window_hands_its_result_to_the_lab_and_shows_the_labs_model(qt
     vas = lab.current.fitted.result.parameters["Vas"]
     assert vas.value == pytest.approx(window.results.result.parameters["Vas"].value)
     assert np.isfinite(vas.value)
+
+
+@pytest.fixture(scope="session")
+def odd_mechanical_result():
+    from tests.odd_physics import odd_recording
+    return analyze_recording(odd_recording("mechanical"), effects=(get_effect("lr2"), get_effect("creep-log")))
+
+
+def test_physics_the_catalogue_lacks_ends_unexplained_with_the_site_and_its_correction(qtbot, make_lab,
+                                                                                       odd_mechanical_result):
+    lab = make_lab(odd_mechanical_result)
+    assert lab.views.currentWidget() is lab.chart
+    outcome = _diagnose(qtbot, lab, lab.candidates.follow_button)
+    assert outcome.verdict == "unexplained" and not outcome.path and len(lab.versions) == 1
+    verdict = lab.candidates.verdict
+    assert verdict.isVisible() and "Unexplained" in verdict.text() and "mechanical site" in verdict.text()
+    assert "effect of your own" in verdict.toolTip()
+    assert "effect of your own" in lab.candidates.explanation.toPlainText()      # nothing selected: the verdict
+    assert lab.candidates.selected() is None and not lab.candidates.apply_button.isEnabled()
+    assert all(row.judgement != "accepted" for row in outcome.candidates)
+    assert lab.candidates.table.item(0, JUDGED).text().startswith("no")
+    # The right-hand side turns to where the physics is missing, with the mechanical site's correction.
+    assert lab.views.currentWidget() is lab.site_panel and lab.site_panel.shown_site == "mechanical"
+    assert "Look at the mechanical site" in lab.site_panel.heading.text()
+    log_f, added = lab.site_panel.plot.size_curve.getData()       # the resistance it adds to Zm, in kg/s
+    freqs = 10.0 ** log_f                                            # a log axis holds log10(f)
+    seen = np.isfinite(added)                                        # drawn where the data determine it
+    assert len(freqs) > 50 and seen.sum() > 50
+    hump = freqs[seen][np.argmax(added[seen])]
+    assert 100 < hump < 500 and np.max(added[seen]) > 0.03         # the odd damping: 0.15 kg/s around 250 Hz
+    assert "compliance" in lab.site_panel.ranking.text()
+
+
+def test_a_flagged_candidate_can_be_applied_by_hand_and_says_so(qtbot, make_lab, odd_mechanical_result):
+    lab = make_lab(odd_mechanical_result)
+    outcome = _diagnose(qtbot, lab)
+    flagged = next(i for i, row in enumerate(outcome.candidates) if row.flags and row.fitted is not None)
+    lab.candidates.select(flagged)
+    assert "Flags:" in lab.candidates.explanation.toPlainText()
+    assert lab.candidates.apply_button.isEnabled()
+    qtbot.mouseClick(lab.candidates.apply_button, Qt.LeftButton)
+    assert lab.current.number == 2 and "not one the diagnosis would take" in lab.status_label.text()
