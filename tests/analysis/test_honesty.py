@@ -101,3 +101,16 @@ def test_with_a_hidden_delay_too_the_delay_is_taken_and_the_rest_left_to_its_sit
     assert result.final.model.effect_ids == ("lr2", "creep-log", "delay-current")
     assert result.final.values["tau_i"] == pytest.approx(20e-6, rel=0.05)
     assert result.sites[0].key == site
+
+
+def test_a_reduced_chi2_far_below_one_is_said_to_be_an_inflated_noise_not_the_noise_floor(pool):
+    import dataclasses
+    from analysis.diagnosis_words import verdict_text
+    data = FitData.from_spectra(estimate_spectra(odd_recording(None)))
+    inflated = FitData(*(dataclasses.replace(tf, std=10 * tf.std) for tf in (data.impedance, data.displacement)))
+    result = diagnose(inflated, Model(parse_effects(DEFAULT)), executor=pool, locate=False)
+    assert result.verdict == acceptance.NOTHING_MISSING
+    assert {f.channel for f in result.final_flags if f.code == acceptance.NOISE_INFLATED} == {"impedance",
+                                                                                              "displacement"}
+    text = verdict_text(result, drift="current: the current changed by 0.4 % during the measurement")
+    assert "inflated" in text and "drift" in text and "0.4 %" in text
