@@ -48,7 +48,7 @@ HX_MAX_OVER_FS = 4.0
 LINES_PER_DECADE = 100
 VALIDITY_NOTE = "imported curves: no per-line noise of their own, no validity checks"
 UNCERTAINTY_NOTE = ("imported curves carry no noise estimate of their own: each line's noise is estimated from the "
-                    "curve's local scatter (a quadratic in log f over 7 lines, pooled over 15), and the "
+                    "curve's local scatter (a quadratic over 7 neighbouring lines, pooled over 15), and the "
                     "uncertainties are scaled by sqrt(reduced chi^2) where the model misses by more than that noise; "
                     "a curve smoothed by the tool that exported it looks less noisy than it was")
 # Below this many lines per decade a curve changes too much from line to line for its local scatter

@@ -100,7 +100,9 @@ class Diagnosis:
 
     @property
     def final_flags(self) -> tuple[Flag, ...]:
-        return self.steps[-1].flags
+        """The flags of the final model (and the step cap when the path reached it)."""
+        last = self.steps[-1]
+        return _model_flags(last.chosen.fit) if last.chosen is not None else last.flags
 
 
 def candidate_models(model: Model) -> list[tuple[str, Effect, Effect | None, Model]]:
@@ -219,7 +221,7 @@ class _SiteFits:
             self.done.update((r.site, r) for r in localise(self.data, self.fit, self.executor, sites=wanted))
 
 
-def choose(data: FitData, current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
+def choose(current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
            ) -> tuple[tuple[Candidate, ...], Candidate | None]:
     """Rule 3 for the candidates that pass rules 1 and 2; the best accepted one (None: stop)."""
     passing = [c for c in ranked if c.accepted]
@@ -271,7 +273,7 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
             progress(f"trying every effect on {current.model.describe()}")
         ranked = rank_candidates(data, current, executor, cancel)
         sites = _SiteFits(data, current, executor)
-        ranked, best = choose(data, current, ranked, sites)
+        ranked, best = choose(current, ranked, sites)
         steps.append(Step(current, ranked, residuals.describe(current), best, _model_flags(current)))
         if best is None or not follow:
             break

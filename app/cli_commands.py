@@ -109,7 +109,8 @@ def cmd_effects(args: argparse.Namespace) -> int:
     for category, effects in categories().items():
         print(f"[{category}]")
         for e in effects:
-            params = ", ".join(f"{p.name} [{p.display_unit}]" for p in e.params)
+            params = ", ".join(f"{p.name} [{p.display_unit}" + (f", typically {p.typical_text()}]" if p.typical else "]")
+                               for p in e.params)
             print(f"  {e.id:<22} {e.title} ({params})")
             print(f"  {'':<22} cures: {e.signature}")
     return 0

@@ -37,7 +37,8 @@ def effect_html(effect: Effect, available: bool = True) -> str:
     """The catalogue entry of an effect, for the detail pane."""
     e = html.escape
     rows = "".join(
-        f"<tr><td><b>{e(p.name)}</b></td><td>{e(p.display_unit)}</td><td>{e(p.description)}</td></tr>"
+        f"<tr><td><b>{e(p.name)}</b></td><td>{e(p.display_unit)}</td><td>{e(p.description)}"
+        + (f"; typically {e(p.typical_text())} (a fit outside is flagged)" if p.typical else "") + "</td></tr>"
         for p in effect.params)
     parts = [
         f"<h3 style='margin-bottom:2px'>{e(effect.title)}</h3>",
