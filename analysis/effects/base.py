@@ -77,7 +77,7 @@ class ParamSpec:
             return ""
         lo, hi = (v * self.display_scale for v in self.typical)
         unit = "" if self.display_unit in ("-", "1") else f" {self.display_unit}"
-        return f"{lo:.3g} to {hi:.3g}{unit}"
+        return f"{lo:.4g} to {hi:.4g}{unit}"
 
 
 @dataclass(frozen=True)
