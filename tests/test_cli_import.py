@@ -58,7 +58,7 @@ def test_analyze_uiv_prints_a_table_with_the_notes(capsys, curves):
     assert code == 0, err
     bl = next(line for line in out.splitlines() if line.startswith("Bl "))
     assert float(bl.split()[1]) == pytest.approx(PAPER.parameters["Bl"], rel=1e-3)
-    assert "residual scatter" in out and "velocity" in out
+    assert "local scatter" in out and "velocity" in out
 
 
 def test_analyze_impedance_alone_reports_why_bl_is_missing(capsys, curves):
