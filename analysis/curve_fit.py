@@ -34,6 +34,7 @@ from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.curve_noise import describe_noise, with_estimated_noise
+from analysis.errors import LinparError
 from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
 from analysis.model import Model
 from analysis.pipeline import model_json
@@ -56,7 +57,7 @@ UNCERTAINTY_NOTE = ("imported curves carry no noise estimate of their own: each 
 MIN_LINES_PER_DECADE_FOR_NOISE = 60
 
 
-class CurveFitError(ValueError):
+class CurveFitError(LinparError, ValueError):
     """The curves cannot be fitted as asked (e.g. too few lines in the chosen range)."""
 
 

@@ -11,12 +11,13 @@ from pathlib import Path
 from typing import Any
 
 from analysis.effects import parse_effects
+from analysis.errors import LinparError
 from analysis.model import Model
 
 DRIVERS_DIR = Path(__file__).resolve().parent.parent / "resources" / "drivers"
 
 
-class DriverFileError(ValueError):
+class DriverFileError(LinparError, ValueError):
     pass
 
 

@@ -28,6 +28,7 @@ import lmfit
 import numpy as np
 
 from analysis.effects.base import Site
+from analysis.errors import LinparError
 from analysis.model import Model
 from analysis.spectra import Spectra, TransferFunction
 from analysis.startvalues import linear_gain, start_context
@@ -39,7 +40,7 @@ CHANNELS = ("impedance", "displacement")
 EVALUATIONS_PER_PARAMETER = 300
 
 
-class FitError(RuntimeError):
+class FitError(LinparError, RuntimeError):
     """The fit could not run (too few lines, cancelled, no convergence)."""
 
 

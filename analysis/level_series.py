@@ -28,6 +28,7 @@ import numpy as np
 
 from analysis.derived import ParameterValue
 from analysis.effects import Effect
+from analysis.errors import LinparError
 from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording
 from analysis.recording import Recording
 from analysis.validity_findings import DISTORTION_HIGH
@@ -37,7 +38,7 @@ TABLE_PARAMETERS = ("fs", "Mms", "Cms", "Kms", "Bl", "Rms", "RE", "Qts", "lambda
 GREEN = "green"
 
 
-class LevelSeriesError(ValueError):
+class LevelSeriesError(LinparError, ValueError):
     """Results that cannot make a level series (none, or one without displacement). One line."""
 
 

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Mapping
 
 from analysis.derived import ParameterValue
+from analysis.errors import LinparError
 
 FORMAT = "linpar-limits/1"
 ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
@@ -42,7 +43,7 @@ _ALIASES = {"Ω": "ohm", "ohms": "ohm", "µF": "uF", "μF": "uF", "L": "l", "m3"
 _PERCENT = re.compile(r"^\s*((?:[0-9]*\.)?[0-9]+(?:[eE][+-]?[0-9]+)?)\s*%\s*$")
 
 
-class LimitsError(ValueError):
+class LimitsError(LinparError, ValueError):
     def __init__(self, message: str):
         super().__init__(" ".join(str(message).splitlines()))
 

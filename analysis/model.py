@@ -21,6 +21,7 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from analysis.errors import LinparError
 # Imported before the effects: effects that need fs import it from here while
 # this module is still loading (analysis.lumped is the cycle-free home).
 from analysis.lumped import resonance_frequency  # noqa: F401  (re-exported)
@@ -38,7 +39,7 @@ BL_PARAM = ParamSpec("Bl", "T*m", "T*m", 1.0, 1e-3, 1e3, 5.0, "force factor")
 ELECTRICAL_BASE = tuple(p.name for p in BASE_PARAMS)
 
 
-class ModelError(ValueError):
+class ModelError(LinparError, ValueError):
     """A model that cannot be composed (unknown effect, two effects of one category, a name collision)."""
 
 

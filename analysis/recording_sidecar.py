@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 
+from analysis.errors import LinparError
+
 if TYPE_CHECKING:
     from analysis.recording import Recording
 
@@ -30,7 +32,7 @@ EXCITATION_KEYS = ("period_samples", "settle_periods", "excited_bins")
 TOP_KEYS = ("format", "channels", "excitation", "driver")
 
 
-class RecordingError(ValueError):
+class RecordingError(LinparError, ValueError):
     """A recording that breaks the format. str(err) is ONE line naming the file, the key or channel, and what was expected."""
 
     def __init__(self, message: str):

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.errors import LinparError
+
 FORMAT_PCM = 0x0001
 FORMAT_IEEE_FLOAT = 0x0003
 FORMAT_EXTENSIBLE = 0xFFFE
@@ -39,7 +41,7 @@ _DECODERS = {
 _U32_MAX = 2**32 - 1
 
 
-class WavFormatError(ValueError):
+class WavFormatError(LinparError, ValueError):
     """Bytes that are not a WAV file the recording format accepts."""
 
 

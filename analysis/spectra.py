@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.errors import LinparError
 from analysis.recording import Recording
 
 ANALYSED_SIGNALS = ("voltage", "current", "displacement")
@@ -33,7 +34,7 @@ DETECT_RANGE_DB = 60.0
 MIN_NOISE_DOF = 40
 
 
-class SpectrumError(ValueError):
+class SpectrumError(LinparError, ValueError):
     """The recording cannot give spectra (no excited line found, no voltage or current)."""
 
 

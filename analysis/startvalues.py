@@ -17,10 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.errors import LinparError
 from analysis.spectra import TransferFunction
 
 
-class StartValueError(ValueError):
+class StartValueError(LinparError, ValueError):
     """The data show no resonance to start from."""
 
 

@@ -74,8 +74,10 @@ from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 from typing import Any, Mapping
 
+from analysis.errors import LinparError
 
-class ThresholdsError(ValueError):
+
+class ThresholdsError(LinparError, ValueError):
     """An override file that cannot be used; the message names the file and the key."""
 
 

@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Mapping
 
+from analysis.errors import LinparError
 from analysis.thresholds import ValidityThresholds
 from analysis.validity_findings import (
     CLIPPING, DROPOUTS, HEADROOM_LOW, LASER_ERRORS, LASER_OUT_OF_RANGE, Finding, Severity)
@@ -45,7 +46,7 @@ SOUND_CARD_SIGNALS = ("voltage", "current")
 OUT_OF_RANGE_CODES = (262077, 262078)
 
 
-class CaptureInfoError(ValueError):
+class CaptureInfoError(LinparError, ValueError):
     """A "capture" object that cannot be read; the message names the key, on one line."""
 
     def __init__(self, message: str):

@@ -11,7 +11,6 @@ refit or diagnose from). Every archive error is one line on the page.
 from __future__ import annotations
 
 import html
-import logging
 from pathlib import Path
 
 from PySide6.QtCore import QItemSelection, QItemSelectionModel, Qt, QTimer, Signal
@@ -23,9 +22,9 @@ from app import style
 from app.archive_filter import FilterBar
 from app.archive_overlay import CompareView
 from app.archive_table import ArchiveTable
-from app.archive_worker import ArchiveWorker, archive_error_text
+from app.archive_worker import ArchiveWorker
+from app.job_book import failure_text
 
-log = logging.getLogger(__name__)
 
 FILTER_DELAY_MS = 250           # typing a serial number should not list the archive once per key
 LIST_LIMIT = 2000               # newest first; more than this is a filter's job, not a scroll bar's
@@ -168,11 +167,7 @@ class ArchivePage(QWidget):
         self.message.hide()
 
     def _error_text(self, exc: Exception) -> str:
-        text = archive_error_text(exc, self.root)
-        if text is None:
-            log.exception("archive page")
-            text = f"internal error ({type(exc).__name__}: {exc}); the details are in the log"
-        return text
+        return failure_text(exc, f"reading the archive {self.root}")
 
     # -- listing -----------------------------------------------------------------
     def refresh(self, *_args) -> None:

@@ -9,8 +9,6 @@ the file system, a results file that does not read) becomes that line.
 """
 from __future__ import annotations
 
-import logging
-import sqlite3
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,11 +16,9 @@ from typing import Any, Callable, Mapping
 
 from PySide6.QtCore import QObject, Signal
 
-from app.job_book import JobBook
-from app.workers import one_line
+from app.job_book import JobBook, failure_text
 from instruments.measurement.raw_stream import raw_capture_path
 
-log = logging.getLogger(__name__)
 
 
 class ArchiveCancelled(Exception):
@@ -48,20 +44,6 @@ class ComparisonData:
 class RebuildDone:
     text: str                   # RebuildReport.describe()
     skipped: int
-
-
-def archive_error_text(exc: BaseException, root: Path) -> str | None:
-    """The one line a user reads for an error of the archive; None for a bug."""
-    from analysis.archive import ArchiveError
-    from analysis.archive.results import ResultsFormatError
-    from analysis.recording import RecordingError
-    if isinstance(exc, ArchiveError):
-        return one_line(exc)
-    if isinstance(exc, sqlite3.Error):
-        return f"the archive's index in {root} cannot be used ({one_line(exc)}); try Rebuild index"
-    if isinstance(exc, (OSError, RecordingError, ResultsFormatError)):
-        return one_line(exc)
-    return None
 
 
 def laser_stream_of(recording: Path) -> Path | None:
@@ -96,13 +78,8 @@ class ArchiveJob:
             result = self._work(self)
         except ArchiveCancelled:
             worker.cancelled.emit(self.id)
-        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
-            text = archive_error_text(exc, self.root)
-            if text is None:
-                log.exception("archive %s failed", self.kind)
-                text = (f"internal error in the archive's {self.kind} ({type(exc).__name__}: {one_line(exc)}); "
-                        "the details are in the log")
-            worker.failed.emit(self.id, text)
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            worker.failed.emit(self.id, failure_text(exc, f"the archive's {self.kind} ({self.root})"))
         else:
             getattr(worker, self.kind).emit(self.id, result)
 

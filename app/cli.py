@@ -2,17 +2,18 @@
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from typing import Sequence
 
+from analysis.errors import LinparError, is_user_error, user_message
 from app import cli_import
 
-EXIT_OK, EXIT_ERROR = 0, 2
+# 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
+EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 2, 70, 130
 
 
-class CliError(Exception):
-    """A user error: printed as one line, exit code 2."""
+class CliError(LinparError):
+    """A command line that cannot be run as given: printed as one line, exit code 2."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -78,50 +79,41 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; the CLI's only error boundary (analysis.errors): exit 2 for the user's errors,
+    70 for a bug (one line, the details in a crash report), 130 for Ctrl-C."""
     try:
         args = build_parser().parse_args(argv)
         return _run(args)
-    except CliError as exc:
-        print(f"linpar: error: {exc}", file=sys.stderr)
-        return EXIT_ERROR
     except KeyboardInterrupt:
         print("linpar: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - the boundary: a user error is one line, anything else a bug
+        if is_user_error(exc):
+            print(f"linpar: error: {user_message(exc)}", file=sys.stderr)
+            return EXIT_ERROR
+        from app.crash_report import internal_error_line
+        print(f"linpar: {internal_error_line(exc, argv=argv)}", file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 def _run(args: argparse.Namespace) -> int:
     if args.command == "rig":
         from app import cli_rig
-        try:
-            return cli_rig.run(args)
-        except cli_rig.user_errors() as exc:
-            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+        return cli_rig.run(args)
     if args.command in ("archive", "report", "export"):
         from app import cli_archive, cli_report
-        try:
-            return cli_archive.run(args) if args.command == "archive" else cli_report.run(args)
-        except cli_report.user_errors() as exc:
-            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+        return cli_archive.run(args) if args.command == "archive" else cli_report.run(args)
     if args.command == "levels":
         from app import cli_levels
-        try:
-            return cli_levels.run(args)
-        except cli_levels.user_errors() as exc:
-            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+        return cli_levels.run(args)
     if args.command == "measure":
         from app import cli_measure
-        try:
-            return cli_measure.run(args)
-        except cli_measure.user_errors() as exc:
-            raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+        return cli_measure.run(args)
     if args.command == "gui":
         from app.main import run_gui
         return run_gui(args.path)
     from app import cli_commands
-    try:
-        return cli_commands.dispatch(args)
-    except cli_commands.USER_ERRORS as exc:
-        raise CliError(str(exc).splitlines()[0] if str(exc) else type(exc).__name__) from None
+    return cli_commands.dispatch(args)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -129,16 +129,13 @@ def run(args: argparse.Namespace) -> int:
         return _store(archive, args)
     if verb == "compare":
         return _compare(archive, args)
-    raise KeyError(f"unknown archive command {verb!r}")
+    raise AssertionError(f"unknown archive command {verb!r}")     # the parser allows no other
 
 
 def _store(archive, args) -> int:
-    from analysis.effects import parse_effects
     from analysis.pipeline import analyze_path
-    try:
-        effects = parse_effects(args.model)
-    except KeyError as exc:
-        raise ValueError(f"--model: {exc.args[0]}") from None
+    from app.cli_commands import _effects
+    effects = _effects(args.model)
     result = analyze_path(args.path, args.sd, effects)
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
                                             "station": args.station, "notes": args.notes,

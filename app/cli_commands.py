@@ -6,18 +6,11 @@ import json
 import sys
 
 from analysis.derived import ParameterValue
-from analysis.drivers import DriverFileError
-from analysis.effects import CATALOGUE, categories, parse_effects
-from analysis.fit import FitError
+from analysis.effects import CATALOGUE, UnknownEffectError, categories, parse_effects
 from analysis.limits import LimitsError
 from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult, analyze_path, result_json
-from analysis.recording import RecordingError
-from analysis.spectra import SpectrumError
-from analysis.startvalues import StartValueError
 
-USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelError, DriverFileError,
-               LimitsError, KeyError, OSError)
 EXIT_QA_FAIL = 1
 
 
@@ -34,14 +27,15 @@ def dispatch(args: argparse.Namespace) -> int:
         return cmd_diagnose(args)
     if args.command == "effects":
         return cmd_effects(args)
-    raise KeyError(f"unknown command {args.command!r}")
+    raise AssertionError(f"unknown command {args.command!r}")     # the parser allows no other
 
 
-def _effects(text: str | None):
+def _effects(text: str | None, option: str = "--model"):
+    """The effects an option names; ModelError that names the option."""
     try:
         return parse_effects(text)
-    except KeyError as exc:
-        raise ModelError(f"--model: {exc.args[0]}") from None
+    except UnknownEffectError as exc:
+        raise ModelError(f"{option}: {exc}") from None
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:

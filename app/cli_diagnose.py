@@ -9,9 +9,8 @@ from analysis.derived import parameter_table
 from analysis.diagnosis import Candidate, Diagnosis, Step, diagnose, explain
 from analysis.diagnosis_words import (VERDICT_TITLES, chi2_words, drift_from_validity, residual_json, sites_json,
                                       tied_sites, verdict_text)
-from analysis.effects import parse_effects
 from analysis.fit import FitData, FitResult
-from analysis.model import Model, ModelError
+from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import resolve_sd
 from analysis.recording import read_recording
@@ -34,11 +33,9 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
 
 
 def run_diagnosis(args: argparse.Namespace):
+    from app.cli_commands import _effects
+    effects = _effects(args.start, "--from")     # a bad --from fails before the data are read
     data, sd, drift = _data(args)
-    try:
-        effects = parse_effects(args.start)
-    except KeyError as exc:
-        raise ModelError(f"--from: {exc.args[0]}") from None
     model = Model(effects, with_displacement=data.displacement is not None)
     with fit_executor() as executor:
         result = diagnose(data, model, executor=executor)

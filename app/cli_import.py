@@ -72,19 +72,13 @@ def wants_curves(args: argparse.Namespace) -> bool:
 
 
 def dispatch(args: argparse.Namespace) -> int:
-    from app.cli import CliError
-    from analysis.curve_fit import CurveFitError
-    from analysis.importers import ImportFormatError
-    try:
-        if args.command == "analyze":
-            return cmd_analyze_curves(args)
-        if args.command == "addedmass":
-            return cmd_addedmass(args)
-        if args.command == "stats":
-            return cmd_stats(args)
-    except (ImportFormatError, CurveFitError) as exc:
-        raise CliError(str(exc).splitlines()[0]) from None
-    raise KeyError(f"unknown command {args.command!r}")
+    if args.command == "analyze":
+        return cmd_analyze_curves(args)
+    if args.command == "addedmass":
+        return cmd_addedmass(args)
+    if args.command == "stats":
+        return cmd_stats(args)
+    raise AssertionError(f"unknown command {args.command!r}")     # the parser allows no other
 
 
 def fit_range(args, hx_f_max=None):
@@ -93,12 +87,8 @@ def fit_range(args, hx_f_max=None):
 
 
 def _effects(text: str | None, option: str = "--model"):
-    from analysis.effects import parse_effects
-    from analysis.model import ModelError
-    try:
-        return parse_effects(text)
-    except KeyError as exc:
-        raise ModelError(f"{option}: {exc.args[0]}") from None
+    from app.cli_commands import _effects as named_effects
+    return named_effects(text, option)
 
 
 def _print_json(doc: dict) -> None:

@@ -43,13 +43,6 @@ def add_commands(sub) -> None:
     levels.add_argument("--json", action="store_true", help="print one JSON object (with the Fig. 14 data)")
 
 
-def user_errors() -> tuple[type[BaseException], ...]:
-    """Errors shown to the user as one line (exit 2) by app.cli."""
-    from analysis.level_series import LevelSeriesError
-    from app.cli_commands import USER_ERRORS
-    return USER_ERRORS + (LevelSeriesError,)
-
-
 def run(args: argparse.Namespace) -> int:
     from analysis.level_series import format_series, level_series
     from app.cli import CliError
@@ -79,7 +72,7 @@ def _simulate(args: argparse.Namespace) -> list:
     levels = args.levels or sim.DEFAULT_LEVELS_V
     try:
         sim.check_levels(levels)
-    except ValueError as exc:
+    except sim.LevelsError as exc:
         raise CliError(f"--levels: {exc}") from None
 
     def progress(i, n, level):      # on stderr: stdout is the table or the JSON

@@ -43,6 +43,7 @@ from contextlib import ExitStack
 from datetime import datetime, timezone
 from pathlib import Path
 
+from analysis.errors import is_user_error, user_message
 from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
@@ -81,19 +82,6 @@ def add_commands(sub) -> None:
                             "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
     where.add_argument("--no-archive", action="store_true", help="do not store the measurement in the archive")
     m.add_argument("--json", action="store_true", help="print one JSON object")
-
-
-def user_errors() -> tuple[type[BaseException], ...]:
-    from analysis.fit import FitError
-    from analysis.model import ModelError
-    from analysis.recording import RecordingError
-    from analysis.spectra import SpectrumError
-    from instruments.audio.errors import AudioError
-    from instruments.laser.sensor import LaserError
-    from instruments.rig.control import ControlError
-    from instruments.rig.manager import RigError
-    return (MeasurementError, AudioError, LaserError, RigError, ControlError, RecordingError, SpectrumError,
-            FitError, ModelError, ValueError, OSError)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -151,9 +139,11 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
         archive = Archive(root)
         mid = archive.store(outcome.recording_path, outcome.result, meta, laser_stream=outcome.raw_path)
     except Exception as exc:  # noqa: BLE001 - whatever went wrong, the recording is on disk: say so, lose nothing
-        known = isinstance(exc, (OSError, ValueError, RuntimeError))      # ArchiveError is a RuntimeError
-        why = " ".join(str(exc).split()) or type(exc).__name__
-        why = why if known else f"internal error ({type(exc).__name__}: {why})"
+        if is_user_error(exc):
+            why = user_message(exc)
+        else:
+            from app.crash_report import internal_error_line
+            why = internal_error_line(exc, "storing the measurement in the archive")
         _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
              f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
         return {"error": why, "root": str(root)}

@@ -51,17 +51,16 @@ def _is_recording(text: str) -> bool:
 
 def load_source(args):
     """(StoredResult, header, settings, calibration) of the ID or PATH."""
+    from app.cli import CliError
     if _is_recording(args.source):
         from analysis.archive.results import stored_from_recording
-        from analysis.effects import parse_effects
-        try:
-            effects = parse_effects(args.model)
-        except KeyError as exc:
-            raise ValueError(f"--model: {exc.args[0]}") from None
+        from app.cli_commands import _effects
+        effects = _effects(args.model)
         stored, header, calibration = stored_from_recording(args.source, args.sd, effects)
         return stored, header, None, calibration
     if args.sd is not None or args.model is not None:
-        raise ValueError("--sd and --model apply to recordings; an archived measurement keeps its own")
+        raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "
+                       "its own")
     from analysis.archive import Archive
     archive = Archive(Path(args.root).expanduser() if args.root else None)
     m = archive.get(args.source)
@@ -71,9 +70,10 @@ def load_source(args):
 
 
 def run(args: argparse.Namespace) -> int:
+    from app.cli import CliError
     if args.command == "report":
         if not args.pdf and not args.html:
-            raise ValueError("report: give --pdf FILE and/or --html FILE")
+            raise CliError("report: give --pdf FILE and/or --html FILE")
         from analysis.limits import load_limits
         from analysis.report import build_report, write_report
         limits = load_limits(args.limits) if args.limits else None    # a bad file fails before the analysis
@@ -85,7 +85,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
         if not targets:
-            raise ValueError("export: give at least one of " + ", ".join(
+            raise CliError("export: give at least one of " + ", ".join(
                 f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
         from analysis.export import write_exports
         stored, header, _, _ = load_source(args)
@@ -94,13 +94,3 @@ def run(args: argparse.Namespace) -> int:
         print(f"written: {path}")
     return 0
 
-
-def user_errors() -> tuple[type[BaseException], ...]:
-    from analysis.archive import ArchiveError
-    from analysis.archive.results import ResultsFormatError
-    from analysis.export import ExportError
-    from analysis.fit import FitError
-    from analysis.recording import RecordingError
-    from analysis.spectra import SpectrumError
-    return (ArchiveError, ResultsFormatError, ExportError, RecordingError, SpectrumError, FitError, ValueError,
-            OSError, KeyError)

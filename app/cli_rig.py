@@ -21,18 +21,10 @@ EXIT_OK, EXIT_NOT_RUNNING = 0, 1
 # The rig server's --model choices (instruments/rig/server.py), spelled here so that the parser loads no rig code.
 RIG_MODELS = ("linear", "nonlinear")
 
-# Errors shown to the user as one line (exit 2) by app.cli.
 def _manager():
     """instruments.rig.manager, imported on use: it loads scipy, which plain `linpar` commands do not need."""
     from instruments.rig import manager
     return manager
-
-
-def user_errors() -> tuple[type[BaseException], ...]:
-    """The errors a user must fix; imported here so that building the parser loads no rig code."""
-    from instruments.rig import manager
-    from instruments.rig.control import ControlError
-    return (manager.RigError, ControlError, ValueError, OSError)
 
 
 def add_commands(sub) -> None:
@@ -70,7 +62,7 @@ def add_commands(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run one `linpar rig` action; user_errors() for what the user must fix."""
+    """Run one `linpar rig` action."""
     if args.rig_action == "start":
         return _start(args)
     if args.rig_action == "status":
@@ -81,13 +73,14 @@ def run(args: argparse.Namespace) -> int:
         stopped = _manager().stop_rig(args.name, args.runtime_dir)
         print(f"rig {args.name!r} stopped" if stopped else f"rig {args.name!r} is not running")
         return EXIT_OK
-    raise KeyError(f"unknown rig action {args.rig_action!r}")
+    raise AssertionError(f"unknown rig action {args.rig_action!r}")     # the parser allows no other
 
 
 def _start(args) -> int:
     if args.model != "linear" and args.effects:
         # The nonlinear driver takes its small-signal model from the driver file's values.
-        raise ValueError(f"--effects applies to the linear model only, not to --model {args.model}")
+        from app.cli import CliError
+        raise CliError(f"--effects applies to the linear model only, not to --model {args.model}")
     handle = _manager().start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir,
                                   model=args.model)
     if args.json:

@@ -4,13 +4,32 @@ A worker (a QObject of the GUI thread) owns a QThreadPool and hands it jobs:
 plain callables with an `id` and a `cancel()` method. The worker's "done"
 signals (finished, failed, cancelled: each carrying the job id) tell this
 book to forget the job, so `cancel_all` and `shutdown` only touch the live ones.
+
+`failure_text` is the GUI's one error boundary (analysis.errors): every job
+hands whatever it raised to it and shows the line it returns. A user error
+is its own message; anything else is a bug: "internal error while ...: ...
+(details in FILE)", with a crash report written (app.crash_report).
 """
 from __future__ import annotations
 
 import itertools
+import logging
 from typing import Iterable
 
 from PySide6.QtCore import QObject, QThreadPool, SignalInstance
+
+from analysis.errors import is_user_error, user_message
+
+log = logging.getLogger(__name__)
+
+
+def failure_text(exc: BaseException, doing: str) -> str:
+    """The one line the GUI shows for a job that raised `exc` while `doing` ("analysing x.wav")."""
+    if is_user_error(exc):
+        return user_message(exc)
+    from app.crash_report import internal_error_line
+    log.error("%s failed", doing, exc_info=exc)
+    return internal_error_line(exc, doing)
 
 
 class JobBook:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
-import logging
 import threading
 from dataclasses import dataclass
 from typing import Callable
@@ -30,10 +29,9 @@ from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from app.result_curves import ResultCurves, result_curves
-from app.workers import USER_ERRORS, one_line
-from app.job_book import JobBook
+from analysis.errors import is_user_error
+from app.job_book import JobBook, failure_text
 
-log = logging.getLogger(__name__)
 
 CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
 
@@ -185,15 +183,11 @@ class LabJob:
             self.run()
         except (FitCancelled, DiagnosisCancelled):
             signals.cancelled.emit(self.id)
-        except USER_ERRORS as exc:
-            if self.cancel_event.is_set():      # a cancelled fit may fail on its way out: still a cancel
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            if self.cancel_event.is_set() and is_user_error(exc):  # a cancelled fit may fail on its way out
                 signals.cancelled.emit(self.id)
             else:
-                signals.failed.emit(self.id, one_line(exc))
-        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
-            log.exception("model lab %s failed", self.kind)
-            signals.failed.emit(self.id, f"internal error in the model lab's {self.kind} "
-                                         f"({type(exc).__name__}: {one_line(exc)}); the details are in the log")
+                signals.failed.emit(self.id, failure_text(exc, f"the model lab's {self.kind}"))
 
 
 class RefitJob(LabJob):

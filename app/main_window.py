@@ -11,6 +11,7 @@ from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QP
 
 from app import style
 from app.archive_page import ArchivePage
+from app.job_book import failure_text
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
 from app.qa_view import QAView
@@ -300,8 +301,9 @@ class MainWindow(QMainWindow):
                         self.open_path(path)
                 elif choice == "discard":
                     discard(unfinished)
-            except (OSError, ValueError) as exc:
-                self.show_error(f"Cannot recover {unfinished.name}", str(exc))
+            except Exception as exc:  # noqa: BLE001 - the GUI's error boundary (job_book.failure_text)
+                self.show_error(f"Cannot recover {unfinished.name}",
+                                failure_text(exc, f"recovering {unfinished.name}"))
         return choices
 
     def ask_unfinished(self, unfinished) -> str:

@@ -18,7 +18,6 @@ write_recording + analyze_recording); `runner_name()` says which.
 """
 from __future__ import annotations
 
-import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,10 +27,10 @@ from PySide6.QtCore import QObject, Signal
 
 from analysis.fit import FitCancelled
 from app.result_curves import result_curves
-from app.workers import USER_ERRORS, AnalysisOutcome, one_line
-from app.job_book import JobBook
+from analysis.errors import is_user_error
+from app.workers import AnalysisOutcome
+from app.job_book import JobBook, failure_text
 
-log = logging.getLogger(__name__)
 
 PROGRESS_STEP = 0.005       # a progress bar 200 pixels wide does not move for less
 FALLBACK_NAME = "app.wizard.tasks (capture, live frames, write_recording, analyze_recording)"
@@ -40,19 +39,6 @@ FALLBACK_NAME = "app.wizard.tasks (capture, live frames, write_recording, analyz
 def runner_name() -> str:
     from app.wizard.plans import find_runner
     return "instruments.measurement.run_measurement" if find_runner() is not None else FALLBACK_NAME
-
-
-def _device_errors() -> tuple[type[BaseException], ...]:
-    """Errors of the devices, whose message is for the user. Imported late: PortAudio loads on demand."""
-    from instruments.audio.errors import AudioError
-    from instruments.laser.sensor import LaserError
-    from instruments.rig.manager import RigError
-    errors = (AudioError, LaserError, RigError)
-    try:
-        from instruments.measurement import MeasurementError
-    except ImportError:
-        return errors
-    return errors + (MeasurementError,)
 
 
 def _cancel_errors() -> tuple[type[BaseException], ...]:
@@ -111,15 +97,11 @@ class SessionJob:
             result = self._work(self)
         except _cancel_errors():
             session.cancelled.emit(self.id)
-        except USER_ERRORS + _device_errors() as exc:
-            if self.cancel_event.is_set():
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            if self.cancel_event.is_set() and is_user_error(exc):   # a device stopped on its way out: a cancel
                 session.cancelled.emit(self.id)
             else:
-                session.failed.emit(self.id, one_line(exc))
-        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
-            log.exception("measurement %s failed", self.kind)
-            session.failed.emit(self.id, f"internal error in the {self.kind} ({type(exc).__name__}: "
-                                         f"{one_line(exc)}); the details are in the log")
+                session.failed.emit(self.id, failure_text(exc, f"the {self.kind}"))
         else:
             if self.cancel_event.is_set():
                 session.cancelled.emit(self.id)

@@ -20,8 +20,8 @@ from PySide6.QtWidgets import (QHBoxLayout, QLabel, QProgressBar, QPushButton, Q
 
 from analysis import acceptance, residuals
 from analysis.derived import parameter_table
+from analysis.errors import LinparError
 from analysis.fit import FitData
-from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult
 from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
 from app.layout_room import keep_room_when_hidden
@@ -258,7 +258,7 @@ class ModelLab(QWidget):
         current = self.current.fitted.fit.model
         try:
             model = changed_model(current, checked)
-        except (KeyError, ModelError) as exc:
+        except LinparError as exc:      # an effect this version does not know, two of one category
             self.catalogue.set_checked(current.effect_ids)
             self.status_label.setText(f"Cannot build that model: {exc}")
             return

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import html
 import importlib.util
-import logging
 import threading
 from pathlib import Path
 
@@ -23,9 +22,8 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxL
 
 from analysis.pipeline import AnalysisResult
 from app.traffic_light import CHANNELS, ChannelLight, TrafficLight
-from app.workers import USER_ERRORS, one_line
+from app.job_book import failure_text
 
-log = logging.getLogger(__name__)
 
 LIMITS_MODULE, REPORT_MODULE = "analysis.limits", "analysis.report"
 NO_LIMITS = "QA limits need analysis/limits.py, which this installation does not have."
@@ -101,12 +99,8 @@ class ReportWorker(QObject):
             kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
             written = write_report(content, **kind)
             self.finished.emit(job, ", ".join(str(p) for p in written))
-        except USER_ERRORS + (ImportError, KeyError) as exc:
-            self.failed.emit(job, one_line(exc))
-        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
-            log.exception("report export failed")
-            self.failed.emit(job, f"internal error while writing the report ({type(exc).__name__}: "
-                                  f"{one_line(exc)}); the details are in the log")
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            self.failed.emit(job, failure_text(exc, f"writing the report {path.name}"))
 
 
 class QAView(QWidget):

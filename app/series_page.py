@@ -11,7 +11,6 @@ page only shows what analysis.repeatability and analysis.level_series return.
 """
 from __future__ import annotations
 
-import logging
 import threading
 from pathlib import Path
 from typing import Callable, Sequence
@@ -20,13 +19,12 @@ from PySide6.QtCore import QObject, QThreadPool, Signal
 from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QHBoxLayout, QLabel, QProgressBar, QPushButton,
                                QTableWidget, QTableWidgetItem, QTabWidget, QVBoxLayout, QWidget)
 
-from analysis.level_series import LevelSeriesError, level_series
+from analysis.level_series import level_series
 from analysis.pipeline import analyze_path
 from analysis.repeatability import Spread, repeatability
 from app.level_series_view import LevelSeriesView
-from app.workers import USER_ERRORS
+from app.job_book import failure_text
 
-log = logging.getLogger(__name__)
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 
 
@@ -75,11 +73,8 @@ class SeriesWorker(QObject):
             self.finished.emit(kind, outcome)
         except SeriesCancelled:
             self.failed.emit(kind, "cancelled")
-        except (LevelSeriesError, *USER_ERRORS) as exc:
-            self.failed.emit(kind, str(exc).splitlines()[0])
-        except Exception as exc:  # noqa: BLE001 - the GUI must survive whatever a file does
-            log.exception("series analysis failed")
-            self.failed.emit(kind, f"internal error ({type(exc).__name__}: {exc})")
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            self.failed.emit(kind, failure_text(exc, f"the {kind} analysis"))
 
 
 class RepeatabilityTable(QTableWidget):

@@ -9,26 +9,18 @@ has replaced. What crosses over is frozen (AnalysisOutcome) or a string.
 """
 from __future__ import annotations
 
-import logging
 import threading
 from dataclasses import dataclass
 from pathlib import Path
 
 from PySide6.QtCore import QObject, Signal
 
-from analysis.fit import FitCancelled, FitError
-from analysis.model import ModelError
+from analysis.errors import one_line as _one_line
+from analysis.fit import FitCancelled
 from analysis.pipeline import AnalysisResult, analyze_recording
-from analysis.recording import RecordingError, read_recording
-from analysis.spectra import SpectrumError
-from analysis.startvalues import StartValueError
+from analysis.recording import read_recording
 from app.result_curves import ResultCurves, result_curves
-from app.job_book import JobBook
-
-log = logging.getLogger(__name__)
-
-# Errors that describe the recording or the fit: their message is shown as it is.
-USER_ERRORS = (RecordingError, SpectrumError, StartValueError, FitError, ModelError, OSError)
+from app.job_book import JobBook, failure_text
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,12 +57,8 @@ class AnalysisJob:
             curves = result_curves(result)
         except FitCancelled:
             signals.cancelled.emit(self.id)
-        except USER_ERRORS as exc:
-            signals.failed.emit(self.id, one_line(exc))
-        except Exception as exc:  # noqa: BLE001 - a bug must reach the user as a message, not kill the thread
-            log.exception("analysis of %s failed", self.path)
-            signals.failed.emit(self.id, f"internal error while analysing {self.path.name} "
-                                         f"({type(exc).__name__}: {one_line(exc)}); the details are in the log")
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
+            signals.failed.emit(self.id, failure_text(exc, f"analysing {self.path.name}"))
         else:
             signals.finished.emit(self.id, AnalysisOutcome(self.id, self.path, result, curves))
 
@@ -91,5 +79,4 @@ class AnalysisWorker(QObject, JobBook):
 
 
 def one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
-    return text or type(exc).__name__
+    return _one_line(exc) or type(exc).__name__

@@ -7,6 +7,19 @@ import shutil
 import pytest
 
 
+@pytest.fixture(scope="session", autouse=True)
+def crash_reports(tmp_path_factory):
+    """Crash reports (app.crash_report) of the whole session go to a folder of its own, not ~/.cache."""
+    folder = tmp_path_factory.mktemp("crash-reports")
+    saved = os.environ.get("LINPAR_CACHE")
+    os.environ["LINPAR_CACHE"] = str(folder)
+    yield folder
+    if saved is None:
+        os.environ.pop("LINPAR_CACHE", None)
+    else:
+        os.environ["LINPAR_CACHE"] = saved
+
+
 @pytest.fixture(scope="session")
 def virtual_rig(tmp_path_factory):
     """The virtual rig (instruments.rig) on a JACK server of its own, for the whole session.

@@ -14,6 +14,8 @@ import unicodedata
 from datetime import datetime, timezone
 from pathlib import Path
 
+from analysis.errors import LinparError
+
 ID_PATTERN = re.compile(r"^\d{8}-\d{6}-[0-9a-f]{6}$")
 # What a user may type for an id: its leading part (a unique prefix selects).
 ID_PREFIX_PATTERN = re.compile(r"^[0-9a-f-]{1,22}$")
@@ -22,7 +24,7 @@ _NOT_SLUG = re.compile(r"[^a-z0-9]+")
 _CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 
 
-class ArchiveError(RuntimeError):
+class ArchiveError(LinparError, RuntimeError):
     """An archive operation that cannot be done; str(err) is one line for the user."""
 
 

@@ -20,6 +20,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from analysis.derived import ParameterValue
+from analysis.errors import LinparError
 
 FORMAT = "linpar-results/1"
 CHANNELS = ("impedance", "displacement")
@@ -109,7 +110,7 @@ class Curve:
         return (self.model - self.measured) / sigma
 
 
-class ResultsFormatError(ValueError):
+class ResultsFormatError(LinparError, ValueError):
     pass
 
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.effects import breakup, channels, creep, inductance
+from analysis.errors import LinparError
 
 # Grouped by category; within a category the effects are alternatives (one per model).
 _ALL: tuple[Effect, ...] = (
@@ -35,12 +36,16 @@ def categories() -> dict[str, list[Effect]]:
     return grouped
 
 
+class UnknownEffectError(LinparError, LookupError):
+    """An effect id that is not in the catalogue (a user's --model, an old archive's effects)."""
+
+
 def get_effect(effect_id: str) -> Effect:
-    try:
-        return CATALOGUE[effect_id]
-    except KeyError:
+    effect = CATALOGUE.get(effect_id)
+    if effect is None:
         known = ", ".join(sorted(CATALOGUE))
-        raise KeyError(f"unknown effect {effect_id!r}; known effects: {known}") from None
+        raise UnknownEffectError(f"unknown effect {effect_id!r}; known effects: {known}")
+    return effect
 
 
 def parse_effects(text: str | None) -> tuple[Effect, ...]:
@@ -53,4 +58,5 @@ def parse_effects(text: str | None) -> tuple[Effect, ...]:
     return tuple(get_effect(i) for i in ids)
 
 
-__all__ = ["CATALOGUE", "DEFAULT_EFFECTS", "Effect", "ParamSpec", "Site", "categories", "get_effect", "parse_effects"]
+__all__ = ["CATALOGUE", "DEFAULT_EFFECTS", "Effect", "ParamSpec", "Site", "UnknownEffectError", "categories",
+           "get_effect", "parse_effects"]

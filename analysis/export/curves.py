@@ -21,6 +21,7 @@ from typing import Iterable
 import numpy as np
 
 from analysis.archive.results import StoredResult
+from analysis.errors import LinparError
 from analysis.spl import predicted_spl
 
 MODEL_PER_DECADE = 100
@@ -28,7 +29,7 @@ SPL_VOLTAGE = 2.83
 SPL_DISTANCE_M = 1.0
 
 
-class ExportError(ValueError):
+class ExportError(LinparError, ValueError):
     """The measurement lacks what an export needs (one line for the user)."""
 
 

@@ -3,8 +3,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from analysis.errors import LinparError
 
-class ImportFormatError(ValueError):
+
+class ImportFormatError(LinparError, ValueError):
     """A file that cannot be imported. The message is one line: FILE: line N: what was expected."""
 
     def __init__(self, path: str | Path, line: int | None, message: str):

@@ -19,12 +19,15 @@ calibrated against a voltmeter (its constant is on the Hardware page).
 """
 from __future__ import annotations
 
+import math
 import threading
 import time
 from dataclasses import asdict, dataclass, replace
+from typing import Mapping
 
 import numpy as np
 
+from analysis.errors import LinparError
 from analysis.model import Model
 from analysis.spectra import Spectra, estimate_spectra
 from instruments.audio.config import Calibration
@@ -36,6 +39,10 @@ PHASE_RESIDUAL_LIMIT_DEG = 2.0   # phase left after the delay: a filter, not a d
 CAL_PERIOD = 16384
 CAL_PERIODS = 4
 CAL_SETTLE = 5
+
+
+class CorrectionsError(LinparError, ValueError):
+    """Stored corrections that cannot be used (settings written by another version, or edited by hand)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,7 +77,24 @@ class Corrections:
 
     @classmethod
     def from_dict(cls, data) -> Corrections:
+        """The corrections of a settings object; CorrectionsError for one that cannot be used."""
+        if not isinstance(data, Mapping):
+            raise CorrectionsError(f"corrections: expected an object, found {type(data).__name__}")
         known = {k: data[k] for k in cls.__dataclass_fields__ if k in data}
+        gain, delay = known.get("current_gain", 1.0), known.get("current_delay_s", 0.0)
+        for name, value in (("current_gain", gain), ("current_delay_s", delay)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise CorrectionsError(f"corrections: {name}: found {value!r}, expected a finite number")
+        if not 1 - GAIN_LIMIT <= gain <= 1 + GAIN_LIMIT or abs(delay) > 1.0:
+            raise CorrectionsError(f"corrections: gain {gain!r} or delay {delay!r} s beyond what a calibration "
+                                   f"against a resistor accepts")
+        for name in ("source", "measured_at", "hardware"):
+            if name in known and not isinstance(known[name], str):
+                raise CorrectionsError(f"corrections: {name}: expected text")
+        resistor = known.get("resistor_ohm")
+        if resistor is not None and (isinstance(resistor, bool) or not isinstance(resistor, (int, float))
+                                     or not math.isfinite(resistor) or resistor <= 0):
+            raise CorrectionsError(f"corrections: resistor_ohm: found {resistor!r}, expected a positive number")
         return cls(**known)
 
 

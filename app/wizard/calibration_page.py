@@ -13,7 +13,7 @@ from app import style
 from app.grid_axis import show_grid
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
-from app.wizard.calibration import Corrections
+from app.wizard.calibration import Corrections, CorrectionsError
 from app.wizard.hardware import RIG, SIMULATOR
 
 SETTINGS_PREFIX = "measure/calibration/"
@@ -160,7 +160,7 @@ class CalibrationPage(WizardPage):
             text = self.state.settings.value(key, "")
             if text:
                 self.stored = Corrections.from_dict(json.loads(text))
-        except (TypeError, ValueError):
+        except (TypeError, json.JSONDecodeError, CorrectionsError):      # settings another version wrote
             self.stored = None
         self._show_stored()
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.errors import LinparError
 from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
@@ -82,7 +83,7 @@ def find_virtual_rig(name: str = DEFAULT_NAME, runtime_dir: str | None = None):
     from instruments.rig.manager import find_rig
     try:
         return find_rig(name, Path(runtime_dir) if runtime_dir else None)
-    except (OSError, ValueError):
+    except (OSError, LinparError):      # a bad name, a state file of another version: no usable rig
         return None
 
 

@@ -45,7 +45,7 @@ class ChannelMapForm(QWidget):
             spin.blockSignals(False)
 
     def channel_map(self) -> ChannelMap:
-        """ValueError (with the reason) for a map that wires two signals to one input."""
+        """AudioConfigError (with the reason) for a map that wires two signals to one input."""
         values = {name: spin.value() for name, spin in self.spins.items()}
         if values["laser_analog"] < 0:
             values["laser_analog"] = None

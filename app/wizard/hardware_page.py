@@ -12,7 +12,7 @@ from app.wizard.hardware import (
     find_virtual_rig)
 from app.wizard.hardware_form import CalibrationForm, ChannelMapForm
 from app.wizard.plans import find_runner
-from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
+from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
 
@@ -153,7 +153,7 @@ class HardwarePage(WizardPage):
         return NO_LASER if self.laser_none.isChecked() else ANALOG_LASER
 
     def config(self) -> HardwareConfig:
-        """The chosen hardware; ValueError (with the reason) when the channel map is not possible."""
+        """The chosen hardware; AudioConfigError (with the reason) when the channel map is not possible."""
         kind = self.kind()
         common = dict(kind=kind, realtime=self.realtime_check.isChecked(), rig_name=self.rig_name,
                       rig_runtime_dir=self.rig_runtime_dir, laser=self.laser_kind(),
@@ -179,7 +179,7 @@ class HardwarePage(WizardPage):
             return "Choose a sound card: " + (self.device_message or "press Refresh list.")
         try:
             config = self.config()
-        except ValueError as exc:
+        except AudioConfigError as exc:
             return f"The channel map is not possible: {exc}"
         if config.laser == ANALOG_LASER and config.channel_map.laser_analog is None:
             return "Give the laser's analog input in the channel map, or choose 'No laser'."
@@ -208,7 +208,9 @@ class HardwarePage(WizardPage):
     def _restore(self) -> None:
         try:
             saved = json.loads(self.state.settings.value(SETTINGS_KEY, "") or "{}")
-        except (TypeError, ValueError):
+        except (TypeError, json.JSONDecodeError):      # not text, or not JSON: settings of another program
+            saved = {}
+        if not isinstance(saved, dict):
             saved = {}
         self.realtime_check.setChecked(bool(saved.get("realtime", True)))
         self.laser_port.setText(str(saved.get("laser_port", "")))
@@ -221,7 +223,7 @@ class HardwarePage(WizardPage):
                                                   if "calibration" in saved else RIG_CALIBRATION)
             if saved.get("device"):
                 self._saved_device = AudioDeviceChoice.from_dict(saved["device"])
-        except (KeyError, TypeError, ValueError):
+        except AudioConfigError:
             pass        # settings of an older version: start from the defaults
         {NO_LASER: self.laser_none, SERIAL_LASER: self.laser_serial}.get(saved.get("laser"),
                                                                           self.laser_analog).setChecked(True)
@@ -304,7 +306,7 @@ class HardwarePage(WizardPage):
     def on_test_audio(self) -> None:
         try:
             config = self.config()
-        except ValueError as exc:
+        except AudioConfigError as exc:
             self.audio_result.setText(coloured(f"Not tested: {exc}", ERROR_COLOUR))
             return
         self.audio_result.setText("")

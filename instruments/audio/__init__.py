@@ -14,7 +14,8 @@ from importlib import import_module
 
 _EXPORTS = {
     "capture": "capture", "CaptureStats": "capture", "CapturedSignals": "capture",
-    "AudioDeviceChoice": "config", "Calibration": "config", "ChannelMap": "config", "JACK_HOSTAPI": "config",
+    "AudioConfigError": "config", "AudioDeviceChoice": "config", "Calibration": "config", "ChannelMap": "config",
+    "JACK_HOSTAPI": "config",
     "AudioError": "errors", "AudioUnavailable": "errors", "CaptureCancelled": "errors",
     "AudioDeviceInfo": "interface", "AudioInterface": "interface",
     "SimulatedAudio": "simulated",

@@ -11,21 +11,27 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from analysis.errors import LinparError
+
 # JACK's PortAudio host API, under the name PortAudio gives it.
 JACK_HOSTAPI = "JACK Audio Connection Kit"
 
 
+class AudioConfigError(LinparError, ValueError):
+    """A device choice, channel map or calibration that cannot be used (a settings or calibration file, an entry)."""
+
+
 def _from_mapping(cls, data: Mapping[str, Any], what: str):
     if not isinstance(data, Mapping):
-        raise ValueError(f"{what}: expected an object, got {type(data).__name__}")
+        raise AudioConfigError(f"{what}: expected an object, got {type(data).__name__}")
     known = {f.name for f in fields(cls)}
     unknown = sorted(set(data) - known)
     if unknown:
-        raise ValueError(f"{what}: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
+        raise AudioConfigError(f"{what}: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
     try:
         return cls(**dict(data))
     except TypeError as exc:   # a missing required key
-        raise ValueError(f"{what}: {exc}") from None
+        raise AudioConfigError(f"{what}: {exc}") from None
 
 
 @dataclass(frozen=True, slots=True)
@@ -46,7 +52,7 @@ class AudioDeviceChoice:
     def from_dict(cls, data: Mapping[str, Any]) -> AudioDeviceChoice:
         choice = _from_mapping(cls, data, "audio device")
         if not isinstance(choice.name, str) or not isinstance(choice.hostapi, str):
-            raise ValueError("audio device: 'name' and 'hostapi' must be strings")
+            raise AudioConfigError("audio device: 'name' and 'hostapi' must be strings")
         return choice
 
     def __str__(self) -> str:
@@ -75,10 +81,10 @@ class ChannelMap:
             if value is None and name == "laser_analog":
                 continue
             if not isinstance(value, int) or isinstance(value, bool) or value < 0:
-                raise ValueError(f"channel map: {name} must be a channel number >= 0, got {value!r}")
+                raise AudioConfigError(f"channel map: {name} must be a channel number >= 0, got {value!r}")
         inputs = self.input_channels()
         if len(set(inputs.values())) != len(inputs):
-            raise ValueError(f"channel map: two signals on one input: {inputs}")
+            raise AudioConfigError(f"channel map: two signals on one input: {inputs}")
 
     def input_channels(self) -> dict[str, int]:
         """Signal name -> input channel, for the signals that are wired."""
@@ -138,7 +144,7 @@ class Calibration:
             value = getattr(self, f.name)
             if (not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value)
                     or value <= 0):
-                raise ValueError(f"calibration: {f.name} must be a positive number, got {value!r}")
+                raise AudioConfigError(f"calibration: {f.name} must be a positive number, got {value!r}")
 
     @property
     def amperes_per_fs(self) -> float:

@@ -3,11 +3,13 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from analysis.errors import LinparError
+
 if TYPE_CHECKING:
     from instruments.audio.capture import CapturedSignals
 
 
-class AudioError(RuntimeError):
+class AudioError(LinparError, RuntimeError):
     """The sound card cannot be used or stopped working.
 
     ``partial`` holds the whole periods captured before the failure (possibly

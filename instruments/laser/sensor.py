@@ -14,6 +14,7 @@ from typing import Mapping, Protocol, Sequence, runtime_checkable
 
 import numpy as np
 
+from analysis.errors import LinparError
 from instruments.laser.frames import RawMeasurements
 from instruments.laser.values import CounterUnwrapper, decode_distance, timestamp_ms
 
@@ -23,7 +24,7 @@ DEFAULT_OUTPUTS: tuple[str, ...] = ("distance", "counter", "timestamp")
 NO_COUNTER = -1
 
 
-class LaserError(RuntimeError):
+class LaserError(LinparError, RuntimeError):
     """The laser cannot do what was asked: not connected, refused a command,
     a setting it cannot keep up with, or the link was lost."""
 

@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 
-class MeasurementError(RuntimeError):
+from analysis.errors import LinparError
+
+class MeasurementError(LinparError, RuntimeError):
     """The measurement could not start (a device missing, a plan the devices cannot do); nothing was recorded."""
 
     def __init__(self, message: str):

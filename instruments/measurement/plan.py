@@ -22,8 +22,14 @@ import math
 from dataclasses import asdict, dataclass, field, is_dataclass, replace
 from typing import Any, Mapping
 
+from analysis.errors import LinparError
+
 SETTLE_SAMPLES = 65536 + 8192
 ON_XRUN = ("end", "restart")
+
+
+class PlanError(LinparError, ValueError):
+    """A plan the measurement cannot follow (a level, a period, a template the user chose); one line."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -74,26 +80,26 @@ class MeasurementPlan:
     def __post_init__(self) -> None:
         p = self.period_samples
         if not (isinstance(p, int) and p >= 1024 and p & (p - 1) == 0):
-            raise ValueError(f"period_samples must be a power of two >= 1024, got {p!r}")
+            raise PlanError(f"period_samples must be a power of two >= 1024, got {p!r}")
         if not self.level_v_rms > 0:
-            raise ValueError(f"the level must be > 0 V RMS, got {self.level_v_rms!r}")
+            raise PlanError(f"the level must be > 0 V RMS, got {self.level_v_rms!r}")
         if not (isinstance(self.n_periods, int) and self.n_periods >= 2):
-            raise ValueError(f"at least 2 periods are needed to estimate the noise, got {self.n_periods!r}")
+            raise PlanError(f"at least 2 periods are needed to estimate the noise, got {self.n_periods!r}")
         if self.settle_periods is not None and self.settle_periods < 0:
-            raise ValueError(f"settle_periods must be >= 0, got {self.settle_periods!r}")
+            raise PlanError(f"settle_periods must be >= 0, got {self.settle_periods!r}")
         if not 0 < self.f_min_hz < self.f_max_hz:
-            raise ValueError(f"the band must be 0 < f_min < f_max, got {self.f_min_hz} - {self.f_max_hz} Hz")
+            raise PlanError(f"the band must be 0 < f_min < f_max, got {self.f_min_hz} - {self.f_max_hz} Hz")
         if self.on_xrun not in (None, *ON_XRUN):
-            raise ValueError(f"on_xrun must be one of {ON_XRUN}, got {self.on_xrun!r}")
+            raise PlanError(f"on_xrun must be one of {ON_XRUN}, got {self.on_xrun!r}")
         if self.laser_sign not in (-1.0, 1.0):
-            raise ValueError(f"laser_sign must be +1 or -1, got {self.laser_sign!r}")
+            raise PlanError(f"laser_sign must be +1 or -1, got {self.laser_sign!r}")
 
     @classmethod
     def from_template(cls, name: str = "woofer", **changes: Any) -> MeasurementPlan:
         try:
             t = TEMPLATES[name]
         except KeyError:
-            raise ValueError(f"unknown template {name!r}; known: {', '.join(TEMPLATES)}") from None
+            raise PlanError(f"unknown template {name!r}; known: {', '.join(TEMPLATES)}") from None
         base = cls(template=t.name, f_min_hz=t.f_min_hz, f_max_hz=t.f_max_hz, period_samples=t.period_samples,
                    level_v_rms=t.level_v_rms, n_periods=t.n_periods, lines_per_octave=t.lines_per_octave)
         return replace(base, **{k: v for k, v in changes.items() if v is not None})

@@ -35,6 +35,7 @@ from __future__ import annotations
 from datetime import datetime
 from pathlib import Path
 
+from analysis.errors import LinparError
 from instruments.measurement.plan import MeasurementPlan
 from instruments.measurement.recovery_journal import (FADE_S, FORMAT, FSYNC_EVERY_S, QUEUE_ITEMS, SUFFIX, Journal,
                                                       journal_path, recording_written)
@@ -47,7 +48,7 @@ __all__ = ["CLIP_LEVEL", "FADE_S", "FORMAT", "FSYNC_EVERY_S", "QUEUE_ITEMS", "SU
            "run_journaled"]
 
 
-class JournalKept(OSError):
+class JournalKept(LinparError, OSError):
     """The recording could not be written (a full disk ...): the measurement is in its journal. One line."""
 
 

@@ -15,10 +15,12 @@ import threading
 from pathlib import Path
 from typing import Any, Callable
 
+from analysis.errors import LinparError
+
 Handler = Callable[[dict[str, Any]], dict[str, Any]]
 
 
-class ControlError(RuntimeError):
+class ControlError(LinparError, RuntimeError):
     pass
 
 

@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 from typing import IO
 
+from analysis.errors import LinparError
 from instruments.audio.portaudio import jack_server_alive
 
 CAPTURE_PORTS, PLAYBACK_PORTS = 4, 2
@@ -27,7 +28,7 @@ _REGISTRY_MAGIC = b"KCAJ"
 _HEADER, _ENTRY, _MAX_SERVERS = 24, 264, 8
 
 
-class JackServerError(RuntimeError):
+class JackServerError(LinparError, RuntimeError):
     pass
 
 

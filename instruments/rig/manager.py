@@ -18,13 +18,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
+from analysis.errors import LinparError
 from instruments.rig.control import ControlError, send_command
 from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, pid_alive, read_pid, read_state
 
 MODELS = ("linear", "nonlinear")     # the rig server's --model choices
 
 
-class RigError(RuntimeError):
+class RigError(LinparError, RuntimeError):
     """The rig could not be started or stopped; one line for the user."""
 
 

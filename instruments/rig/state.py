@@ -20,10 +20,19 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from analysis.errors import LinparError
 from instruments.audio.config import Calibration, ChannelMap
 
 STATE_FORMAT = "linpar-rig-state/1"
 DEFAULT_NAME = "linpar"
+
+
+class RigNameError(LinparError, ValueError):
+    """A rig name that cannot name a folder (and a JACK server)."""
+
+
+class RigStateError(LinparError, ValueError):
+    """A rig's state file that cannot be read (another version's, or damaged)."""
 
 
 def runtime_root() -> Path:
@@ -41,7 +50,7 @@ class RigPaths:
     @classmethod
     def for_name(cls, name: str, root: Path | None = None) -> RigPaths:
         if not name or "/" in name or name.startswith("."):
-            raise ValueError(f"rig name {name!r}: expected a plain name (letters, digits, '-', '_')")
+            raise RigNameError(f"rig name {name!r}: expected a plain name (letters, digits, '-', '_')")
         return cls(Path(root or runtime_root()) / name)
 
     @property
@@ -101,11 +110,16 @@ class RigState:
 
     @classmethod
     def from_json(cls, text: str) -> RigState:
-        d = json.loads(text)
-        if d.get("format") != STATE_FORMAT:
-            raise ValueError(f"rig state: format {d.get('format')!r}, expected {STATE_FORMAT!r}")
-        d["effects"], d["faults"] = tuple(d["effects"]), tuple(d["faults"])
-        return cls(**d)
+        try:
+            d = json.loads(text)
+            if not isinstance(d, dict) or d.get("format") != STATE_FORMAT:
+                found = d.get("format") if isinstance(d, dict) else type(d).__name__
+                raise RigStateError(f"rig state: format {found!r}, expected {STATE_FORMAT!r}")
+            d["effects"], d["faults"] = tuple(d["effects"]), tuple(d["faults"])
+            return cls(**d)
+        except (json.JSONDecodeError, KeyError, TypeError) as exc:
+            raise RigStateError(f"rig state: not readable ({type(exc).__name__}: {exc}); stop the rig and start "
+                                f"it again") from None
 
 
 def write_atomic(path: Path, text: str) -> None:

@@ -19,6 +19,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Sequence
 
+from analysis.errors import LinparError
 from analysis.recording import Recording, write_recording
 from instruments.simulation.faults import DEFAULT_BENCH, Bench, clean_nonlinear
 
@@ -26,6 +27,10 @@ DEFAULT_LEVELS_V = (0.3, 1.0, 3.0, 6.0, 10.0, 14.0)
 # Above ~16 V RMS the default driver's cone passes 11.5 mm, where its Kms(x) turns up again and
 # the polynomials stop meaning anything (nonlinear_driver: they are clipped at 12 mm).
 MAX_LEVEL_V = 16.0
+
+
+class LevelsError(LinparError, ValueError):
+    """Drive levels the simulated driver cannot take; one line."""
 
 
 def simulate_level(level_v_rms: float, bench: Bench = DEFAULT_BENCH, index: int = 0) -> Recording:
@@ -64,10 +69,10 @@ def write_level_series(folder: str | Path, levels_v: Sequence[float] = DEFAULT_L
 
 
 def check_levels(levels_v: Sequence[float]) -> None:
-    """ValueError (one line) unless every level is one the simulated driver can take."""
+    """LevelsError (one line) unless every level is one the simulated driver can take."""
     if len(levels_v) == 0:
-        raise ValueError("no levels: give at least one drive level in V RMS")
+        raise LevelsError("no levels: give at least one drive level in V RMS")
     for level in levels_v:
         if not 0 < level <= MAX_LEVEL_V:
-            raise ValueError(f"level {level:g} V RMS: expected above 0 and at most {MAX_LEVEL_V:g} V "
+            raise LevelsError(f"level {level:g} V RMS: expected above 0 and at most {MAX_LEVEL_V:g} V "
                              f"(beyond, the simulated driver's cone leaves the range of its polynomials)")

@@ -6,9 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from analysis.effects import CATALOGUE, DEFAULT_EFFECTS, categories, get_effect, parse_effects
+from analysis.effects import CATALOGUE, DEFAULT_EFFECTS, UnknownEffectError, categories, get_effect, parse_effects
 from analysis.effects.base import Site
 from analysis.effects.breakup import breakup
+from analysis.errors import LinparError
 from analysis.model import Model
 from analysis.startvalues import StartContext
 
@@ -293,5 +294,6 @@ def test_parse_effects_defaults_and_errors():
     assert tuple(e.id for e in parse_effects(None)) == DEFAULT_EFFECTS
     assert parse_effects("textbook") == ()
     assert parse_effects(" lr3 , creep-rs ") == (get_effect("lr3"), get_effect("creep-rs"))
-    with pytest.raises(KeyError, match="known effects"):
+    with pytest.raises(UnknownEffectError, match="known effects") as error:
         parse_effects("lr2,no-such-effect")
+    assert isinstance(error.value, LinparError)      # a user's --model: one line, exit 2

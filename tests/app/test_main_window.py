@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import threading
+from pathlib import Path
 
 from PySide6.QtCore import QMimeData, QPoint, Qt, QUrl
 from PySide6.QtGui import QDropEvent
@@ -109,6 +110,8 @@ def test_an_internal_error_is_reported_without_traceback(qtbot, window, recordin
     open_and_wait(qtbot, window, recordings["paper"], "analysis_failed")
     text = dialogs[0][2]
     assert "internal error" in text and "ZeroDivisionError" in text and "Traceback" not in text
+    report = Path(text.rsplit("(details in ", 1)[1].rstrip(")"))     # the GUI says where the crash report is
+    assert "ZeroDivisionError" in report.read_text(encoding="utf-8")
 
 
 def test_recent_files_are_remembered_newest_first(qtbot, window, recordings, settings):
