@@ -12,6 +12,7 @@ fs is far better known than CMES or LCES alone.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
@@ -119,31 +120,50 @@ def _split(x) -> tuple[float, float | None]:
     return float(x), None
 
 
-def parameter_table(fit: FitResult, sd_m2: float | None) -> dict[str, ParameterValue]:
-    """Fitted and derived parameters, in the order of physics.md, with reasons for the missing."""
+def parameter_table(fit: FitResult, sd_m2: float | None,
+                    no_displacement: str = NO_DISPLACEMENT) -> dict[str, ParameterValue]:
+    """Fitted and derived parameters, in the order of physics.md, with reasons for the missing.
+
+    `no_displacement`: why the parameters that need Bl are missing when the fit had no displacement.
+    """
     table: dict[str, ParameterValue] = {}
     for spec in fit.model.param_specs:
         table[spec.name] = ParameterValue(spec.name, fit.values[spec.name], fit.stderr.get(spec.name),
                                           spec.unit, spec.display_unit, spec.display_scale, fitted=True)
     has_bl = fit.model.with_displacement
     if not has_bl:
-        table["Bl"] = ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, NO_DISPLACEMENT)
+        table["Bl"] = ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, no_displacement)
     p = _correlated(fit)
     for d in DERIVED:
         if d.needs_bl and not has_bl:
             table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
-                                           NO_DISPLACEMENT)
+                                           no_displacement)
             continue
         if d.needs_sd and not sd_m2:
             table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale, NO_SD)
             continue
         try:
             value, std = _split(d.formula(p, sd_m2))
-        except (ValueError, ZeroDivisionError) as exc:
+        except (ValueError, ZeroDivisionError, OverflowError) as exc:     # math of extreme fitted values
             table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
                                            f"cannot be computed from the fitted values ({exc})")
             continue
+        if not math.isfinite(value):
+            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
+                                           f"cannot be computed from the fitted values ({value})")
+            continue
         table[d.name] = ParameterValue(d.name, value, std, d.unit, d.display_unit, d.display_scale)
+    return table
+
+
+def unmeasured_table(model, reason: str) -> dict[str, ParameterValue]:
+    """Every parameter of `model` (an analysis.model.Model) and the derived ones, each "not measured: reason"."""
+    table = {spec.name: ParameterValue(spec.name, None, None, spec.unit, spec.display_unit, spec.display_scale,
+                                       reason)
+             for spec in model.param_specs}
+    table.setdefault("Bl", ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, reason))
+    for d in DERIVED:
+        table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale, reason)
     return table
 
 

@@ -29,7 +29,7 @@ import numpy as np
 from analysis.derived import ParameterValue
 from analysis.effects import Effect
 from analysis.errors import LinparError
-from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording
+from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording, require_fit
 from analysis.recording import Recording
 from analysis.validity_findings import DISTORTION_HIGH
 
@@ -158,10 +158,13 @@ def small_signal_reasons(validity: Mapping) -> tuple[str, ...]:
 
 def _analysed(item, sd_m2: float | None, effects: Sequence[Effect] | None) -> AnalysisResult:
     if isinstance(item, AnalysisResult):
-        return item
-    if isinstance(item, Recording):
-        return analyze_recording(item, sd_m2, effects)
-    return analyze_path(item, sd_m2, effects)
+        result = item
+    elif isinstance(item, Recording):
+        result = analyze_recording(item, sd_m2, effects)
+    else:
+        result = analyze_path(item, sd_m2, effects)
+    require_fit(result, "be a level of the series")
+    return result
 
 
 def _level(result: AnalysisResult, index: int) -> Level:

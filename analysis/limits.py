@@ -251,21 +251,31 @@ def verdict_of(verdicts) -> str:
     return "pass" if all(v.passed for v in verdicts) else "fail"
 
 
-def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity_overall: str) -> dict:
-    """The QA verdict as JSON: "pass", "fail", or "invalid" when the measurement itself is red.
+def _blocker(validity: Mapping | str) -> tuple[str, str] | None:
+    from analysis.validity_fit import qa_blocker
+    return qa_blocker({"overall": validity} if isinstance(validity, str) else validity)
+
+
+def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
+    """The QA verdict as JSON: "pass", "fail", "invalid" when the measurement itself is red, or "not judged"
+    when the model does not describe it (analysis.validity_fit.qa_blocker; `validity`: the result's validity,
+    or its overall light alone).
 
     A red measurement's parameters are worthless (physics.md section 5):
     they can neither pass nor fail a driver, the driver must be measured again.
     """
     verdicts = limits.judge(parameters)
-    verdict = "invalid" if validity_overall == "red" else verdict_of(verdicts)
-    return {"file": str(limits.path), "name": limits.name, "verdict": verdict,
-            "parameters": [v.as_json() for v in verdicts]}
+    blocker = _blocker(validity)
+    doc = {"file": str(limits.path), "name": limits.name, "verdict": blocker[0] if blocker else verdict_of(verdicts),
+           "parameters": [v.as_json() for v in verdicts]}
+    if blocker:
+        doc["why"] = blocker[1]
+    return doc
 
 
-def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity_overall: str) -> str:
+def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> str:
     """A table for the terminal: each limit in its file's unit, the measured value, pass or FAIL."""
-    doc = judge_result(limits, parameters, validity_overall)
+    doc = judge_result(limits, parameters, validity)
     lines = [f"QA limits: {limits.name} ({limits.path})"]
     for limit, v in zip(limits.limits, limits.judge(parameters)):
         unit = "" if _unit(limit.unit) == "1" else limit.unit
@@ -275,6 +285,8 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
                      + (f"  ({v.note})" if v.note else ""))
     if doc["verdict"] == "invalid":
         lines.append("QA: INVALID: the measurement is not valid (validity red): fix it and measure again")
+    elif doc["verdict"] == "not judged":
+        lines.append(f"QA: NOT JUDGED: {doc['why']}")
     else:
         lines.append(f"QA: {doc['verdict'].upper()}")
     return "\n".join(lines)

@@ -1,32 +1,58 @@
-"""From a recording to the full parameter table: spectra, fit, derived parameters."""
+"""From a recording to the full parameter table: spectra, judged channels, fit, derived parameters.
+
+A broken measurement is judged, not refused (analysis.validity_fit): the
+channels are judged first; a silent or copied voltage or current leaves the
+impedance nothing to fit, and the result then carries its validity with
+every parameter "not measured" and why (`fit` is None); a silent
+displacement is left out, and the electrical parameters are fitted as for a
+recording without the laser. After the fit, a misfit far above the noise is
+a finding too. Callers that need a fit (a diagnosis, a report, the archive)
+call `require_fit`, which raises NotAnalysable with the reason.
+"""
 from __future__ import annotations
 
+import dataclasses
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
-from analysis.derived import ParameterValue, parameter_table
+from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
+from analysis.errors import LinparError
 from analysis.fit import FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, estimate_spectra
-from analysis.validity import CaptureInfo, CaptureInfoError, assess, capture_of
+from analysis.validity import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
+from analysis.validity_fit import FitChannels, fit_channels, misfit_findings
+
+
+class NotAnalysable(LinparError):
+    """A recording whose channels leave nothing to fit (message: which and why, with the remedy)."""
 
 
 @dataclass(frozen=True)
 class AnalysisResult:
     spectra: Spectra
-    fit: FitResult
+    fit: FitResult | None               # None: nothing could be fitted (not_fitted says why)
     parameters: dict[str, ParameterValue]
     sd_m2: float | None
     source: Path | None = None
     validity: dict = field(default_factory=lambda: {"overall": "unknown"})
+    not_fitted: str | None = None
 
     @property
     def model(self) -> Model:
-        return self.fit.model
+        return require_fit(self).model
+
+
+def require_fit(result: AnalysisResult, doing: str = "") -> FitResult:
+    """The result's fit; NotAnalysable (naming the file, what was being done and why) when it has none."""
+    if result.fit is not None:
+        return result.fit
+    where = f"{result.source}: " if result.source is not None else ""
+    raise NotAnalysable(f"{where}{'cannot ' + doing + ': ' if doing else ''}{result.not_fitted}")
 
 
 def default_effects() -> tuple[Effect, ...]:
@@ -43,15 +69,51 @@ def resolve_sd(recording: Recording, sd_m2: float | None) -> float | None:
 def analyze_recording(recording: Recording, sd_m2: float | None = None,
                       effects: Sequence[Effect] | None = None,
                       cancel: threading.Event | None = None) -> AnalysisResult:
-    capture = checked_capture(recording)      # before the fit: a sidecar that cannot be judged is refused at once
-    spectra = estimate_spectra(recording)
-    data = FitData.from_spectra(spectra)
-    model = Model(tuple(default_effects() if effects is None else effects),
-                  with_displacement=data.displacement is not None)
-    fit = fit_model(data, model, cancel=cancel)
+    return analyze_spectra(recording, estimate_spectra(recording), sd_m2, effects, cancel)
+
+
+StartOf = Callable[[FitData, Model, "threading.Event | None"], dict]
+
+
+def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None = None,
+                    effects: Sequence[Effect] | None = None, cancel: threading.Event | None = None,
+                    start_of: StartOf | None = None) -> AnalysisResult:
+    """The judged analysis of a recording's spectra (module doc); `start_of(data, model, cancel)` may give
+    start values for the fit."""
+    validity, usable, spectra = _judged(recording, spectra)
+    effects = tuple(default_effects() if effects is None else effects)
     sd = resolve_sd(recording, sd_m2)
-    validity = assess(recording, spectra, capture).as_json()      # per channel, with the peak excursion
-    return AnalysisResult(spectra, fit, parameter_table(fit, sd), sd, recording.source, validity)
+    if usable.impedance is not None:
+        model = Model(effects, with_displacement=False)
+        return AnalysisResult(spectra, None, unmeasured_table(model, usable.impedance), sd, recording.source,
+                              validity.as_json(), usable.impedance)
+    data = FitData.from_spectra(spectra)
+    model = Model(effects, with_displacement=data.displacement is not None)
+    start = start_of(data, model, cancel) if start_of is not None else None
+    fit = fit_model(data, model, start=start, cancel=cancel)
+    judged = validity.with_findings(misfit_findings(fit))
+    parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
+    return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged.as_json())
+
+
+def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChannels, Spectra]:
+    """The channels judged, what they leave to fit, and the spectra without an unusable displacement."""
+    capture = checked_capture(recording)      # a sidecar that cannot be judged is refused at once
+    validity = assess(recording, spectra, capture)
+    usable = fit_channels(validity)
+    if usable.displacement is not None and spectra.displacement is not None:
+        spectra = dataclasses.replace(spectra, displacement=None)
+    return validity, usable, spectra
+
+
+def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, Validity]:
+    """The lines a fit of the recording may use and its judged channels (module doc); NotAnalysable naming
+    the file and `doing` when the impedance has none."""
+    validity, usable, spectra = _judged(recording, estimate_spectra(recording))
+    if usable.impedance is not None:
+        where = f"{recording.source}: " if recording.source is not None else ""
+        raise NotAnalysable(f"{where}cannot {doing}: {usable.impedance}")
+    return FitData.from_spectra(spectra), validity
 
 
 def checked_capture(recording: Recording) -> CaptureInfo | None:
@@ -72,7 +134,8 @@ def result_json(result: AnalysisResult) -> dict:
     """The object `linpar analyze --json` prints."""
     return {
         "parameters": {name: p.as_json() for name, p in result.parameters.items()},
-        "model": model_json(result.fit),
+        "model": model_json(result.fit) if result.fit is not None else
+        {"effects": [], "converged": False, "not_fitted": result.not_fitted},
         "validity": result.validity,
     }
 

@@ -60,6 +60,16 @@ laser_gap_growth_yellow = 0.10, laser_gap_growth_red = 0.5, laser_gap_unseen_red
     Red too when a stretch of the period longer than 0.5 ms (two samples at
     4 kHz) was measured in no period: the spot was lost at the same point of
     every period, and there the motion is only bridged, a guess.
+copy_residual_red = 1e-4
+    A channel whose excited lines are those of another times one complex
+    gain, to 1 % in amplitude (1e-4 in power), is a copy of it: two inputs on
+    one sense (analysis.validity_wiring). The motional branch alone moves |Z|
+    by a factor of 2 or more, so no driver comes near; a resistor does.
+misfit_yellow_chi2_red = 100
+    A reduced chi^2 of 100 on a fitted channel is a misfit ten times the
+    noise on every line: the model does not describe the measurement, and
+    the parameters carry an error their (Birge-scaled) uncertainties only
+    guess at (analysis.validity_fit). Yellow, and QA does not judge it.
 drift_*
     Line spectra of the first and the last drift_periods periods compared.
     A drift of 0.5 % is above the paper's repeatability (yellow), 2 % is a
@@ -111,6 +121,10 @@ class ValidityThresholds:
     laser_gap_growth_yellow: float = 0.10
     laser_gap_growth_red: float = 0.5
     laser_gap_unseen_red_s: float = 0.0005
+    # A channel that copies another (residual power of the best complex gain, fraction).
+    copy_residual_red: float = 1e-4
+    # The fit's misfit (reduced chi^2 of a fitted channel).
+    misfit_yellow_chi2_red: float = 100.0
     # Drift between the first and the last periods (relative change, fraction).
     drift_periods: int = 4
     drift_yellow: float = 0.005
@@ -138,6 +152,10 @@ class ValidityThresholds:
             raise ThresholdsError("noise_pool_lines, distortion_min_bins and drift_periods must be at least 1")
         if self.distortion_band_octaves <= 0:
             raise ThresholdsError("distortion_band_octaves must be positive")
+        if not 0.0 <= self.copy_residual_red < 1.0:
+            raise ThresholdsError("copy_residual_red is a fraction of the channel's power in 0..1")
+        if self.misfit_yellow_chi2_red < 1.0:
+            raise ThresholdsError("misfit_yellow_chi2_red must be at least 1 (a model that fits gives 1)")
 
     def as_json(self) -> dict[str, float]:
         return asdict(self)

@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Mapping
+from typing import Mapping, Sequence
 
 from analysis.excursion import recording_peak_displacement
 from analysis.recording import Recording
@@ -78,6 +78,19 @@ class Validity:
 
     def codes(self, channel: str) -> set[str]:
         return {f.code for f in self.channels[channel].findings}
+
+    def with_findings(self, extra: Mapping[str, Sequence[Finding]]) -> "Validity":
+        """This validity with more findings on some channels (the fit's, analysis.validity_fit), lights redone."""
+        channels = {}
+        for name, ch in self.channels.items():
+            added = tuple(extra.get(name, ()))
+            if not added or ch.status == ABSENT:
+                channels[name] = ch
+                continue
+            findings = ch.findings + added
+            channels[name] = ChannelValidity(name, str(worst(f.severity for f in findings)), findings, ch.measures)
+        overall = worst(Severity(ch.status) for ch in channels.values() if ch.status != ABSENT)
+        return Validity(overall, channels, self.peak_displacement_m)
 
     def as_json(self) -> dict:
         peak = self.peak_displacement_m

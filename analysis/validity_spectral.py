@@ -24,6 +24,9 @@ Variances below float64 rounding ((1e-12 x the strongest line)^2, -240 dB)
 are raised to it: a noise-free synthetic recording has exactly zero scatter,
 and its rounding residue would otherwise stand "infinitely" above it.
 
+A channel that is a scaled copy of another (two inputs on one sense) is
+found by analysis.validity_wiring, from the same lines.
+
 The same functions serve the whole recording (analysis.validity) and the live
 per-period frames (analysis.live); they hold no state.
 """
@@ -39,6 +42,7 @@ from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import ValidityThresholds
 from analysis.validity_findings import (
     DISTORTION_HIGH, NO_SIGNAL, SNR_LOW, X_BAND_LOW, X_FEW_LINES, Finding, Severity, graded)
+from analysis.validity_wiring import copy_findings
 
 SIGNALS = ("voltage", "current", "displacement")
 # A voltage line counts as carrying something (amplifier distortion) above this |U|^2 / <var_U>.
@@ -175,7 +179,8 @@ def spectral_checks(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray
     already known. Measures (keys of the dict): snr_db, present_share,
     distortion_db, distortion_re_signal_db; for the displacement also
     x_band_hz and x_lines. A channel with no signal gets only the no-signal
-    finding.
+    finding; one that is a scaled copy of another gets the channel-copy
+    finding first (analysis.validity_wiring).
     """
     excited = np.asarray(excited, dtype=np.int64)
     unexcited = np.asarray(unexcited, dtype=np.int64)
@@ -219,6 +224,9 @@ def spectral_checks(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray
         if name == "displacement":
             findings += _band_findings(snr, line_freqs, th, measures)
         out[name] = (findings, measures)
+
+    for name, finding in copy_findings(channels, excited, silent, th).items():
+        out[name][0].insert(0, finding)
 
     # Distortion last: the displacement's remedy depends on whether the current is distorted.
     shared = None

@@ -43,19 +43,18 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     path = getattr(args, "limits", None)
     limits = qa.load_limits(path) if path else None    # a bad limits file fails before the analysis
     result = analyze_path(args.path, args.sd, _effects(args.model))
-    overall = result.validity.get("overall", "unknown")
     doc = result_json(result)
     if limits is not None:
-        doc["limits"] = qa.judge_result(limits, result.parameters, overall)
+        doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)
     if args.json:
         print(json.dumps(doc, allow_nan=False, default=_json_number))
     else:
         print(format_result(result))
         if limits is not None:
-            print("\n" + qa.format_verdicts(limits, result.parameters, overall))
+            print("\n" + qa.format_verdicts(limits, result.parameters, result.validity))
     if limits is None:
         return 0
-    # 0 pass, 1 fail, 2 (an error: the measurement must be repeated) when it is invalid.
+    # 0 pass, 1 fail, 2 (an error: the measurement must be repeated, or its model found) when not judged.
     return {"pass": 0, "fail": EXIT_QA_FAIL}.get(doc["limits"]["verdict"], 2)
 
 
@@ -78,21 +77,29 @@ def format_value(p: ParameterValue) -> tuple[str, str]:
 
 def format_result(result: AnalysisResult) -> str:
     lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"]
-    notes = []
+    missing: dict[str, list[str]] = {}      # reason -> the parameters it keeps out
     for p in result.parameters.values():
         value, std = format_value(p)
         lines.append(f"{p.name:<14}{value:>14}  {std:>10}  {p.display_unit}")
         if p.value is None:
-            notes.append(f"  {p.name}: {p.reason}")
+            missing.setdefault(str(p.reason), []).append(p.name)
+    notes = [f"  {', '.join(names)}: {reason}" for reason, names in missing.items()]
     fit = result.fit
-    chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
-    lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   BIC {fit.bic:.1f}"
-              f"   ({fit.n_data} data, {fit.n_varying} parameters)"]
-    if not fit.success:
-        lines.append(f"warning: the fit did not converge: {fit.message}")
+    if fit is None:
+        lines += ["", f"not fitted: {getattr(result, 'not_fitted', None)}"]
+        notes = []          # every parameter has that one reason
+    else:
+        chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
+        lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
+                      f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
+        if not fit.success:
+            lines.append(f"warning: the fit did not converge: {fit.message}")
     if notes:
-        lines += ["", "not reported:"] + sorted(set(notes))
+        lines += ["", "not reported:"] + notes
     lines.append(f"validity: {result.validity.get('overall', 'unknown')}")
+    for channel in (result.validity.get("channels") or {}).values():
+        for f in channel.get("findings") or ():
+            lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
     return "\n".join(lines)
 
 

@@ -12,10 +12,8 @@ from analysis.diagnosis_words import (VERDICT_TITLES, chi2_words, drift_from_val
 from analysis.fit import FitData, FitResult
 from analysis.model import Model
 from analysis.parallel import fit_executor
-from analysis.pipeline import resolve_sd
+from analysis.pipeline import judged_fit_data, resolve_sd
 from analysis.recording import read_recording
-from analysis.spectra import estimate_spectra
-from analysis.validity import assess
 
 
 def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
@@ -27,9 +25,8 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
         data, _ = curve_data(z, hx, cli_import.fit_range(args, args.hx_fmax), notes)
         return data, args.sd, None
     recording = read_recording(args.path)
-    spectra = estimate_spectra(recording)
-    drift = drift_from_validity(assess(recording, spectra).as_json())
-    return FitData.from_spectra(spectra), resolve_sd(recording, args.sd), drift
+    data, validity = judged_fit_data(recording, "be diagnosed")
+    return data, resolve_sd(recording, args.sd), drift_from_validity(validity.as_json())
 
 
 def run_diagnosis(args: argparse.Namespace):

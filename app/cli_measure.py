@@ -131,6 +131,10 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     """Store the measurement in the archive: {"id", "root"}, or {"error", "root"} and a warning (module doc)."""
     from analysis.archive import Archive, default_root
     root = Path(args.archive_root).expanduser() if args.archive_root else default_root()
+    if outcome.result.fit is None:        # a broken measurement: judged (printed), but nothing to keep in the archive
+        why = f"nothing could be fitted ({outcome.result.not_fitted})"
+        _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in {outcome.recording_path}")
+        return {"error": why, "root": str(root)}
     meta = {"serial": args.serial, "operator": args.operator, "station": args.station, "measured_at": measured_at,
             "settings": {"template": plan.template, "rig": args.rig,
                          "laser": "serial" if outcome.raw_path is not None else (args.laser or LASER_ANALOG)}}

@@ -177,8 +177,9 @@ class MainWindow(QMainWindow):
         self.settings.add_recent_file(outcome.path)
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {self._titles.get(outcome.path, outcome.path.name)}")
-        self.status_label.setText(f"Loaded {outcome.path} — model {outcome.result.fit.model.describe()}, "
-                                  f"analysed in {elapsed:.2g} s")
+        fit = outcome.result.fit
+        model = f"model {fit.model.describe()}" if fit is not None else "nothing could be fitted"
+        self.status_label.setText(f"Loaded {outcome.path} — {model}, analysed in {elapsed:.2g} s")
         self.result_pages.after(lambda: self.analysis_shown.emit(outcome))
 
     @Slot(int, str)

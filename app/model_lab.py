@@ -146,6 +146,11 @@ class ModelLab(QWidget):
             self._sync_sd(result.sd_m2)
             return
         self._drop_job()
+        if result.fit is None:          # a broken measurement: nothing the lab could start from
+            self.base, self.data, self.versions = None, None, []
+            self.empty.setText(f"Nothing to model: {result.not_fitted}")
+            self.stack.setCurrentWidget(self.empty)
+            return
         self.base = result
         self.data = FitData.from_spectra(result.spectra)
         self.versions = []

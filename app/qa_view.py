@@ -15,6 +15,7 @@ import html
 import importlib.util
 import threading
 from pathlib import Path
+from typing import Mapping
 
 from PySide6.QtCore import QObject, QSettings, Qt, QThreadPool, Signal
 from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxLayout, QHeaderView, QLabel,
@@ -50,10 +51,16 @@ def display(value: float | None, parameter) -> str:
     return f"{value * parameter.display_scale:.4g}{unit}"
 
 
-def qa_verdict(validity_overall: str, limits_verdict: str | None) -> tuple[str, str]:
-    """(verdict, why): the measurement's validity first, then the limits."""
-    if validity_overall == "red":
+def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str, str]:
+    """(verdict, why): the measurement's validity first (analysis.validity_fit.qa_blocker), then the limits."""
+    from analysis.validity_fit import INVALID, qa_blocker
+    validity = {"overall": validity} if isinstance(validity, str) else validity
+    validity_overall = str(validity.get("overall", "unknown"))
+    blocker = qa_blocker(validity)
+    if blocker is not None and blocker[0] == INVALID:
         return "not judged", "the measurement is invalid (see the red channels): measure this driver again"
+    if blocker is not None:
+        return "not judged", blocker[1]
     if limits_verdict is None:
         return "none", "no limits loaded: only the measurement's validity is judged"
     if limits_verdict == "fail":
@@ -239,8 +246,9 @@ class QAView(QWidget):
             light.set_state(str(entry.get("status", "unknown" if result is None else "absent")),
                             entry.get("findings") or ())
         if result is not None:
+            model = f"model {result.fit.model.describe()}" if result.fit is not None else "nothing fitted"
             self.source.setText(f"Result of {result.source.name if result.source else 'an unsaved measurement'}"
-                                f" — model {result.fit.model.describe()}")
+                                f" — {model}")
         self._show_limits(keep_limits_text)
         self._show_verdict(overall)
         self._update_export()
@@ -263,8 +271,10 @@ class QAView(QWidget):
         if self.result is None:
             return
         self.verdicts = self.limits.judge(self.result.parameters)
-        # Parameters of an invalid measurement are worthless (physics.md section 5): not a pass, not a fail.
-        invalid = self.result.validity.get("overall") == "red"
+        # Parameters of an invalid measurement, or of a model that does not describe it, are worthless
+        # (physics.md section 5): not a pass, not a fail.
+        from analysis.validity_fit import qa_blocker
+        invalid = qa_blocker(self.result.validity) is not None
         self.table.setRowCount(len(self.verdicts))
         for row, v in enumerate(self.verdicts):
             parameter = self.result.parameters.get(v.limit.name)
@@ -287,7 +297,7 @@ class QAView(QWidget):
         if self.result is None:
             verdict, why = "none", "nothing to judge yet"
         else:
-            verdict, why = qa_verdict(overall, limits_verdict)
+            verdict, why = qa_verdict(self.result.validity, limits_verdict)
         background, text = VERDICT_COLOURS[verdict]
         title = {"pass": "PASS", "fail": "FAIL", "not judged": "NOT JUDGED", "none": "NO VERDICT"}[verdict]
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "

@@ -73,7 +73,10 @@ def _channel(result: AnalysisResult, name: str, dense: np.ndarray) -> ChannelCur
                          dense, dense_model)
 
 
-def result_curves(result: AnalysisResult, points: int = DENSE_POINTS) -> ResultCurves:
+def result_curves(result: AnalysisResult, points: int = DENSE_POINTS) -> ResultCurves | None:
+    """The curves of a fitted result; None when nothing was fitted (a broken measurement, judged)."""
+    if result.fit is None:
+        return None
     freqs = result.fit.channels["impedance"].freqs
     dense = np.geomspace(freqs.min(), freqs.max(), points)
     return ResultCurves(_channel(result, "impedance", dense), _channel(result, "displacement", dense))

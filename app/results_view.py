@@ -42,6 +42,9 @@ class ValidityBox(QLabel):
 
 def fit_quality_text(result: AnalysisResult) -> str:
     fit = result.fit
+    if fit is None:
+        return (f"<span style='color:#8e1b1b'><b>Nothing could be fitted</b>: "
+                f"{html.escape(str(result.not_fitted))}</span>")
     effects = ", ".join(f"{e.title} ({e.id})" for e in fit.model.effects) or "none"
     names = {"impedance": "Z", "displacement": "Hx"}
     chi = ", ".join(f"{names.get(k, k)} {v:.2f}" for k, v in fit.chi2_red_by_channel().items())
@@ -155,6 +158,14 @@ class ResultsView(QWidget):
         self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
         self.fit_quality.setText(fit_quality_text(result))
         self._show_parameters(result)
+        if curves is None:          # a broken measurement: judged (validity, reasons), nothing to draw
+            self.impedance_plot.clear_curves()
+            self.displacement_plot.clear_curves()
+            self.displacement_stack.setCurrentWidget(self.displacement_plot)
+            self.spl_panel.clear()
+            self.stack.setCurrentWidget(self.content)
+            self.result_changed.emit(result)
+            return
         self.impedance_plot.set_curves(curves.impedance, "Impedance Z = U / I")
         if curves.displacement is not None:
             self.displacement_plot.set_curves(curves.displacement, "Displacement per volt Hx = X / U")
@@ -177,7 +188,7 @@ class ResultsView(QWidget):
 
     def on_sd_changed(self, sd_m2: float | None) -> None:
         """Sd feeds only derived parameters (Vas, eta0, SPL): recomputed here, no new fit needed."""
-        if self.result is None:
+        if self.result is None or self.result.fit is None:
             return
         # parameter_table propagates through the covariance: milliseconds, fine on the GUI thread.
         result = dataclasses.replace(self.result, sd_m2=sd_m2,
@@ -187,5 +198,5 @@ class ResultsView(QWidget):
         self.result_changed.emit(result)
 
     def _show_parameters(self, result: AnalysisResult) -> None:
-        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
+        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs} if result.fit else {}
         self.parameter_table.set_parameters(result.parameters, descriptions)

@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QHBoxLayout, QLab
                                QTableWidget, QTableWidgetItem, QTabWidget, QVBoxLayout, QWidget)
 
 from analysis.level_series import level_series
-from analysis.pipeline import analyze_path
+from analysis.pipeline import analyze_path, require_fit
 from analysis.repeatability import Spread, repeatability
 from app.level_series_view import LevelSeriesView
 from app.job_book import failure_text
@@ -60,7 +60,9 @@ class SeriesWorker(QObject):
             if cancel.is_set():
                 raise SeriesCancelled()
             self.progress.emit(kind, done, len(paths))
-            results.append(analyze_path(path))
+            result = analyze_path(path)
+            require_fit(result, f"be one of the {kind} results")
+            results.append(result)
         return results
 
     def _run(self, kind: str, paths: list[Path], cancel: threading.Event) -> None:

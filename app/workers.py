@@ -28,7 +28,7 @@ class AnalysisOutcome:
     job: int
     path: Path
     result: AnalysisResult
-    curves: ResultCurves
+    curves: ResultCurves | None         # None: nothing was fitted (result.not_fitted says why)
 
 
 class AnalysisJob:

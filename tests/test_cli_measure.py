@@ -163,3 +163,19 @@ def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, me
     assert entry.serial == "SN 8" and entry.effects == tuple(printed["model"]["effects"])
     # Dated when it was measured, not when the command was run.
     assert entry.measured_at == "2024-05-01T12:00:00Z" != entry.stored_at
+
+
+def test_a_measurement_with_the_voltage_lead_off_is_judged_kept_and_not_stored(monkeypatch, tmp_path, capsys):
+    """It used to end in a ZeroDivisionError traceback after writing the recording."""
+    import app.cli_measure as cli_measure
+    from instruments.audio.simulated import SimulatedAudio
+    from instruments.rig.engine import RigFaults
+    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+        SimulatedAudio(realtime=False, seed=1, faults=RigFaults(disconnected={"voltage"})), None,
+        {"name": "paper (simulated)", "sd_m2": 0.0133}))
+    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(tmp_path / "archive"))
+    assert code == 3 and "Traceback" not in err
+    assert printed["validity"]["channels"]["voltage"]["findings"][0]["code"] == "no-signal"
+    assert printed["parameters"]["RE"]["value"] is None and printed["archive"]["error"].startswith("nothing")
+    assert "warning: not stored in the archive" in err and "The recording is kept in" in err
+    assert (tmp_path / "out" / "m.wav").is_file() and not (tmp_path / "archive").exists()

@@ -59,8 +59,13 @@ def _settings_of(recording, result) -> dict:
 
 
 def results_document(result, recording=None) -> dict:
-    """The JSON document of an analysis.pipeline.AnalysisResult (and of its recording's settings)."""
-    fit = result.fit
+    """The JSON document of an analysis.pipeline.AnalysisResult (and of its recording's settings).
+
+    A result with nothing fitted (analysis.pipeline.require_fit) raises NotAnalysable: it has no curves
+    or model to keep, report or export.
+    """
+    from analysis.pipeline import require_fit
+    fit = require_fit(result, "be stored, reported or exported")
     curves = {}
     for name, ch in fit.channels.items():
         curves[name] = {"unit": "ohm" if name == "impedance" else "m/V", "has_phase": bool(ch.has_phase),

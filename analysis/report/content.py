@@ -171,7 +171,7 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
         parameters=tuple(params), model=_model_rows(result),
         settings=_settings_rows({**dict(result.settings), **dict(settings or {})}),
         calibration=tuple(cal) or (("Calibration", "not recorded"),), result=result, notes=tuple(notes),
-        qa=None if limits is None else qa_section(limits, result.parameters, result.overall))
+        qa=None if limits is None else qa_section(limits, result.parameters, result.validity))
 
 
 __all__ = ["Finding", "Light", "LimitRow", "ParameterRow", "QASection", "ReportContent", "build_report",

@@ -2,9 +2,10 @@
 
 Numbers are shown in the unit the limits file uses for that parameter, so
 the operator reads them against the file as written. The verdict keeps the
-two questions apart as the QA page does: a red measurement is not judged
-(its parameters are worthless: measure the driver again), it does not fail
-the driver.
+two questions apart as the QA page does: a red measurement, or one the model
+does not describe, is not judged (its parameters are worthless: measure the
+driver again, or find the model; analysis.validity_fit.qa_blocker), it does
+not fail the driver.
 """
 from __future__ import annotations
 
@@ -66,15 +67,19 @@ def _row(verdict, parameter: ParameterValue | None, judged: bool) -> LimitRow:
                     outcome, "")
 
 
-def qa_section(limits, parameters: Mapping[str, ParameterValue], validity_overall: str) -> QASection:
-    """limits: analysis.limits.Limits; parameters in SI as the result has them."""
+def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> QASection:
+    """limits: analysis.limits.Limits; parameters in SI as the result has them; validity: the result's (as
+    JSON), or its overall light alone."""
+    from analysis.validity_fit import qa_blocker
+    validity = {"overall": validity} if isinstance(validity, str) else validity
+    validity_overall = str(validity.get("overall", "unknown"))
     verdicts = limits.judge(parameters)
-    judged = validity_overall != "red"
+    blocker = qa_blocker(validity)
+    judged = blocker is None
     rows = tuple(_row(v, parameters.get(v.limit.name), judged) for v in verdicts)
     failed = [v.limit.name for v in verdicts if not v.passed]
-    if not judged:
-        verdict, why = "not judged", ("the measurement is invalid (validity red): its parameters judge nothing; "
-                                      "fix what the findings say and measure this driver again")
+    if blocker is not None:
+        verdict, why = "not judged", blocker[1]
     elif failed:
         verdict, why = "fail", (f"{len(failed)} of {len(verdicts)} parameters outside their limits: "
                                 + ", ".join(failed))

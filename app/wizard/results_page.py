@@ -55,7 +55,7 @@ class ResultsPage(WizardPage):
         self.source.setText(f"<b>{html.escape(outcome.path.name)}</b> in {html.escape(str(outcome.path.parent))}")
         self.validity.set_validity(result.validity)
         self.fit_quality.setText(fit_quality_text(result))
-        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
+        descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs} if result.fit else {}
         self.table.set_parameters(result.parameters, descriptions)
 
     def missing(self) -> str | None:

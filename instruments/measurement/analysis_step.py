@@ -23,14 +23,12 @@ from typing import Sequence
 
 import numpy as np
 
-from analysis.derived import parameter_table
 from analysis.effects import Effect, Site
 from analysis.fit import FitData, fit_model, start_values
 from analysis.model import Model
-from analysis.pipeline import AnalysisResult, analyze_recording, default_effects, resolve_sd
+from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra
 from analysis.recording import Recording
 from analysis.spectra import Spectra, estimate_spectra
-from analysis.validity import assess
 
 DISPLACEMENT_MAX_KEY = "displacement_max_hz"
 COARSE_HZ = 200.0
@@ -86,10 +84,4 @@ def analyse_measurement(recording: Recording, sd_m2: float | None = None, effect
     if max_hz is None:
         return analyze_recording(recording, sd_m2, effects, cancel)
     spectra = measured_lines_only(estimate_spectra(recording), max_hz)
-    data = FitData.from_spectra(spectra)
-    model = Model(tuple(default_effects() if effects is None else effects),
-                  with_displacement=data.displacement is not None)
-    fit = fit_model(data, model, start=delay_start(data, model, cancel), cancel=cancel)
-    sd = resolve_sd(recording, sd_m2)
-    validity = assess(recording, spectra).as_json()
-    return AnalysisResult(spectra, fit, parameter_table(fit, sd), sd, recording.source, validity)
+    return analyze_spectra(recording, spectra, sd_m2, effects, cancel, start_of=delay_start)

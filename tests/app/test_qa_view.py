@@ -7,7 +7,7 @@ import json
 import pytest
 
 import app.qa_view as qa_view
-from analysis.recording import write_recording
+from analysis.recording import make_recording, write_recording
 from app.qa_view import NO_LIMITS, NO_REPORT, QAView
 from instruments.simulation import faults
 
@@ -47,6 +47,28 @@ def test_a_faulty_recording_shows_a_red_light_and_its_message(qtbot, window, fau
     assert qa.channels["voltage"].light.status == "green"
     assert qa.verdict == "not judged"            # an invalid measurement fails no driver
     assert "measure this driver again" in plain(qa.verdict_label)
+
+
+@pytest.fixture(scope="module")
+def zeroed_current(tmp_path_factory):
+    """A broken current lead read as exact zeros: nothing can be fitted (it used to be a modal error only)."""
+    rec = faults.clean()
+    signals = {c.signal: rec.signal(c.signal) for c in rec.channels}
+    signals["current"] = signals["current"] * 0.0
+    broken = make_recording(rec.sample_rate, signals, rec.period_samples, rec.settle_periods, rec.excited_bins)
+    wav, _ = write_recording(tmp_path_factory.mktemp("faults") / "current-zeroed", broken)
+    return wav
+
+
+def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_current, dialogs):
+    outcome, = open_and_wait(qtbot, window, zeroed_current)
+    assert dialogs == [] and outcome.result.fit is None
+    qa = window.qa
+    assert qa.channels["current"].light.status == "red" and qa.channels["voltage"].light.status == "green"
+    assert "no signal" in plain(qa.channels["current"].details)
+    assert qa.verdict == "not judged"
+    assert "Nothing could be fitted" in window.results.fit_quality.text()
+    assert "Nothing to model" in window.model_lab.empty.text()
 
 
 def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limits_file):

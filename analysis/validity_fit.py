@@ -1,0 +1,95 @@
+"""A broken measurement is judged, not refused: what the findings leave to fit, the fit's own finding, and QA.
+
+The mechanism every way of analysing a recording shares (analysis.pipeline,
+the measurement's analysis step, the GUI), in three steps:
+
+1. `fit_channels(validity)`: the channels are judged before anything is
+   fitted. A channel with no signal, or that copies another (a wiring
+   fault), carries nothing to fit. The impedance needs the voltage and the
+   current; without it nothing is fitted, and the result keeps its judged
+   channels with every parameter "not measured" and the reason. Without a
+   usable displacement the impedance alone is fitted, as for a recording
+   made without the laser: the electrical parameters are still reported.
+2. `misfit_findings(fit)`: a fitted channel whose reduced chi^2 is far above 1
+   (`misfit_yellow_chi2_red`, analysis.thresholds) gets a yellow "model-misfit"
+   finding: the model does not describe this measurement. Its findings go on
+   the signal the fitted channel answers with: the impedance's on the current
+   (Z = U / I, the current's response to the voltage), Hx's on the displacement.
+3. `qa_blocker(validity)`: a red measurement is invalid, a misfit one is not
+   judged; neither ever passes (or fails) a driver against QA limits.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Mapping
+
+from analysis.fit import FitResult
+from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
+from analysis.validity import ABSENT, Validity
+from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity
+
+# Findings after which a channel carries nothing a fit could use.
+UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)
+# The signal channel whose light a fitted channel's findings go on.
+FIT_SIGNAL = {"impedance": "current", "displacement": "displacement"}
+INVALID, NOT_JUDGED = "invalid", "not judged"
+MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar diagnose') and fit again; if no effect "
+                 "helps, check the wiring and the channels' findings")
+
+
+@dataclass(frozen=True, slots=True)
+class FitChannels:
+    """What can be fitted: None where a channel can be used, else why it cannot (a finding and its remedy)."""
+
+    impedance: str | None
+    displacement: str | None       # None also when the recording has no displacement at all
+
+
+def _unusable(validity: Validity, name: str) -> str | None:
+    channel = validity.channels.get(name)
+    if channel is None or channel.status == ABSENT:
+        return None
+    for finding in channel.findings:
+        if finding.code in UNUSABLE:
+            return f"{finding.message}; {finding.remedy}"
+    return None
+
+
+def fit_channels(validity: Validity) -> FitChannels:
+    impedance = _unusable(validity, "voltage") or _unusable(validity, "current")
+    displacement = _unusable(validity, "displacement")
+    if impedance is None and displacement is None:
+        return FitChannels(None, None)
+    return FitChannels(impedance and f"the impedance cannot be fitted: {impedance}",
+                       displacement and f"the displacement cannot be used: {displacement}")
+
+
+def misfit_findings(fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS) -> dict[str, list[Finding]]:
+    """A yellow model-misfit finding per fitted channel whose reduced chi^2 reaches the limit."""
+    found: dict[str, list[Finding]] = {}
+    for name, chi2_red in fit.chi2_red_by_channel().items():
+        if not (chi2_red >= th.misfit_yellow_chi2_red) and math.isfinite(chi2_red):
+            continue
+        shown = "not finite" if not math.isfinite(chi2_red) else f"{chi2_red:.3g}"
+        times = "" if not math.isfinite(chi2_red) else f", a misfit {math.sqrt(chi2_red):.3g} times the noise"
+        signal = FIT_SIGNAL.get(name, "current")
+        found.setdefault(signal, []).append(Finding(
+            signal, MODEL_MISFIT, Severity.YELLOW,
+            f"{name}: the model does not describe this measurement (reduced chi^2 {shown}{times}; "
+            f"limit: yellow from {th.misfit_yellow_chi2_red:g})", MISFIT_REMEDY,
+            chi2_red if math.isfinite(chi2_red) else float("inf")))
+    return found
+
+
+def qa_blocker(validity: Mapping) -> tuple[str, str] | None:
+    """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None."""
+    if validity.get("overall") == "red":
+        return INVALID, ("the measurement is invalid (validity red): its parameters judge nothing; fix what the "
+                         "findings say and measure this driver again")
+    for channel in (validity.get("channels") or {}).values():
+        for finding in channel.get("findings") or ():
+            if finding.get("code") == MODEL_MISFIT:
+                return NOT_JUDGED, (f"the model does not describe this measurement ({finding.get('message')}): its "
+                                    f"parameters judge nothing; {finding.get('remedy')}")
+    return None
