@@ -11,7 +11,9 @@ from pathlib import Path
 from typing import Any
 
 from analysis.effects import parse_effects
+from analysis.bounds import SD, Bound
 from analysis.errors import LinparError
+from analysis.files import read_text
 from analysis.model import Model
 
 DRIVERS_DIR = Path(__file__).resolve().parent.parent / "resources" / "drivers"
@@ -41,26 +43,36 @@ def load_driver(name_or_path: str | Path = "paper") -> DriverDefinition:
     path = Path(name_or_path)
     if not path.suffix:
         path = DRIVERS_DIR / f"{name_or_path}.json"
+    if not path.exists():
+        raise DriverFileError(f"{path}: no such driver file; built-in drivers: {', '.join(available_drivers())}")
+    text = read_text(path, "config", "a JSON driver file", DriverFileError)
     try:
-        raw = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise DriverFileError(f"{path}: no such driver file; built-in drivers: {', '.join(available_drivers())}") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raw = json.loads(text, parse_constant=_not_a_number)
+    except (json.JSONDecodeError, RecursionError, ValueError) as exc:   # ValueError: NaN, a 5000-digit integer
         raise DriverFileError(f"{path}: not a readable JSON driver file ({exc})") from None
     if not isinstance(raw, dict) or not isinstance(raw.get("parameters"), dict):
         raise DriverFileError(f"{path}: expected a JSON object with a 'parameters' object")
-    effects = tuple(raw.get("effects", []))
+    effects = raw.get("effects", [])
+    if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+        raise DriverFileError(f"{path}: key 'effects': expected a list of effect ids")
+    effects = tuple(effects)
     try:
         model = Model(parse_effects(",".join(effects) or "none"))
-    except (KeyError, ValueError) as exc:
+    except LinparError as exc:      # an unknown effect, two of one category
         raise DriverFileError(f"{path}: key 'effects': {exc}") from None
     params = {}
     for spec in model.param_specs:
         value = raw["parameters"].get(spec.name)
-        if not isinstance(value, (int, float)) or isinstance(value, bool):
-            raise DriverFileError(f"{path}: parameters.{spec.name}: expected a number in {spec.unit}")
-        params[spec.name] = float(value)
+        # The model's own range of each parameter is its plausible range.
+        bound = Bound(f"{spec.name}", spec.unit, spec.min, spec.max, spec.description)
+        params[spec.name] = bound.check(value, f"{path}: parameters.{spec.name}", DriverFileError)
     sd = raw.get("sd_m2")
+    if sd is not None:
+        SD.check(sd, f"{path}: sd_m2", DriverFileError)
     return DriverDefinition(str(raw.get("name", path.stem)), effects, params,
                             float(sd) if isinstance(sd, (int, float)) else None,
                             {k: v for k, v in raw.items() if k not in ("name", "effects", "parameters", "sd_m2")})
+
+
+def _not_a_number(name: str):
+    raise ValueError(f"{name} is not a number")

@@ -32,6 +32,7 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue
 from analysis.errors import LinparError
+from analysis.files import read_text
 
 FORMAT = "linpar-limits/1"
 ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
@@ -131,14 +132,7 @@ def _line_of(text: str, key: str, after: int = 0) -> int:
 
 def load_limits(path: str | Path) -> Limits:
     path = Path(path)
-    try:
-        if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
-            raise LimitsError(f"{path}: not a regular file: expected a JSON limits file")
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise LimitsError(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError:
-        raise LimitsError(f"{path}: not UTF-8 text: expected a JSON limits file") from None
+    text = read_text(path, "config", "a JSON limits file", LimitsError)     # a FIFO, a device: refused unread
     try:
         doc = json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as exc:

@@ -27,9 +27,11 @@ from typing import Any, Mapping
 import numpy as np
 
 # The sidecar's vocabulary (FORMAT, UNITS, Channel, RecordingError) is defined there and importable from here.
+from analysis.bounds import CHANNEL_SCALE, PERIOD_SAMPLES, SAMPLE_RATE, SD
+from analysis.files import mapped, regular_file
 from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
                                         RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
-                                        read_bytes, show, sidecar_of, unit_wanted)
+                                        show, sidecar_of, unit_wanted)
 from analysis.recording_wav import WavFormatError, decode_wav, encode_float32_wav
 
 __all__ = ["FORMAT", "IN_MEMORY", "MIN_PERIODS", "REQUIRED_SIGNALS", "UNITS", "Channel", "Recording",
@@ -100,19 +102,20 @@ def read_recording(path: str | Path) -> Recording:
     RecordingError and nothing is returned.
     """
     wav_path, json_path = recording_paths(path)
-    for missing, other, what in ((json_path, wav_path, "sidecar"), (wav_path, json_path, "signals")):
-        if not missing.is_file():
-            raise RecordingError(f"{missing}: missing, expected the {what} of the recording next to {other.name}")
+    # A FIFO, folder or device is named as what it is; a file beyond its size limit is refused unread.
+    regular_file(json_path, "sidecar", f"the sidecar of the recording next to {wav_path.name}", RecordingError)
+    regular_file(wav_path, "wav", f"the signals of the recording next to {json_path.name}", RecordingError)
     sidecar = parse_sidecar(load_sidecar(json_path), str(json_path))
     channels = _checked_channels(sidecar["channels"], str(json_path))
     try:
-        wav = decode_wav(read_bytes(wav_path))
+        with mapped(wav_path, "wav", "a WAV file", RecordingError) as blob:      # decoded out of the map
+            wav = decode_wav(blob)
     except WavFormatError as err:
         raise RecordingError(f"{wav_path}: {err}") from None
     _check_channel_count(wav.samples.shape[0], len(channels), str(wav_path), str(json_path))
-    scales = np.array([c.scale for c in channels])[:, None]
+    data = wav.samples          # ours alone: scaled in place, no second copy of a long recording
     with np.errstate(over="ignore", invalid="ignore"):   # a scale that overflows is refused below
-        data = wav.samples * scales
+        data *= np.array([c.scale for c in channels])[:, None]
     data.flags.writeable = False
     return Recording(sample_rate=wav.sample_rate, channels=channels, data=data, source=wav_path, **sidecar["rest"])
 
@@ -199,8 +202,8 @@ def _checked_fields(rec: Recording) -> dict[str, Any]:
                              else tuple(str(p) for p in recording_paths(source)))
     channels = _checked_channels(rec.channels, json_label)
     data = _checked_data(rec.data, channels, wav_label, json_label)
-    sample_rate = _integer(rec.sample_rate, 1, wav_label, "sample rate", "a positive integer (Hz)")
-    period = _integer(rec.period_samples, 1, json_label, "excitation.period_samples", "a positive integer")
+    sample_rate = _bounded(rec.sample_rate, SAMPLE_RATE, wav_label, "sample rate")
+    period = _bounded(rec.period_samples, PERIOD_SAMPLES, json_label, "excitation.period_samples")
     settle = _integer(rec.settle_periods, 0, json_label, "excitation.settle_periods", "a non-negative integer")
     _check_length(data.shape[1], period, settle, json_label, wav_label)
     return {
@@ -237,6 +240,7 @@ def _checked_channels(channels, label: str) -> tuple[Channel, ...]:
         if not _is_finite_real(scale) or scale == 0:
             raise RecordingError(f"{label}: {key}.scale: found {show(scale)} for signal {signal!r}, "
                                  f"expected a finite nonzero number")
+        CHANNEL_SCALE.check(abs(scale), f"{label}: {key}.scale of signal {signal!r}", RecordingError)
         extra = _checked_mapping(channel.extra, CHANNEL_KEYS, label, f"{key}.")
         checked.append(Channel(signal, unit, float(scale), extra))
     for required in REQUIRED_SIGNALS:
@@ -317,9 +321,7 @@ def _checked_driver(driver, label: str) -> Mapping[str, Any]:
     if "name" in driver and not isinstance(driver["name"], str):
         raise RecordingError(f"{label}: driver.name: found {show(driver['name'])}, expected a string")
     if "sd_m2" in driver:
-        sd = driver["sd_m2"]
-        if not _is_finite_real(sd) or sd <= 0:
-            raise RecordingError(f"{label}: driver.sd_m2: found {show(sd)}, expected a positive area in m^2")
+        SD.check(driver["sd_m2"], f"{label}: driver.sd_m2", RecordingError)
     return driver
 
 
@@ -354,6 +356,13 @@ def _write_atomic(path: Path, payload: bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _bounded(value, bound, label: str, key: str) -> int:
+    """An integer field within its bound (analysis.bounds); a non-integer is refused as such, not rounded."""
+    if not _is_integer(value):
+        raise RecordingError(f"{label}: {key}: found {show(value)}, expected {bound.expected()}")
+    return bound.check(value, f"{label}: {key}", RecordingError)
 
 
 def _integer(value, minimum: int, label: str, key: str, expected: str) -> int:

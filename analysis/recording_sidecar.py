@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 
 from analysis.errors import LinparError
+from analysis.files import read_bytes
 
 if TYPE_CHECKING:
     from analysis.recording import Recording
@@ -53,7 +54,7 @@ class Channel:
 def load_sidecar(path: Path) -> Any:
     """The JSON document in `path`: UTF-8 (a BOM is allowed), finite numbers only, writable again as UTF-8."""
     try:
-        text = read_bytes(path).decode("utf-8-sig")   # tolerate the BOM that some editors add
+        text = read_bytes(path, "sidecar", "a JSON sidecar", RecordingError).decode("utf-8-sig")   # a BOM is fine
     except UnicodeDecodeError as err:
         raise RecordingError(f"{path}: not UTF-8 (byte {err.start}), expected a UTF-8 JSON object") from None
     try:
@@ -179,13 +180,6 @@ def json_default(value: Any) -> Any:
 
 
 # --- files and messages, shared with analysis.recording ---------------------
-
-def read_bytes(path: Path) -> bytes:
-    try:
-        return path.read_bytes()
-    except OSError as err:
-        raise RecordingError(f"{path}: cannot be read ({err.strerror or err}), expected a readable file") from None
-
 
 def unit_wanted(signal) -> str:
     if isinstance(signal, str) and signal in UNITS:

@@ -70,16 +70,22 @@ def decode_wav(blob: bytes) -> WavSamples:
     if size % frame_bytes:
         raise WavFormatError(f"data chunk: {size} bytes is not a whole number of {frame_bytes}-byte frames "
                              f"({n_channels} channels x {bits} bits), expected whole frames")
-    raw = np.frombuffer(blob, dtype=np.uint8, count=size, offset=data_start)
-    if bits == 24:
-        # Put the 3 bytes on top of an int32 so that the sign comes for free.
-        wide = np.zeros((size // 3, 4), dtype=np.uint8)
-        wide[:, 1:] = raw.reshape(-1, 3)
-        raw = wide.reshape(-1)
-    values = raw.view(dtype).astype(np.float64)
-    if full_scale != 1.0:
-        values /= full_scale
-    samples = np.ascontiguousarray(values.reshape(-1, n_channels).T)
+    frames = np.frombuffer(blob, dtype=np.uint8, count=size, offset=data_start).reshape(-1, frame_bytes)
+    # Channel by channel straight into the result: a long file (memory-mapped by the reader) is never held
+    # twice, and no view of `blob` outlives this function.
+    samples = np.empty((n_channels, frames.shape[0]), dtype=np.float64)
+    width = bits // 8
+    for c in range(n_channels):
+        column = frames[:, c * width:(c + 1) * width]
+        if bits == 24:
+            # Put the 3 bytes on top of an int32 so that the sign comes for free.
+            wide = np.zeros((column.shape[0], 4), dtype=np.uint8)
+            wide[:, 1:] = column
+            values = wide.view(dtype)[:, 0]
+        else:
+            values = np.ascontiguousarray(column).view(dtype)[:, 0]
+        np.divide(values, full_scale, out=samples[c])
+    del frames
     return WavSamples(sample_rate, samples, describe_format(fmt_code, bits))
 
 

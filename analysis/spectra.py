@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.bounds import FREQUENCY
 from analysis.errors import LinparError
 from analysis.recording import Recording
 
@@ -188,10 +189,7 @@ def _displacement_max_hz(recording: Recording) -> float | None:
     value = recording.extra.get("displacement_max_hz") if recording.extra else None
     if value is None:
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value <= 0:
-        raise SpectrumError(f"sidecar key displacement_max_hz: found {value!r}, expected a positive number "
-                            "in Hz (the top of the laser's band)")
-    return float(value)
+    return FREQUENCY.check(value, "sidecar key displacement_max_hz (the top of the laser's band)", SpectrumError)
 
 
 def estimate_spectra(recording: Recording) -> Spectra:

@@ -85,6 +85,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from analysis.errors import LinparError
+from analysis.files import read_text
 
 
 class ThresholdsError(LinparError, ValueError):
@@ -174,12 +175,17 @@ class ValidityThresholds:
 DEFAULT_THRESHOLDS = ValidityThresholds()
 
 
+def _not_a_number(name: str):
+    raise ValueError(f"{name} is not a number")
+
+
 def load_thresholds(path: str | Path, base: ValidityThresholds = DEFAULT_THRESHOLDS) -> ValidityThresholds:
     """The defaults with the overrides of a JSON object file ({field: number}) applied."""
     path = Path(path)
+    text = read_text(path, "config", "a JSON file of threshold overrides", ThresholdsError)
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        doc = json.loads(text, parse_constant=_not_a_number)
+    except (json.JSONDecodeError, RecursionError, ValueError) as err:      # ValueError: NaN, a 5000-digit int
         raise ThresholdsError(f"{path}: not a readable JSON file ({err})") from None
     if not isinstance(doc, dict):
         raise ThresholdsError(f"{path}: expected a JSON object of threshold overrides")

@@ -5,8 +5,10 @@ import argparse
 import sys
 from typing import Sequence
 
+from analysis.bounds import SD, SIZE_KINDS, size_limits_set
 from analysis.errors import LinparError, is_user_error, user_message
 from app import cli_import
+from app.cli_options import number, size_limit
 
 # 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
 EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 2, 70, 130
@@ -18,28 +20,20 @@ class CliError(LinparError):
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # one line, no usage dump: scripts read stderr
-        raise CliError(f"{message} (see 'linpar {self.prog.split()[-1]} --help')"
-                       if " " in self.prog else f"{message} (see 'linpar --help')")
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
+        raise CliError(f"{message} (see '{self.prog} --help')")
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="linpar", description="Loudspeaker linear parameters from voltage, current and "
                                                 "laser displacement.")
+    parser.add_argument("--size-limit", action="append", type=size_limit, metavar="KIND=SIZE", default=[],
+                        help="read larger files than the defaults, which fit any real measurement: KIND is "
+                             f"{', '.join(SIZE_KINDS)}; SIZE like 500M or 4G (before the command; repeatable)")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     analyze = sub.add_parser("analyze", help="fit the parameters of a recording")
     analyze.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
-    analyze.add_argument("--sd", type=_positive_float, metavar="M2", help="effective radiating area in m^2")
+    analyze.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
     analyze.add_argument("--model", metavar="EFFECTS",
                          help="effect ids separated by commas (default lr2,creep-log; 'none' for the textbook model)")
     analyze.add_argument("--json", action="store_true", help="print one JSON object")
@@ -51,7 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     diagnose.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
     diagnose.add_argument("--from", dest="start", metavar="EFFECTS", default="none",
                           help="the starting model's effect ids (default: the textbook model)")
-    diagnose.add_argument("--sd", type=_positive_float, metavar="M2")
+    diagnose.add_argument("--sd", type=number(SD), metavar="M2")
     diagnose.add_argument("--json", action="store_true")
     cli_import.add_analyze_options(diagnose)
 
@@ -83,7 +77,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     70 for a bug (one line, the details in a crash report), 130 for Ctrl-C."""
     try:
         args = build_parser().parse_args(argv)
-        return _run(args)
+        with size_limits_set(**dict(args.size_limit)):
+            return _run(args)
     except KeyboardInterrupt:
         print("linpar: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -10,6 +10,9 @@ import json
 import sys
 from pathlib import Path
 
+from analysis.bounds import LIST_LIMIT, SD
+from app.cli_options import number
+
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
 
 
@@ -28,7 +31,7 @@ def add_commands(sub) -> None:
     ls.add_argument("--validity", choices=("green", "yellow", "red"))
     ls.add_argument("--since", metavar="DATE", help="measured on or after DATE (ISO, e.g. 2024-05-01)")
     ls.add_argument("--until", metavar="DATE", help="measured on or before DATE")
-    ls.add_argument("--limit", type=int, metavar="N")
+    ls.add_argument("--limit", type=number(LIST_LIMIT), metavar="N")
 
     show = verbs.add_parser("show", help="one measurement's record and files")
     show.add_argument("id", help="measurement id (or its first characters)")
@@ -45,7 +48,7 @@ def add_commands(sub) -> None:
         store.add_argument(f"--{name}", metavar="TEXT", default="")
     store.add_argument("--measured-at", metavar="DATE", help="when it was measured (ISO 8601; default: now)")
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
-    store.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2")
+    store.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
     store.add_argument("--model", metavar="EFFECTS", help="effect ids separated by commas (default lr2,creep-log)")
 
     compare = verbs.add_parser("compare", help="up to 8 measurements' parameters side by side")

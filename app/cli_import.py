@@ -10,26 +10,19 @@ import json
 import math
 from typing import Any
 
+from analysis.bounds import ADDED_MASS_G, FREQUENCY, SD
+from app.cli_options import number
+
 CURVE_OPTIONS = ("impedance", "uiv")
 # Options that mean something for imported curves only: with a recording they are refused, not ignored.
 CURVE_ONLY = ("hx", "mm_per_volt", "hx_fmax", "phase", "fmin", "fmax", "all_lines")
 
 
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (value > 0 and math.isfinite(value)):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
-
-
 def _add_range_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--phase", choices=("deg", "rad"),
                         help="phase unit of the files (default: what the file's header says, else degrees)")
-    parser.add_argument("--fmin", type=_positive, metavar="HZ", help="fit only lines at or above HZ")
-    parser.add_argument("--fmax", type=_positive, metavar="HZ", help="fit only lines at or below HZ")
+    parser.add_argument("--fmin", type=number(FREQUENCY), metavar="HZ", help="fit only lines at or above HZ")
+    parser.add_argument("--fmax", type=number(FREQUENCY), metavar="HZ", help="fit only lines at or below HZ")
     parser.add_argument("--all-lines", action="store_true",
                         help="keep every line of linearly spaced files (default: thinned to 100 lines per decade)")
 
@@ -41,7 +34,7 @@ def add_analyze_options(analyze: argparse.ArgumentParser) -> None:
     group.add_argument("--hx", metavar="FILE", help="displacement transfer function X/U (m/V; see --mm-per-volt)")
     group.add_argument("--uiv", metavar="FILE", help="CSV of complex U, I and laser velocity (or displacement) spectra")
     group.add_argument("--mm-per-volt", action="store_true", help="the --hx magnitude is in mm/V")
-    group.add_argument("--hx-fmax", type=_positive, metavar="HZ",
+    group.add_argument("--hx-fmax", type=number(FREQUENCY), metavar="HZ",
                        help="fit Hx only up to HZ (default: 4 x fs, where the cone is still a piston)")
     _add_range_options(group)
 
@@ -52,7 +45,7 @@ def add_commands(sub) -> None:
     mass.add_argument("free", metavar="FREE", help="free-air impedance curve")
     mass.add_argument("--mass", nargs=2, action="append", metavar=("G", "FILE"), required=True,
                       help="an added mass in grams and its impedance curve (once or twice)")
-    mass.add_argument("--sd", type=_positive, metavar="M2", help="effective radiating area in m^2 (for Vas)")
+    mass.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2 (for Vas)")
     mass.add_argument("--model", metavar="EFFECTS",
                       help="effect ids (default leach,creep-log-causal: real coils need the semi-inductance)")
     mass.add_argument("--json", action="store_true", help="print one JSON object")
@@ -60,7 +53,7 @@ def add_commands(sub) -> None:
 
     stats = sub.add_parser("stats", help="repeatability: mean, std and percent over repeated recordings")
     stats.add_argument("paths", nargs="+", metavar="FILE", help="recordings (NAME, NAME.wav or NAME.json)")
-    stats.add_argument("--sd", type=_positive, metavar="M2")
+    stats.add_argument("--sd", type=number(SD), metavar="M2")
     stats.add_argument("--model", metavar="EFFECTS", help="effect ids (default lr2,creep-log)")
     stats.add_argument("--json", action="store_true")
 
@@ -164,13 +157,13 @@ def _mass_curves(args):
     curves, notes = [MassCurve(free.transfer, 0.0)], [free.describe()]
     if len(args.mass) > 2:
         raise CliError("--mass: give one or two added masses")
-    for grams, path in args.mass:
-        try:
-            mass = _positive(grams) * 1e-3
-        except argparse.ArgumentTypeError as exc:
-            raise CliError(f"--mass: {exc}") from None
+    masses = [ADDED_MASS_G.parse(grams, f"--mass {grams} {path}") for grams, path in args.mass]
+    if len(masses) == 2 and masses[0] == masses[1]:
+        raise CliError(f"--mass: both added masses are {masses[0]:g} g: give two different masses (or one)")
+    # Lightest first: the model-free dual-mass method takes them in that order, whatever the command line's.
+    for grams, (_, path) in sorted(zip(masses, args.mass), key=lambda pair: pair[0]):
         curve = read_curve(path, "impedance", args.phase)
-        curves.append(MassCurve(curve.transfer, mass))
+        curves.append(MassCurve(curve.transfer, grams * 1e-3))
         notes.append(curve.describe())
     return curves, notes
 
@@ -222,10 +215,14 @@ def _format_added_mass(result) -> str:
 
 
 def cmd_stats(args: argparse.Namespace) -> int:
-    from analysis.pipeline import analyze_path
+    from analysis.pipeline import analyze_path, require_fit
     from analysis.repeatability import format_spread, repeatability
     effects = _effects(args.model) if args.model else None
-    tables = [analyze_path(path, args.sd, effects).parameters for path in args.paths]
+    tables = []
+    for path in args.paths:
+        result = analyze_path(path, args.sd, effects)
+        require_fit(result, "be one of the repeated results")
+        tables.append(result.parameters)
     spreads = repeatability(tables)
     if args.json:
         _print_json({"n_results": len(tables), "files": list(args.paths),

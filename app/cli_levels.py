@@ -19,17 +19,19 @@ import sys
 
 
 def _levels(text: str) -> tuple[float, ...]:
+    from analysis.bounds import LEVEL_V_RMS, BoundsError
     try:
-        levels = tuple(float(part) for part in text.split(",") if part.strip())
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected volts RMS separated by commas (0.3,1,3), got {text!r}") from None
-    if not levels or not all(v > 0 for v in levels):
-        raise argparse.ArgumentTypeError(f"expected positive volts RMS separated by commas, got {text!r}")
+        levels = tuple(LEVEL_V_RMS.parse(part, "") for part in text.split(",") if part.strip())
+    except BoundsError as exc:
+        raise argparse.ArgumentTypeError(f"{exc} (volts RMS separated by commas: 0.3,1,3)") from None
+    if not levels:
+        raise argparse.ArgumentTypeError(f"expected volts RMS separated by commas (0.3,1,3), got {text!r}")
     return levels
 
 
 def add_commands(sub) -> None:
-    from app.cli_import import _positive
+    from analysis.bounds import SD
+    from app.cli_options import number
     levels = sub.add_parser("levels", help="level series: the parameters against peak excursion (Table II)")
     levels.add_argument("paths", nargs="*", metavar="FILE",
                         help="recordings at rising levels (NAME, NAME.wav or NAME.json)")
@@ -38,7 +40,7 @@ def add_commands(sub) -> None:
     levels.add_argument("--levels", type=_levels, metavar="V1,V2,...",
                         help="with --simulate: drive levels in V RMS (default 0.3,1,3,6,10,14: ~0.15-8.5 mm)")
     levels.add_argument("--out", metavar="DIR", help="with --simulate: write the recordings to DIR (kept)")
-    levels.add_argument("--sd", type=_positive, metavar="M2", help="effective radiating area in m^2")
+    levels.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
     levels.add_argument("--model", metavar="EFFECTS", help="effect ids (default lr2,creep-log)")
     levels.add_argument("--json", action="store_true", help="print one JSON object (with the Fig. 14 data)")
 

@@ -43,7 +43,9 @@ from contextlib import ExitStack
 from datetime import datetime, timezone
 from pathlib import Path
 
+from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS, SAMPLE_RATE, SD
 from analysis.errors import is_user_error, user_message
+from app.cli_options import number
 from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
@@ -65,10 +67,11 @@ def add_commands(sub) -> None:
     m.add_argument("--laser", metavar="URL", help="serial laser port or pyserial URL; 'analog': the laser's "
                                                   "analog output on the sound card; 'none': no displacement")
     m.add_argument("--template", choices=tuple(TEMPLATES), default="woofer", help="driver class (default woofer)")
-    m.add_argument("--level", type=float, metavar="VOLT", help="excitation level, V RMS at the terminals")
-    m.add_argument("--periods", type=int, metavar="N", help="periods averaged")
-    m.add_argument("--period", type=int, metavar="SAMPLES", help="period length, a power of two")
-    m.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2")
+    m.add_argument("--level", type=number(LEVEL_V_RMS), metavar="VOLT",
+                   help="excitation level, V RMS at the terminals")
+    m.add_argument("--periods", type=number(PERIODS), metavar="N", help="periods averaged")
+    m.add_argument("--period", type=number(PERIOD_SAMPLES), metavar="SAMPLES", help="period length, a power of two")
+    m.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
     m.add_argument("--on-xrun", choices=("end", "restart"),
                    help="an xrun while periods are kept: end the measurement, keeping them (the default with the "
                         "serial laser), or average again")
@@ -213,7 +216,15 @@ def _sound_card(args: argparse.Namespace):
     if args.calibration is None:
         raise MeasurementError("--rig soundcard needs --calibration FILE (the sound card's calibration and "
                                "channel map)")
-    doc = json.loads(args.calibration.read_text(encoding="utf-8"))
+    from analysis.files import read_text
+    what = 'a JSON file {"calibration": {...}, "channel_map": {...}}'
+    text = read_text(args.calibration, "config", what, MeasurementError)
+    try:
+        doc = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise MeasurementError(f"{args.calibration}: not JSON ({exc}): expected {what}") from None
+    if not isinstance(doc, dict):
+        raise MeasurementError(f"{args.calibration}: expected {what}")
     calibration = Calibration.from_dict(doc.get("calibration", {}))
     channel_map = ChannelMap.from_dict(doc.get("channel_map", {}))
     if args.laser != LASER_ANALOG:
@@ -226,7 +237,8 @@ def _sound_card(args: argparse.Namespace):
         what = f"no full-duplex sound card named {args.device!r}" if not devices else \
             f"{len(devices)} sound cards match; name one with --device"
         raise MeasurementError(f"{what}; full-duplex cards: {names}")
-    return SoundDeviceAudio(devices[0].choice, calibration, int(doc.get("sample_rate", 48000)), channel_map)
+    rate = SAMPLE_RATE.check(doc.get("sample_rate", 48000), f"{args.calibration}: sample_rate", MeasurementError)
+    return SoundDeviceAudio(devices[0].choice, calibration, rate, channel_map)
 
 
 class _Progress:

@@ -14,7 +14,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from analysis.bounds import SD
 from app.cli_archive import add_root_option
+from app.cli_options import number
 
 EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
                   ("zma", "measured impedance (.zma)"), ("zma_model", "modelled impedance (.zma)"),
@@ -25,7 +27,8 @@ EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
 def _source_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", metavar="ID|PATH", help="archived measurement id, or a recording to analyse")
     add_root_option(parser)
-    parser.add_argument("--sd", type=float, metavar="M2", help="effective radiating area in m^2 (recordings only)")
+    parser.add_argument("--sd", type=number(SD), metavar="M2",
+                        help="effective radiating area in m^2 (recordings only)")
     parser.add_argument("--model", metavar="EFFECTS", help="effect ids for a recording (default lr2,creep-log)")
 
 

@@ -16,6 +16,8 @@ import argparse
 import json
 from pathlib import Path
 
+from analysis.bounds import XRUN_S
+from app.cli_options import number
 
 EXIT_OK, EXIT_NOT_RUNNING = 0, 1
 # The rig server's --model choices (instruments/rig/server.py), spelled here so that the parser loads no rig code.
@@ -54,7 +56,7 @@ def add_commands(sub) -> None:
     fault = actions.add_parser("fault", parents=[common], help="change the faults of the running rig")
     fault.add_argument("specs", nargs="*", metavar="SPEC", help="faults to add (as for start --fault)")
     fault.add_argument("--clear", action="store_true", help="remove every fault first")
-    fault.add_argument("--xrun", nargs="?", const=0.1, type=float, metavar="SECONDS",
+    fault.add_argument("--xrun", nargs="?", const=0.1, type=number(XRUN_S), metavar="SECONDS",
                        help="make one process cycle overrun by SECONDS (default 0.1)")
     fault.add_argument("--kill-client", action="store_true", help="close the rig's JACK client (a crash)")
 

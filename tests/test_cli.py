@@ -78,7 +78,7 @@ def test_textbook_model_on_request(capsys, rec_path):
     (["analyze", "/nonexistent/rec"], "rec"),
     (["analyze"], "path"),
     (["analyze", "REC", "--model", "nonsense"], "nonsense"),
-    (["analyze", "REC", "--sd", "-1"], "positive"),
+    (["analyze", "REC", "--sd", "-1"], "an effective radiating area Sd"),
     (["frobnicate"], "frobnicate"),
 ])
 def test_bad_use_exits_2_with_one_line(capsys, rec_path, argv, words):

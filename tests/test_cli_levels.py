@@ -71,7 +71,7 @@ def test_simulate_in_memory_keeps_nothing(capsys, tmp_path, monkeypatch):
     (("some.wav", "--levels", "1,2"), "--levels: only with --simulate"),
     (("--simulate", "--levels", "1,40"), "at most 16 V"),
     (("--simulate", "--levels", "a,b"), "volts RMS"),
-    (("--simulate", "--levels", "1,-2"), "positive"),
+    (("--simulate", "--levels", "1,-2"), "found -2, expected a drive level"),
     (("--simulate", "--model", "nonsense"), "--model"),
     (("missing.wav",), "missing.json"),
 ])

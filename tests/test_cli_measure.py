@@ -73,7 +73,7 @@ def test_measure_starts_a_rig_when_none_runs_and_stops_it_after(virtual_rig, tmp
     (["--period", "1000"], "power of two"),
     (["--rig", "soundcard"], "--calibration"),
     (["--rig", "soundcard", "--calibration", "/nonexistent/cal.json"], "cal.json"),
-    (["--periods", "1"], "at least 2 periods"),
+    (["--periods", "1"], "found 1, expected a number of periods: a whole number from 2"),
 ])
 def test_mistakes_are_one_line_errors_before_anything_starts(tmp_path, capsys, argv, message):
     code = main(["measure", "--out", str(tmp_path), "--rig-name", f"never-{os.getpid()}",

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis.bounds import FREQUENCY, HX, IMPEDANCE, Bound
 from analysis.importers.columns import HX_UNITS, assign_columns, hx_unit, phase_unit
 from analysis.importers.table import Table, read_table
 from analysis.spectra import TransferFunction
@@ -87,6 +88,7 @@ def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: st
         chosen, why = hx_unit(table, columns, unit)
         value = value * HX_UNITS[chosen]
         notes.append(f"magnitude in {chosen} ({why})")
+    check_bound(table, np.abs(value), HX if kind == "displacement" else IMPEDANCE, value_name.split(" in ")[0])
     has_phase = columns.is_complex or columns.phase is not None
     n = len(freqs)
     tf = TransferFunction(kind, si_unit, freqs.copy(), np.arange(n), value, np.full(n, np.nan),
@@ -94,11 +96,20 @@ def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: st
     return ImportedCurve(tf, table.path, tuple(notes))
 
 
+def check_bound(table: Table, values: np.ndarray, bound: Bound, what: str) -> None:
+    """Every value inside the bound (analysis.bounds); else the first one outside, with its line."""
+    bad = np.flatnonzero(~((values >= bound.low) & (values <= bound.high)))
+    if bad.size:
+        i = bad[0]
+        raise table.error(int(table.lines[i]), f"{what} {values[i]:g}: expected {bound.expected()}")
+
+
 def check_frequencies(table: Table, freqs: np.ndarray) -> None:
     bad = np.flatnonzero(freqs <= 0)
     if bad.size:
         i = bad[0]
         raise table.error(int(table.lines[i]), f"frequency {freqs[i]:g} Hz: expected a positive frequency")
+    check_bound(table, freqs, FREQUENCY, "frequency")
     steps = np.flatnonzero(np.diff(freqs) <= 0)
     if steps.size:
         i = steps[0] + 1

@@ -12,17 +12,16 @@ number. A silently skipped line would be a silently wrong curve.
 from __future__ import annotations
 
 import re
-import stat
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from analysis.errors import LinparError
+from analysis.files import read_bytes
 from analysis.importers.errors import ImportFormatError
 
 COMMENT_MARKERS = ("*", "#", "%", "'", "//", "!")
-# Bigger than any curve export (the 0.5 Hz-step Dayton files are 0.7 MB).
-MAX_FILE_BYTES = 200 * 1024 * 1024
 # [0-9]+(?:\.[0-9]*)? rather than [0-9]+\.?[0-9]*: the same numbers, but a long run of digits cannot be split
 # between two quantifiers in n ways, so refusing a field costs linear, not quadratic, time.
 _NUMBER = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
@@ -65,20 +64,16 @@ class Table:
         return ImportFormatError(self.path, line, message)
 
 
+class _Refused(LinparError):
+    pass
+
+
 def read_text(path: str | Path) -> str:
     path = Path(path)
-    try:
-        status = path.stat()
-        if not stat.S_ISREG(status.st_mode):    # a FIFO or a device would block the read forever
-            raise ImportFormatError(path, None, "not a regular file: expected a text file")
-        size = status.st_size
-        if size > MAX_FILE_BYTES:
-            raise ImportFormatError(path, None, f"{size} bytes: too large for a curve export")
-        raw = path.read_bytes()
-    except ImportFormatError:
-        raise
-    except OSError as exc:
-        raise ImportFormatError(path, None, f"cannot be read ({exc.strerror or exc})") from None
+    try:    # a FIFO or a device would block the read forever; a huge file is no curve export
+        raw = read_bytes(path, "curve", "a text file (a curve export)", _Refused)
+    except _Refused as exc:
+        raise ImportFormatError(path, None, str(exc).removeprefix(f"{path}: ")) from None
     return decode(path, raw)
 
 

@@ -14,7 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from analysis.importers.curves import check_frequencies
+from analysis.bounds import HX, IMPEDANCE
+from analysis.importers.curves import check_bound, check_frequencies
 from analysis.importers.table import Table, read_table
 from analysis.spectra import TransferFunction
 
@@ -91,11 +92,14 @@ def read_uiv(path: str | Path) -> ImportedUIV:
     else:
         X = v[:, col["xre"]] + 1j * v[:, col["xim"]]
         notes = ("motion given as displacement (m): Hx = X / U",)
-    Z, Hx = U / I, X / U
+    with np.errstate(over="ignore", invalid="ignore"):
+        Z, Hx = U / I, X / U
     for name, value in (("impedance", Z), ("Hx", Hx)):
         bad = np.flatnonzero(~np.isfinite(value))
         if bad.size:
             raise table.error(int(table.lines[bad[0]]), f"the {name} overflows: expected finite spectra")
+    check_bound(table, np.abs(Z), IMPEDANCE, "|Z| = |U / I|")
+    check_bound(table, np.abs(Hx), HX, "|Hx| = |X / U|")
     n = len(f)
     nan = np.full(n, np.nan)
     z_tf = TransferFunction("impedance", "ohm", f.copy(), np.arange(n), Z, nan, has_phase=True, noise_known=False)

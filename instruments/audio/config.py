@@ -6,7 +6,7 @@ objects (``to_dict`` / ``from_dict``) so the settings can keep them.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import MISSING, asdict, dataclass, fields
 from typing import Any, Mapping
 
 import numpy as np
@@ -28,10 +28,11 @@ def _from_mapping(cls, data: Mapping[str, Any], what: str):
     unknown = sorted(set(data) - known)
     if unknown:
         raise AudioConfigError(f"{what}: unknown key(s) {', '.join(unknown)}; known: {', '.join(sorted(known))}")
-    try:
-        return cls(**dict(data))
-    except TypeError as exc:   # a missing required key
-        raise AudioConfigError(f"{what}: {exc}") from None
+    missing = [f.name for f in fields(cls)
+               if f.name not in data and f.default is MISSING and f.default_factory is MISSING]
+    if missing:
+        raise AudioConfigError(f"{what}: missing key(s) {', '.join(missing)}")
+    return cls(**dict(data))
 
 
 @dataclass(frozen=True, slots=True)

@@ -176,7 +176,7 @@ def test_declared_radians_refuse_degree_values(tmp_path):
 
 
 def test_a_missing_file(tmp_path):
-    with pytest.raises(ImportFormatError, match="cannot be read"):
+    with pytest.raises(ImportFormatError, match="nope.zma: missing, expected a text file"):
         read_curve(tmp_path / "nope.zma")
 
 

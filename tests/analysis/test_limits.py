@@ -90,8 +90,10 @@ def test_a_bad_limits_file_gives_one_line_naming_file_line_and_key(tmp_path, doc
 
 
 def test_unreadable_file(tmp_path):
-    with pytest.raises(LimitsError, match="cannot be read"):
+    with pytest.raises(LimitsError, match="missing, expected a JSON limits file"):
         load_limits(tmp_path / "missing.json")
+    with pytest.raises(LimitsError, match="a folder, not a regular file"):
+        load_limits(tmp_path)
     path = tmp_path / "latin.json"
     path.write_bytes(b'{"name": "\xe9"}')
     with pytest.raises(LimitsError, match="not UTF-8"):

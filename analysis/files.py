@@ -1,0 +1,118 @@
+"""Files a user names, read safely: regular files only, within a size limit, each refusal one clear line.
+
+A FIFO or a character device (/dev/zero) would block a read forever or feed
+it without end; a folder cannot be read; a file far larger than any real
+measurement would exhaust the memory. So every file linpar reads whole goes
+through `regular_file` first, which says what the path is when it is not a
+regular file, and refuses one above its kind's size limit
+(analysis.bounds.SizeLimits, raised with `linpar --size-limit KIND=SIZE`).
+
+`read_bytes` reads a small file; `mapped` memory-maps a large one (the WAV
+samples), so that the file's bytes are not copied before they are decoded.
+"""
+from __future__ import annotations
+
+import contextlib
+import mmap
+import os
+import stat
+from pathlib import Path
+from typing import Iterator
+
+from analysis.bounds import describe_size, size_limit
+from analysis.errors import LinparError
+
+# Below this a file is read into memory; above it, memory-mapped.
+MAP_FROM_BYTES = 16 * 1024 * 1024
+
+
+def _what_it_is(mode: int) -> str | None:
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO (named pipe)"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a regular file"
+
+
+def regular_file(path: str | Path, kind: str, what: str, error: type[LinparError]) -> int:
+    """The size of `path` when it is a regular file within the `kind`'s size limit; else `error` (one line).
+
+    `what` says what was expected ("the sidecar of the recording"), `kind` is one of analysis.bounds.SIZE_KINDS.
+    """
+    path = Path(path)
+    try:
+        status = path.stat()
+    except FileNotFoundError:
+        raise error(f"{path}: missing, expected {what}") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot be read ({exc.strerror or exc}), expected {what}") from None
+    other = _what_it_is(status.st_mode)
+    if other is not None:
+        raise error(f"{path}: {other}, not a regular file: expected {what}")
+    limit = size_limit(kind)
+    if status.st_size > limit:
+        raise error(f"{path}: {describe_size(status.st_size)}, above the limit of {describe_size(limit)} for "
+                    f"{kind} files: expected {what}; if it is one, raise the limit with "
+                    f"'linpar --size-limit {kind}=SIZE ...'")
+    return status.st_size
+
+
+def read_bytes(path: str | Path, kind: str, what: str, error: type[LinparError]) -> bytes:
+    """The bytes of a regular file within its size limit (see regular_file)."""
+    regular_file(path, kind, what, error)
+    try:
+        with open(path, "rb") as f:
+            # Read one byte more than the limit: a file that grew since the check is still refused.
+            data = f.read(size_limit(kind) + 1)
+    except OSError as exc:
+        raise error(f"{path}: cannot be read ({exc.strerror or exc}), expected {what}") from None
+    if len(data) > size_limit(kind):
+        raise error(f"{path}: grew beyond the limit of {describe_size(size_limit(kind))} while being read")
+    return data
+
+
+def read_text(path: str | Path, kind: str, what: str, error: type[LinparError]) -> str:
+    """A regular UTF-8 text file within its size limit (a BOM is allowed); `error` for anything else."""
+    data = read_bytes(path, kind, what, error)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: not UTF-8 text (byte {exc.start}), expected {what}") from None
+
+
+@contextlib.contextmanager
+def mapped(path: str | Path, kind: str, what: str, error: type[LinparError]) -> Iterator[bytes | mmap.mmap]:
+    """The file's bytes for the duration of the block: memory-mapped when large, read when small.
+
+    Whatever the block makes of them must be copied out before it ends (numpy views of the map are not).
+    """
+    size = regular_file(path, kind, what, error)
+    if size < MAP_FROM_BYTES:
+        yield read_bytes(path, kind, what, error)
+        return
+    try:
+        with open(path, "rb") as f:
+            view = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)      # the map outlives the descriptor
+    except (OSError, ValueError) as exc:       # ValueError: the file shrank to nothing meanwhile
+        raise error(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc}), expected {what}") from None
+    try:
+        yield view
+    finally:
+        try:
+            view.close()
+        except BufferError:     # a view of it still lives (an exception's frame): unmapped when that goes
+            pass
+
+
+def is_regular(path: str | Path) -> bool:
+    """True for an existing regular file (after symlinks), without reading it."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except OSError:
+        return False
