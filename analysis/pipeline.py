@@ -13,17 +13,19 @@ from __future__ import annotations
 
 import dataclasses
 import threading
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
-from analysis.fit import FitData, FitResult, fit_model
-from analysis.model import Model
+from analysis.fit import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.model import Model, ModelError
 from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
-from analysis.spectra import Spectra, estimate_spectra
+from analysis.spectra import Spectra, SpectrumError, estimate_spectra
+from analysis.startvalues import StartValueError
 from analysis.validity import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity_fit import FitChannels, fit_channels, misfit_findings
 
@@ -69,7 +71,21 @@ def resolve_sd(recording: Recording, sd_m2: float | None) -> float | None:
 def analyze_recording(recording: Recording, sd_m2: float | None = None,
                       effects: Sequence[Effect] | None = None,
                       cancel: threading.Event | None = None) -> AnalysisResult:
-    return analyze_spectra(recording, estimate_spectra(recording), sd_m2, effects, cancel)
+    with naming_the_file(recording):
+        spectra = estimate_spectra(recording)
+    return analyze_spectra(recording, spectra, sd_m2, effects, cancel)
+
+
+@contextmanager
+def naming_the_file(recording: Recording) -> Iterator[None]:
+    """An error of the analysis (no excited line, too few lines, no resonance, a fit that fails) names the
+    recording's file: the user may have given many (stats, levels)."""
+    try:
+        yield
+    except (SpectrumError, StartValueError, FitError, ModelError) as exc:
+        if isinstance(exc, FitCancelled) or recording.source is None or str(recording.source) in str(exc):
+            raise
+        raise type(exc)(f"{recording.source}: {exc}") from None
 
 
 StartOf = Callable[[FitData, Model, "threading.Event | None"], dict]
@@ -80,6 +96,12 @@ def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None 
                     start_of: StartOf | None = None) -> AnalysisResult:
     """The judged analysis of a recording's spectra (module doc); `start_of(data, model, cancel)` may give
     start values for the fit."""
+    with naming_the_file(recording):
+        return _analyzed(recording, spectra, sd_m2, effects, cancel, start_of)
+
+
+def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effects: Sequence[Effect] | None,
+              cancel: threading.Event | None, start_of: StartOf | None) -> AnalysisResult:
     validity, usable, spectra = _judged(recording, spectra)
     effects = tuple(default_effects() if effects is None else effects)
     sd = resolve_sd(recording, sd_m2)
@@ -109,7 +131,8 @@ def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChanne
 def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, Validity]:
     """The lines a fit of the recording may use and its judged channels (module doc); NotAnalysable naming
     the file and `doing` when the impedance has none."""
-    validity, usable, spectra = _judged(recording, estimate_spectra(recording))
+    with naming_the_file(recording):
+        validity, usable, spectra = _judged(recording, estimate_spectra(recording))
     if usable.impedance is not None:
         where = f"{recording.source}: " if recording.source is not None else ""
         raise NotAnalysable(f"{where}cannot {doing}: {usable.impedance}")

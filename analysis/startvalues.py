@@ -95,6 +95,10 @@ def start_context(z: TransferFunction) -> StartContext:
     RE = float(np.min(real))
     if RE <= 0:
         RE = float(np.min(np.abs(Z)))
+    if not (np.isfinite(RE) and RE > 0):
+        # A zero at one line would divide by zero below (CMES = Qms / (w RES), RES ~ 1e-3 RE).
+        raise StartValueError(f"the impedance is {RE:g} ohm at a line: expected the resistance of a voice coil; "
+                              "check the voltage sense and the current sense")
     excess = real - RE
     k = _motional_peak(f, excess)
     fs = float(f[k])

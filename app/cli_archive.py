@@ -6,11 +6,11 @@ a large archive must not wait for numpy and scipy to load.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
 from analysis.bounds import LIST_LIMIT, SD
+from app.cli_json import dumps
 from app.cli_options import number
 
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
                                       args.since, args.until, args.limit))
         _notes(archive)
         if args.json:
-            print(json.dumps([e.as_json() for e in entries], ensure_ascii=False))
+            print(dumps([e.as_json() for e in entries]))
             return 0
         cols = "  ".join(f"{n + (' [' + u + ']' if u else ''):>10}" for n, u, _ in LIST_PARAMETERS)
         lines = [f"{'id':<22}  {'date (UTC)':<20}  {'driver':<20}  {'serial':<12}  {'validity':<8}  {cols}"]
@@ -99,7 +99,7 @@ def run(args: argparse.Namespace) -> int:
         m = archive.get(args.id)
         _notes(archive)
         if args.json:
-            print(json.dumps({**m.record, "path": str(m.folder)}, ensure_ascii=False, indent=1))
+            print(dumps({**m.record, "path": str(m.folder)}, indent=1))
             return 0
         r = m.record
         for key in ("id", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity",
@@ -119,12 +119,12 @@ def run(args: argparse.Namespace) -> int:
     if verb == "export":
         target = archive.export(args.id, args.dir)
         _notes(archive)
-        print(json.dumps({"exported": str(target)}) if args.json else f"exported to {target}")
+        print(dumps({"exported": str(target)}) if args.json else f"exported to {target}")
         return 0
     if verb == "rebuild":
         report = archive.rebuild()
         if args.json:
-            print(json.dumps({"indexed": report.indexed, "skipped": report.skipped}))
+            print(dumps({"indexed": report.indexed, "skipped": report.skipped}))
         else:
             print(report.describe())
         return 0
@@ -144,7 +144,7 @@ def _store(archive, args) -> int:
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)
     _notes(archive)
-    print(json.dumps({"id": mid, "validity": result.validity.get("overall")}) if args.json else
+    print(dumps({"id": mid, "validity": result.validity.get("overall")}) if args.json else
           f"stored {mid} (validity {result.validity.get('overall')})")
     return 0
 
@@ -155,7 +155,7 @@ def _compare(archive, args) -> int:
     c = compare(archive, args.ids)
     _notes(archive)
     if args.json:
-        print(json.dumps(c.as_json(), ensure_ascii=False, allow_nan=False))
+        print(dumps(c.as_json()))
         return 0
     width = 14
     print(f"{'parameter':<14}{'unit':<8}" + "".join(f"{label[:width - 1]:>{width}}" for label in c.labels)

@@ -10,6 +10,7 @@ from analysis.effects import CATALOGUE, UnknownEffectError, categories, parse_ef
 from analysis.limits import LimitsError
 from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult, analyze_path, result_json
+from app.cli_json import dumps
 
 EXIT_QA_FAIL = 1
 
@@ -47,7 +48,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)
     if args.json:
-        print(json.dumps(doc, allow_nan=False, default=_json_number))
+        print(dumps(doc))
     else:
         print(format_result(result))
         if limits is not None:
@@ -56,10 +57,6 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         return 0
     # 0 pass, 1 fail, 2 (an error: the measurement must be repeated, or its model found) when not judged.
     return {"pass": 0, "fail": EXIT_QA_FAIL}.get(doc["limits"]["verdict"], 2)
-
-
-def _json_number(value):
-    return None
 
 
 def format_value(p: ParameterValue) -> tuple[str, str]:

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 
 from analysis import acceptance
 from analysis.derived import parameter_table
@@ -13,6 +12,7 @@ from analysis.fit import FitData, FitResult
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import judged_fit_data, resolve_sd
+from app.cli_json import dumps
 from analysis.recording import read_recording
 
 
@@ -123,7 +123,7 @@ def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
 def cmd_diagnose(args: argparse.Namespace) -> int:
     result, sd, drift = run_diagnosis(args)
     if args.json:
-        print(json.dumps(diagnosis_json(result, sd, drift), allow_nan=False, default=lambda _: None))
+        print(dumps(diagnosis_json(result, sd, drift)))
     else:
         print(format_diagnosis(result, drift))
     return 0

@@ -6,9 +6,6 @@ The analysis modules are imported inside the commands: building the parser
 from __future__ import annotations
 
 import argparse
-import json
-import math
-from typing import Any
 
 from analysis.bounds import ADDED_MASS_G, FREQUENCY, SD
 from app.cli_options import number
@@ -85,20 +82,8 @@ def _effects(text: str | None, option: str = "--model"):
 
 
 def _print_json(doc: dict) -> None:
-    print(json.dumps(_finite(doc), allow_nan=False))
-
-
-def _finite(x: Any) -> Any:
-    """NaN and infinities as null: JSON has no such numbers."""
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if hasattr(x, "item") and not isinstance(x, (str, bytes)):     # numpy scalars
-        return _finite(x.item())
-    return x
+    from app.cli_json import dumps
+    print(dumps(doc))
 
 
 def load_curves(args: argparse.Namespace):

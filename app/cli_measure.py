@@ -45,6 +45,7 @@ from pathlib import Path
 
 from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS, SAMPLE_RATE, SD
 from analysis.errors import is_user_error, user_message
+from app.cli_json import dumps
 from app.cli_options import number
 from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
@@ -124,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
         doc = result_json(result)
         if archived is not None:
             doc = {**doc, "archive": archived}
-        print(json.dumps(doc, allow_nan=False, default=lambda value: None))
+        print(dumps(doc))
     else:
         print(format_result(result))
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0

@@ -35,6 +35,8 @@ from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, cle
                                     new_measurement_id, safe_suffix)
 from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
 from analysis.archive.schema import KEY_PARAMETERS
+from analysis.bounds import YEAR
+from analysis.files import read_text, regular_file
 
 MeasurementId = str
 FOLDERS = "measurements"
@@ -94,11 +96,10 @@ class Measurement:
         path = self.path(role)
         if path is None:
             return {}
+        text = read_text(path, "archive", f"the measurement's {role} (JSON)", ArchiveError)
         try:
-            if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
-                raise ArchiveError(f"{path}: not a regular file")
-            return json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            return json.loads(text)
+        except ValueError as exc:
             raise ArchiveError(f"{path}: not readable JSON ({exc})") from None
         except RecursionError:
             raise ArchiveError(f"{path}: not readable JSON (nested too deeply)") from None
@@ -106,6 +107,9 @@ class Measurement:
     def result(self):
         """The analysis as stored (analysis.archive.results.StoredResult)."""
         from analysis.archive.results import ResultsFormatError, StoredResult
+        if self.path("results") is None:
+            raise ArchiveError(f"{self.folder / RECORD_FILE}: files.results: missing, expected the name of the "
+                               f"measurement's results file (results.json)")
         try:
             return StoredResult.from_json(self.load_json("results"))
         except ResultsFormatError as exc:
@@ -138,6 +142,8 @@ def _iso(text: str | None, field_name: str) -> str | None:
         raise ArchiveError(f"meta.{field_name}: {text!r} is not an ISO 8601 date or time") from None
     if when.tzinfo is None:
         when = when.replace(tzinfo=timezone.utc)
+    YEAR.check(when.year, f"meta.{field_name} ({text})", ArchiveError)
+    # 9999-12-31T23:59:59-05:00 is in the year 10000 in UTC: the bound keeps the conversion in range.
     return when.astimezone(timezone.utc).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
@@ -215,6 +221,8 @@ class Archive:
         files = {"recording": "recording.wav", "sidecar": "recording.json", "results": RESULTS_FILE,
                  "settings": "settings.json", "calibration": "calibration.json"}
         if laser_stream is not None:
+            # /dev/zero would be copied forever, a FIFO block: only a regular file within its size limit.
+            regular_file(laser_stream, "laser-stream", "the raw laser stream of the measurement", ArchiveError)
             files["laser_stream"] = "laser" + safe_suffix(str(laser_stream))
         params = doc["parameters"]
         record = {

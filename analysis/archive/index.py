@@ -3,7 +3,7 @@
 On open the index is checked, cheapest first: the file exists, starts with
 SQLite's magic bytes, passes `PRAGMA quick_check`, has a schema_version this
 program knows (older ones are migrated) and the expected columns. A file
-that fails any check is renamed aside (index.sqlite.broken-<time>, kept for
+that fails any check is renamed aside (index.sqlite.broken-<time>-<pid>, kept for
 a look) and the index is rebuilt from the folders. Then the set of folders
 is compared with the set of indexed ones, so that a folder stored by a
 program that crashed before it reached the index, or one removed by hand,
@@ -32,8 +32,8 @@ from typing import Iterable
 
 from analysis.archive.atomic import fsync_dir
 from analysis.archive.leftovers import STALE_AFTER_S, sweep
-from analysis.archive.names import ArchiveError
-from analysis.archive.record import Entry, entry_of, read_record
+from analysis.archive.names import ArchiveError, check_id
+from analysis.archive.record import Entry, checked_entry, checked_parameter, entry_of, one_line_text, read_record
 from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -241,13 +241,12 @@ class Index:
 
     def _set_aside(self) -> None:
         """Keep a damaged database for a look, and never let its journal touch the new one."""
-        stamp = time.strftime("%Y%m%d-%H%M%S")
         if self.path.exists() and self._problem_is_damage():
-            os.replace(self.path, self.path.with_name(f"{INDEX_FILE}.broken-{stamp}"))
+            os.replace(self.path, _aside_name(self.path))
         for suffix in ("-journal", "-wal", "-shm"):
             side = Path(str(self.path) + suffix)
             if side.is_dir() and not side.is_symlink():     # not SQLite's: kept for a look, out of its way
-                os.replace(side, side.with_name(f"{side.name}.broken-{stamp}"))
+                os.replace(side, _aside_name(side))
             else:
                 side.unlink(missing_ok=True)
 
@@ -279,10 +278,23 @@ class Index:
         if flt.limit is not None:
             sql += " LIMIT ?"
             args.append(int(flt.limit))
-        rows = conn.execute(sql, args).fetchall()
-        entries = {r[0]: Entry(*r[:9], tuple(e for e in r[9].split(",") if e), {}) for r in rows}
+        entries: dict[str, Entry] = {}
+        refused: list[str] = []
+        for row in conn.execute(sql, args).fetchall():
+            try:
+                entries[row[0]] = _entry_of_row(row)
+            except ArchiveError as exc:
+                refused.append(str(exc))
         for mid, name, value, std, unit in self._parameters(conn, list(entries)):
-            entries[mid].parameters[name] = {"value": value, "std": std, "unit": unit}
+            try:
+                where = f"index row of {mid}: parameter {one_line_text(name, 'parameter name')}"
+                entries[mid].parameters[name] = checked_parameter({"value": value, "std": std, "unit": unit}, where)
+            except ArchiveError as exc:
+                refused.append(str(exc))
+        if refused:
+            self.notes.append(f"skipped {len(refused)} row(s) of the index {self.path} that cannot be used "
+                              f"({refused[0]}{'; ...' if len(refused) > 1 else ''}): 'linpar archive rebuild' "
+                              f"makes the index anew from the measurement folders")
         return list(entries.values())
 
     def _parameters(self, conn, ids: list[str]) -> Iterable[tuple]:
@@ -297,9 +309,40 @@ class Index:
                             f"WHERE measurement_id IN ({marks})", ids).fetchall()
 
     def matching_ids(self, conn: sqlite3.Connection, prefix: str) -> list[tuple[str, str]]:
-        """(id, folder) of every measurement whose id starts with `prefix`."""
-        return conn.execute("SELECT id, folder FROM measurements WHERE substr(id, 1, ?) = ? ORDER BY id",
+        """(id, folder) of every measurement whose id starts with `prefix` (rows that cannot be used: skipped)."""
+        rows = conn.execute("SELECT id, folder FROM measurements WHERE substr(id, 1, ?) = ? ORDER BY id",
                             (len(prefix), prefix)).fetchall()
+        usable = []
+        for mid, folder in rows:
+            try:
+                usable.append((check_id(mid), one_line_text(folder, f"index row of {mid}: folder")))
+            except ArchiveError as exc:
+                self.notes.append(f"skipped a row of the index {self.path} ({exc}): 'linpar archive rebuild' "
+                                  f"makes the index anew from the measurement folders")
+        return usable
+
+
+def _aside_name(path: Path) -> Path:
+    """NAME.broken-<time>-<pid>[-n]: unique, so that two damaged indexes set aside in one second (by one
+    program or two) never replace one another."""
+    stem = f"{path.name}.broken-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}"
+    for n in range(1, 1000):
+        candidate = path.with_name(stem if n == 1 else f"{stem}-{n}")
+        if not os.path.lexists(candidate):
+            return candidate
+    raise ArchiveError(f"{path.parent}: a thousand damaged indexes set aside this second: remove some")
+
+
+def _entry_of_row(row: tuple) -> Entry:
+    """An Entry of an index row, checked as a record is (the index is a file like any other)."""
+    keys = ("id", "folder", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity")
+    values = dict(zip(keys, row[:9]))
+    effects = row[9]
+    where = f"index row of {row[0]!r:.40}"
+    one_line_text(effects, f"{where}: effects")
+    values["effects"] = tuple(e for e in effects.split(",") if e)
+    checked_entry(values, where)
+    return Entry(*(values[k] for k in keys), values["effects"], {})
 
 
 def insert(conn: sqlite3.Connection, record: dict) -> None:

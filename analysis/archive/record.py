@@ -7,19 +7,32 @@
                "settings": "settings.json", "calibration": "calibration.json", "laser_stream": ...}}
 
 Dates are ISO 8601 in UTC. No numpy here: `linpar archive list` stays fast.
+
+A measurement.json is a file like any other: whatever it holds is checked
+when it is read (`read_record`), and the rows of the index the same way
+(`checked_entry`, `checked_parameter`): strings without control characters
+(one line each, as the listing prints them), dates that are dates, numbers
+that are finite and within analysis.bounds. What fails is reported and
+skipped, never printed as it is.
 """
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass, field
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 from analysis.archive.names import ArchiveError, check_id
+from analysis.bounds import PARAMETER, SD, YEAR
+from analysis.files import read_text
 
 RECORD_FORMAT = "linpar-measurement/1"
 RECORD_FILE = "measurement.json"
 TEXT_FIELDS = ("driver", "serial", "operator", "station")
+VALIDITY_STATES = ("green", "yellow", "red", "unknown")
+_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
 @dataclass(frozen=True)
@@ -50,28 +63,68 @@ def entry_of(record: dict) -> Entry:
                  dict(record.get("key_parameters", {})))
 
 
-def _number_or_null(value) -> bool:
-    if value is None:
-        return True
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return False
+def one_line_text(value, where: str) -> str:
+    """A string without control characters (line breaks, NUL, escapes): it is printed on one line."""
+    if not isinstance(value, str):
+        raise ArchiveError(f"{where}: found {type(value).__name__}, expected a string")
+    bad = _CONTROL.search(value)
+    if bad:
+        raise ArchiveError(f"{where}: holds the control character {bad.group()!r}: expected one line of text")
+    return value
+
+
+def iso_date(value, where: str) -> str:
+    """An ISO 8601 date (or date and time) string, its year within analysis.bounds.YEAR."""
+    text = one_line_text(value, where)
     try:
-        float(value)
-    except OverflowError:       # an integer beyond the float range
-        return False
-    return True
+        when = datetime.fromisoformat(text)
+    except ValueError:
+        raise ArchiveError(f"{where}: {text[:40]!r} is not an ISO 8601 date") from None
+    YEAR.check(when.year, where, ArchiveError)
+    return text
+
+
+def number_or_null(value, where: str, bound=PARAMETER) -> float | None:
+    """None, or a finite number within `bound` (as float); ArchiveError otherwise."""
+    return None if value is None else bound.check(value, where, ArchiveError)
+
+
+def checked_parameter(p, where: str) -> dict[str, Any]:
+    if not isinstance(p, dict):
+        raise ArchiveError(f"{where}: expected an object with value, std and unit")
+    return {"value": number_or_null(p.get("value"), f"{where}.value"),
+            "std": number_or_null(p.get("std"), f"{where}.std"),
+            "unit": one_line_text(p.get("unit", ""), f"{where}.unit")}
+
+
+def checked_entry(values: dict[str, Any], where: str) -> dict[str, Any]:
+    """The fields an Entry is made of, each checked (a record's or an index row's)."""
+    try:
+        check_id(values.get("id"))
+    except ArchiveError as exc:
+        raise ArchiveError(f"{where}: id: {exc}") from None
+    for key in ("folder", *TEXT_FIELDS):
+        one_line_text(values.get(key), f"{where}: {key}")
+    for key in ("measured_at", "stored_at"):
+        iso_date(values.get(key), f"{where}: {key}")
+    if values.get("validity") not in VALIDITY_STATES:
+        raise ArchiveError(f"{where}: validity: found {str(values.get('validity'))[:20]!r}, expected one of "
+                           f"{', '.join(VALIDITY_STATES)}")
+    effects = values.get("effects", [])
+    if not isinstance(effects, (list, tuple)):
+        raise ArchiveError(f"{where}: effects: expected a list of effect ids (strings)")
+    for i, e in enumerate(effects):
+        one_line_text(e, f"{where}: effects[{i}]")
+    return values
 
 
 def read_record(folder: Path) -> dict:
     """The checked measurement.json of a folder; ArchiveError naming the file and key otherwise."""
     path = folder / RECORD_FILE
+    text = read_text(path, "archive", "a measurement record (JSON)", ArchiveError)
     try:
-        if path.exists() and not path.is_file():    # a FIFO or a device would block the read forever
-            raise ArchiveError(f"{path}: not a regular file")
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ArchiveError(f"{path}: missing") from None
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        doc = json.loads(text)
+    except ValueError as exc:       # not JSON, or an integer of more digits than Python converts
         raise ArchiveError(f"{path}: not readable JSON ({exc})") from None
     except RecursionError:
         raise ArchiveError(f"{path}: not readable JSON (nested too deeply)") from None
@@ -81,25 +134,21 @@ def read_record(folder: Path) -> dict:
         raise ArchiveError(f"{path}: a string holds half of a UTF-16 surrogate pair, expected Unicode text") from None
     if not isinstance(doc, dict) or doc.get("format") != RECORD_FORMAT:
         raise ArchiveError(f"{path}: format: expected {RECORD_FORMAT!r}")
-    for key in ("id", "folder", "measured_at", "stored_at", "validity", *TEXT_FIELDS):
-        if not isinstance(doc.get(key), str):
-            raise ArchiveError(f"{path}: {key}: expected a string")
-    try:
-        check_id(doc["id"])
-    except ArchiveError as exc:
-        raise ArchiveError(f"{path}: id: {exc}") from None
+    checked_entry(doc, str(path))
     if doc["folder"] != folder.name:
         raise ArchiveError(f"{path}: folder: {doc['folder']!r} but the file is in {folder.name!r}")
+    if "notes" in doc:
+        one_line_text(doc["notes"], f"{path}: notes")
     params = doc.get("key_parameters", {})
-    if not isinstance(params, dict) or not all(isinstance(p, dict) for p in params.values()):
+    if not isinstance(params, dict):
         raise ArchiveError(f"{path}: key_parameters: expected an object of objects")
-    for name, p in params.items():
-        for key in ("value", "std"):
-            if not _number_or_null(p.get(key)):
-                raise ArchiveError(f"{path}: key_parameters.{name}.{key}: expected a number or null")
-    if not isinstance(doc.get("files", {}), dict):
+    doc["key_parameters"] = {one_line_text(name, f"{path}: key_parameters"):
+                             checked_parameter(p, f"{path}: key_parameters.{name}") for name, p in params.items()}
+    files = doc.get("files", {})
+    if not isinstance(files, dict):
         raise ArchiveError(f"{path}: files: expected an object")
-    effects = doc.get("effects", [])
-    if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
-        raise ArchiveError(f"{path}: effects: expected a list of effect ids (strings)")
+    for role, name in files.items():
+        one_line_text(role, f"{path}: files")
+        one_line_text(name, f"{path}: files.{role}")
+    doc["sd_m2"] = number_or_null(doc.get("sd_m2"), f"{path}: sd_m2", SD)
     return doc

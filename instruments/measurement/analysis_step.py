@@ -26,7 +26,7 @@ import numpy as np
 from analysis.effects import Effect, Site
 from analysis.fit import FitData, fit_model, start_values
 from analysis.model import Model
-from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra
+from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra, naming_the_file
 from analysis.recording import Recording
 from analysis.spectra import Spectra, estimate_spectra
 
@@ -83,5 +83,6 @@ def analyse_measurement(recording: Recording, sd_m2: float | None = None, effect
     max_hz = displacement_max_hz(recording)
     if max_hz is None:
         return analyze_recording(recording, sd_m2, effects, cancel)
-    spectra = measured_lines_only(estimate_spectra(recording), max_hz)
+    with naming_the_file(recording):
+        spectra = measured_lines_only(estimate_spectra(recording), max_hz)
     return analyze_spectra(recording, spectra, sd_m2, effects, cancel, start_of=delay_start)
