@@ -54,8 +54,9 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_rig
     cli_rig.add_commands(sub)
 
-    from app import cli_measure
+    from app import cli_measure, cli_recover
     cli_measure.add_commands(sub)
+    cli_recover.add_commands(sub)
 
     from app import cli_archive, cli_report
     cli_archive.add_commands(sub)
@@ -104,6 +105,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "measure":
         from app import cli_measure
         return cli_measure.run(args)
+    if args.command == "recover":
+        from app import cli_recover
+        return cli_recover.run(args)
     if args.command == "gui":
         from app.main import run_gui
         return run_gui(args.path)

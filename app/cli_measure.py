@@ -37,11 +37,13 @@ import argparse
 import dataclasses
 import json
 import shlex
+import signal
 import sys
 import threading
-from contextlib import ExitStack
+from contextlib import ExitStack, contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
+from typing import Iterator
 
 from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS, SAMPLE_RATE, SD
 from analysis.errors import is_user_error, user_message
@@ -51,7 +53,7 @@ from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
 LASER_ANALOG, LASER_NONE = "analog", "none"
-EXIT_NOT_STORED = 3
+EXIT_NOT_STORED, EXIT_INTERRUPTED = 3, 130
 
 
 def add_commands(sub) -> None:
@@ -92,10 +94,12 @@ def run(args: argparse.Namespace) -> int:
     from app.cli_commands import _effects, format_result
     from analysis.pipeline import result_json
     from instruments.measurement.recovery import find_unfinished, run_journaled
+    from instruments.measurement.runner import MeasurementCancelled
 
     effects = _effects(args.model) if args.model else None
     for unfinished in find_unfinished(args.out):
-        _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal}")
+        _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
+             f"('linpar recover {args.out}' keeps, analyses or discards it)")
     # The plan first: a plan that cannot work must not start a rig.
     plan = MeasurementPlan.from_template(args.template, level_v_rms=args.level, n_periods=args.periods,
                                          period_samples=args.period, on_xrun=args.on_xrun)
@@ -104,17 +108,26 @@ def run(args: argparse.Namespace) -> int:
         if args.sd is not None:
             driver = {**driver, "sd_m2": args.sd}
         plan = dataclasses.replace(plan, driver={k: v for k, v in driver.items() if v is not None})
-        cancel = threading.Event()
+        cancel = _Cancel()
         _say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
              f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"
              f" of sound) on {audio.describe()}" + (f", laser {laser!r}" if laser is not None else ""))
         try:
-            outcome = run_journaled(plan, audio, _laser_sensor(laser), args.out, name=args.name,
-                                      cancel=cancel, progress=_Progress(), effects=effects)
+            with _ctrl_c_cancels(cancel):
+                outcome = run_journaled(plan, audio, _laser_sensor(laser), args.out, name=args.name,
+                                        cancel=cancel, progress=_Progress(), effects=effects)
             # The recording carries no date, and a store later would be dated then (--measured-at).
             measured_at = datetime.now(timezone.utc).isoformat(timespec="seconds")
-        except KeyboardInterrupt:
+        except MeasurementCancelled as exc:
+            if not cancel.interrupted:
+                raise
+            # Ctrl-C: what was captured is written (marked partial), as when a device fails.
+            print(f"linpar: interrupted: {exc}", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        except KeyboardInterrupt:       # a second Ctrl-C: the journal keeps what was measured
             cancel.set()
+            _say(f"interrupted twice: what was measured is in the journal in {args.out}; 'linpar recover "
+                 f"{args.out}' makes it a recording")
             raise
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
@@ -129,6 +142,33 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(format_result(result))
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
+
+
+class _Cancel(threading.Event):
+    """The measurement's cancel event, which knows whether Ctrl-C set it."""
+
+    interrupted = False
+
+
+@contextmanager
+def _ctrl_c_cancels(cancel: _Cancel) -> Iterator[None]:
+    """The first Ctrl-C cancels the measurement (its periods are written, marked partial); a second one
+    interrupts at once (the journal keeps the data). Only in the main thread, where signals arrive."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_sigint(signum, frame):
+        if cancel.is_set():
+            raise KeyboardInterrupt
+        cancel.interrupted = True
+        cancel.set()
+        _say("Ctrl-C: stopping; the periods measured so far are written (Ctrl-C again to stop at once)")
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at: str) -> dict:

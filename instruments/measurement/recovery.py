@@ -39,12 +39,12 @@ from analysis.errors import LinparError
 from instruments.measurement.plan import MeasurementPlan
 from instruments.measurement.recovery_journal import (FADE_S, FORMAT, FSYNC_EVERY_S, QUEUE_ITEMS, SUFFIX, Journal,
                                                       journal_path, recording_written)
-from instruments.measurement.recovery_replay import (CLIP_LEVEL, Unfinished, discard, find_unfinished, inspect,
-                                                     recover)
+from instruments.measurement.recovery_replay import (CLIP_LEVEL, RecoveryError, Unfinished, discard, find_unfinished,
+                                                     inspect, recover)
 from instruments.measurement.runner import MeasurementError, MeasurementOutcome, run_measurement
 
 __all__ = ["CLIP_LEVEL", "FADE_S", "FORMAT", "FSYNC_EVERY_S", "QUEUE_ITEMS", "SUFFIX", "Journal", "JournalKept",
-           "Unfinished", "default_name", "discard", "find_unfinished", "inspect", "journal_path", "recover",
+           "RecoveryError", "Unfinished", "default_name", "discard", "find_unfinished", "inspect", "journal_path", "recover",
            "run_journaled"]
 
 

@@ -22,11 +22,16 @@ from instruments.audio.config import Calibration, ChannelMap
 from instruments.audio.periods import PeriodCollector
 from instruments.audio.stream_core import XRUN_FLAGS, InputBlock
 from instruments.laser.sensor import LaserBlock
+from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import MeasurementPlan
 from instruments.measurement.recovery_journal import (FADE_S, FORMAT, INDEX_RECORD, LASER_COLUMNS, LASER_HEAD,
                                                       SUFFIX, in_use, now_utc, recording_written)
 
 CLIP_LEVEL = 0.999           # as instruments.audio.capture
+
+
+class RecoveryError(MeasurementError):
+    """A journal that cannot be turned into a recording (still running, too short, unreadable); one line."""
 
 
 @dataclass(frozen=True)
@@ -80,19 +85,25 @@ def inspect(journal: Path) -> Unfinished:
 
 
 def recover(unfinished: Unfinished) -> Path:
-    """Write the journal's whole periods as a recording (partial, "ended_by": "crash"); its .wav. The journal goes."""
+    """Write the journal's whole periods as a recording (partial, "ended_by": "crash"); its .wav. The journal goes.
+
+    RecoveryError (one line) when it cannot be: still running, too short, or a journal that cannot be read.
+    """
     journal = unfinished.journal
     if in_use(journal):
-        raise ValueError(f"{journal}: the measurement is still running")
-    meta = _meta(journal)
-    stem = journal.parent / meta["name"]
-    if recording_written(stem):
-        shutil.rmtree(journal)
-        return stem.with_name(stem.name + ".wav")
-    replay = _replay(journal, meta)
-    recording, laser_info, blocks, starts = _recording_of(replay, meta)
+        raise RecoveryError(f"{journal}: the measurement is still running")
+    try:        # the journal is a file like any other: what it holds is read here, once
+        meta = _meta(journal)
+        stem = journal.parent / meta["name"]
+        if recording_written(stem):
+            shutil.rmtree(journal)
+            return stem.with_name(stem.name + ".wav")
+        replay = _replay(journal, meta)
+        recording, laser_info, blocks, starts = _recording_of(replay, meta)
+    except (ValueError, KeyError, TypeError) as exc:
+        raise RecoveryError(f"{journal}: the journal cannot be read ({type(exc).__name__}: {exc})") from None
     if recording is None:
-        raise ValueError(f"{journal}: {inspect(journal).problem or 'nothing to recover'}")
+        raise RecoveryError(f"{journal}: {inspect(journal).problem or 'nothing to recover'}")
     stem = _free_stem(stem)
     if laser_info is not None:
         from instruments.measurement.raw_stream import raw_capture_path, write_raw_capture
@@ -106,7 +117,7 @@ def recover(unfinished: Unfinished) -> Path:
 
 def discard(unfinished: Unfinished) -> None:
     if in_use(unfinished.journal):
-        raise ValueError(f"{unfinished.journal}: the measurement is still running")
+        raise RecoveryError(f"{unfinished.journal}: the measurement is still running")
     shutil.rmtree(unfinished.journal)
 
 

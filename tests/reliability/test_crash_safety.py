@@ -27,7 +27,7 @@ from analysis.archive.results import results_document
 from analysis.pipeline import analyze_recording
 from analysis.recording import read_recording, write_recording
 from instruments.measurement.analysis_step import analyse_measurement
-from instruments.measurement.recovery import discard, find_unfinished, inspect, recover
+from instruments.measurement.recovery import RecoveryError, discard, find_unfinished, inspect, recover
 from instruments.measurement.runner import default_effects
 from tests.builders import PAPER, REPO_ROOT, TYPICAL_NOISE, recording
 
@@ -90,7 +90,7 @@ def test_a_journal_killed_before_two_periods_says_so_and_can_be_discarded(tmp_pa
     (unfinished,) = find_unfinished(tmp_path)
     if unfinished.periods < 2:
         assert "too few" in unfinished.problem
-        with pytest.raises(ValueError, match="too few"):
+        with pytest.raises(RecoveryError, match="too few"):
             recover(unfinished)
     discard(unfinished)
     assert not journal.exists() and find_unfinished(tmp_path) == [] and list(tmp_path.iterdir()) == []
