@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import re
 
+from analysis.bounds import LASER_RANGE_M
 from instruments.laser.frames import Reply, value_slots
 from instruments.laser.sensor import LaserError, SensorInfo
 
@@ -104,10 +105,13 @@ def parse_info(reply: Reply) -> SensorInfo:
     match = re.search(r"(\d+(?:\.\d+)?)", range_text) or re.search(r"-(\d+)\b", name)
     if not match:
         raise LaserError(f"cannot tell the measuring range of {name!r} from GETINFO")
+    # A range of 0 would divide every distance by zero; the reply is checked against its bound where it enters.
+    measuring_range = LASER_RANGE_M.check(float(match.group(1)) / 1000.0, f"GETINFO of {name!r}: measuring range",
+                                          LaserError)
     return SensorInfo(
         name=name,
         serial=fields.get("serial", fields.get("serial number", "")),
-        measuring_range_m=float(match.group(1)) / 1000.0,
+        measuring_range_m=measuring_range,
         firmware=fields.get("version", fields.get("firmware", "")),
         text=reply.text,
     )

@@ -22,6 +22,7 @@ import math
 from dataclasses import asdict, dataclass, field, is_dataclass, replace
 from typing import Any, Mapping
 
+from analysis.bounds import FREQUENCY, LEVEL_V_RMS, PERIODS
 from analysis.errors import LinparError
 
 SETTLE_SAMPLES = 65536 + 8192
@@ -83,8 +84,12 @@ class MeasurementPlan:
             raise PlanError(f"period_samples must be a power of two >= 1024, got {p!r}")
         if not self.level_v_rms > 0:
             raise PlanError(f"the level must be > 0 V RMS, got {self.level_v_rms!r}")
+        LEVEL_V_RMS.check(self.level_v_rms, "the level", PlanError)       # inf, 1e6 V: refused here too
         if not (isinstance(self.n_periods, int) and self.n_periods >= 2):
             raise PlanError(f"at least 2 periods are needed to estimate the noise, got {self.n_periods!r}")
+        PERIODS.check(self.n_periods, "the periods averaged", PlanError)
+        for name in ("f_min_hz", "f_max_hz"):
+            FREQUENCY.check(getattr(self, name), name, PlanError)
         if self.settle_periods is not None and self.settle_periods < 0:
             raise PlanError(f"settle_periods must be >= 0, got {self.settle_periods!r}")
         if not 0 < self.f_min_hz < self.f_max_hz:
