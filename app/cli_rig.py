@@ -83,6 +83,13 @@ def _start(args) -> int:
         # The nonlinear driver takes its small-signal model from the driver file's values.
         from app.cli import CliError
         raise CliError(f"--effects applies to the linear model only, not to --model {args.model}")
+    # A driver file or a spec that cannot be used is one line here, not a rig process that dies starting.
+    from analysis.drivers import load_driver
+    from instruments.rig.engine import RigFaults, RigNoise
+    load_driver(args.driver)
+    RigFaults.parse(args.fault)
+    if args.noise:
+        RigNoise.parse(args.noise)
     handle = _manager().start_rig(args.name, args.driver, args.effects, args.fault, args.noise, args.runtime_dir,
                                   model=args.model)
     if args.json:

@@ -22,6 +22,7 @@ from typing import Callable, Iterable
 
 import numpy as np
 
+from analysis.errors import LinparError
 from instruments.audio.config import Calibration, ChannelMap
 from instruments.simulation.block_driver import BlockDriver
 
@@ -38,6 +39,10 @@ SIGNALS = ("voltage", "current", "displacement")
 DisplacementSink = Callable[[np.ndarray, int], None]
 
 
+class RigSpecError(LinparError, ValueError):
+    """A --noise or --fault specification of the rig that cannot be used; one line."""
+
+
 @dataclass(frozen=True, slots=True)
 class RigNoise:
     """RMS of the white noise on each sensor, in V, A and m (about -105 dB of full scale by default)."""
@@ -50,7 +55,7 @@ class RigNoise:
         for name in SIGNALS:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-                raise ValueError(f"noise.{name} must be a number >= 0, got {value!r}")
+                raise RigSpecError(f"noise.{name} must be a number >= 0, got {value!r}")
 
     @classmethod
     def parse(cls, text: str) -> RigNoise:
@@ -58,7 +63,7 @@ class RigNoise:
         values = _key_values(text, "noise")
         unknown = sorted(set(values) - set(SIGNALS))
         if unknown:
-            raise ValueError(f"noise: unknown channel(s) {', '.join(unknown)}; known: {', '.join(SIGNALS)}")
+            raise RigSpecError(f"noise: unknown channel(s) {', '.join(unknown)}; known: {', '.join(SIGNALS)}")
         return cls(**{k: _number(v, f"noise.{k}") for k, v in values.items()})
 
 
@@ -79,11 +84,11 @@ class RigFaults:
         object.__setattr__(self, "disconnected", frozenset(self.disconnected))
         unknown = sorted(self.disconnected - set(SIGNALS))
         if unknown:
-            raise ValueError(f"fault: cannot disconnect {', '.join(unknown)}; signals: {', '.join(SIGNALS)}")
+            raise RigSpecError(f"fault: cannot disconnect {', '.join(unknown)}; signals: {', '.join(SIGNALS)}")
         if self.amp_clip_volts is not None and not self.amp_clip_volts > 0:
-            raise ValueError(f"fault: the clipping level must be > 0 V, got {self.amp_clip_volts}")
+            raise RigSpecError(f"fault: the clipping level must be > 0 V, got {self.amp_clip_volts}")
         if not self.noise_factor >= 0:
-            raise ValueError(f"fault: the noise factor must be >= 0, got {self.noise_factor}")
+            raise RigSpecError(f"fault: the noise factor must be >= 0, got {self.noise_factor}")
 
     @classmethod
     def parse(cls, texts: Iterable[str]) -> RigFaults:
@@ -103,7 +108,7 @@ class RigFaults:
             return replace(self, amp_clip_volts=_number(value, "clip"))
         if key == "noise":
             return replace(self, noise_factor=_number(value, "noise"))
-        raise ValueError(f"unknown fault {key!r}; known: disconnect=SIGNAL, clip=VOLTS, noise=FACTOR")
+        raise RigSpecError(f"unknown fault {key!r}; known: disconnect=SIGNAL, clip=VOLTS, noise=FACTOR")
 
     def describe(self) -> list[str]:
         out = [f"disconnect={name}" for name in sorted(self.disconnected)]
@@ -201,7 +206,7 @@ def default_driver(name_or_path: str = "paper", sample_rate: int = 48000, effect
     values = dict(definition.parameters)
     missing = [p.name for p in model.param_specs if p.name not in values]
     if missing:
-        raise ValueError(f"driver {definition.name!r} has no value for {', '.join(missing)} "
+        raise RigSpecError(f"driver {definition.name!r} has no value for {', '.join(missing)} "
                          f"(needed by effects {effects!r})")
     return LinearBlockDriver(model, values, sample_rate), definition
 
@@ -213,7 +218,7 @@ def _key_values(text: str, what: str) -> dict[str, str]:
             continue
         key, sep, value = item.partition("=")
         if not sep:
-            raise ValueError(f"{what}: expected KEY=VALUE, got {item!r}")
+            raise RigSpecError(f"{what}: expected KEY=VALUE, got {item!r}")
         out[key.strip()] = value.strip()
     return out
 
@@ -222,7 +227,7 @@ def _number(text: str, what: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"{what}: expected a number, got {text!r}") from None
+        raise RigSpecError(f"{what}: expected a number, got {text!r}") from None
     if not math.isfinite(value):
-        raise ValueError(f"{what}: expected a finite number, got {text!r}")
+        raise RigSpecError(f"{what}: expected a finite number, got {text!r}")
     return value
