@@ -130,6 +130,7 @@ BOUNDS = (SAMPLE_RATE, PERIOD_SAMPLES, SD, FREQUENCY, IMPEDANCE, HX, PHASE_DEG, 
 # --- file sizes ------------------------------------------------------------------------------------------------
 
 KiB, MiB, GiB = 1024, 1024**2, 1024**3
+MAX_SIZE_LIMIT = 1024 * GiB         # no file linpar reads is a terabyte; beyond, reads overflow their counts
 
 
 @dataclass(frozen=True)
@@ -179,8 +180,8 @@ def parse_size_limit(text: str) -> tuple[str, int]:
         raise BoundsError(f"--size-limit: found {text!r}, expected KIND=SIZE with KIND one of "
                           f"{', '.join(SIZE_KINDS)} and SIZE like 500M or 4G")
     value = int(float(match.group(1)) * _FACTOR[match.group(2).lower()])
-    if value < 1:
-        raise BoundsError(f"--size-limit: {text!r} is no size: expected at least 1 byte")
+    if not 1 <= value <= MAX_SIZE_LIMIT:
+        raise BoundsError(f"--size-limit: {text!r}: expected a size from 1 byte to {describe_size(MAX_SIZE_LIMIT)}")
     return kind.replace("-", "_"), value
 
 

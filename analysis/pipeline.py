@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterator, Sequence
 
+import numpy as np
+
 from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
@@ -28,6 +30,10 @@ from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.startvalues import StartValueError
 from analysis.validity import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity_fit import FitChannels, fit_channels, misfit_findings
+
+
+# Displacement lines below which Hx carries too little to fit Bl (and a delay) from.
+MIN_X_LINES = 3
 
 
 class NotAnalysable(LinparError):
@@ -123,7 +129,14 @@ def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChanne
     capture = checked_capture(recording)      # a sidecar that cannot be judged is refused at once
     validity = assess(recording, spectra, capture)
     usable = fit_channels(validity)
-    if usable.displacement is not None and spectra.displacement is not None:
+    x = spectra.displacement
+    if usable.displacement is None and x is not None and usable.impedance is None:
+        lines = int(np.sum(np.isfinite(x.value) & (x.freqs > 0)))
+        if lines < MIN_X_LINES:     # e.g. a displacement_max_hz below the excitation: Bl from nothing
+            usable = dataclasses.replace(usable, displacement=(
+                f"the displacement cannot be used: {lines} of its lines lie in the laser's band (at least "
+                f"{MIN_X_LINES} are needed for Bl); check the sidecar's displacement_max_hz and the laser's rate"))
+    if usable.displacement is not None and x is not None:
         spectra = dataclasses.replace(spectra, displacement=None)
     return validity, usable, spectra
 

@@ -19,6 +19,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from analysis.bounds import FREQUENCY, SD
 from analysis.derived import ParameterValue
 from analysis.errors import LinparError
 
@@ -189,9 +190,11 @@ class StoredResult:
                                               None if reason is None else str(reason), bool(p.get("fitted", False)))
         model = _get(doc, "model", dict, "")
         effects = tuple(str(e) for e in _get(model, "effects", list, "model."))
-        values = {k: _number(v, f"model.values.{k}") for k, v in _get(model, "values", dict, "model.").items()
-                  if v is not None}
-        values = {k: math.nan if v is None else v for k, v in values.items()}   # non-finite, as float() read it
+        values = {}
+        for k, v in _get(model, "values", dict, "model.").items():
+            values[k] = _number(v, f"model.values.{k}")
+            if values[k] is None:       # the model's curves are drawn from these: each must be a number
+                raise ResultsFormatError(f"model.values.{k}: found {v!r}, expected a finite number")
         curves = {}
         for name, c in _get(doc, "curves", dict, "").items():
             if name not in CHANNELS:
@@ -201,13 +204,17 @@ class StoredResult:
                    for k in ("freqs_hz", "measured_re", "measured_im", "std", "model_re", "model_im")}
             if len({len(a) for a in arr.values()}) != 1:
                 raise ResultsFormatError(f"{where}: the lists differ in length")
+            bad = np.flatnonzero(~((arr["freqs_hz"] >= FREQUENCY.low) & (arr["freqs_hz"] <= FREQUENCY.high)))
+            if bad.size:
+                raise ResultsFormatError(f"{where}freqs_hz[{bad[0]}]: found {arr['freqs_hz'][bad[0]]!r}, "
+                                         f"expected {FREQUENCY.expected()}")
             curves[name] = Curve(name, str(c.get("unit", "")), arr["freqs_hz"],
                                  arr["measured_re"] + 1j * arr["measured_im"], arr["std"],
                                  arr["model_re"] + 1j * arr["model_im"], bool(c.get("has_phase", True)))
         sd = doc.get("sd_m2")
         return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
                    dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
-                   _number(sd, "sd_m2") if type(sd) in (int, float) else None, _object(doc, "settings", ""),
+                   None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
                    curves)
 
     def model(self):

@@ -98,6 +98,8 @@ def draw_hx(result: StoredResult, ax_mag, ax_phase) -> None:
     ax_phase.set_ylabel("phase of Hx [°] (unwrapped)")
     both = np.concatenate([model_phase, measured_phase if c.has_phase else model_phase])
     both = both[np.isfinite(both)]
+    if both.size == 0:          # nothing finite to draw (a damaged stored result): a plain axis
+        both = np.array([-180.0, 0.0])
     lo = 90 * np.floor(both.min() / 90 - 0.1)
     hi = 90 * np.ceil(both.max() / 90 + 0.1)
     ax_phase.set_ylim(lo, hi)
