@@ -110,6 +110,29 @@ def mapped(path: str | Path, kind: str, what: str, error: type[LinparError]) -> 
             pass
 
 
+class OutputError(LinparError, OSError):
+    """An output that would replace something that is not a regular file (a FIFO, a device, a folder)."""
+
+
+def check_output(path: str | Path) -> None:
+    """OutputError unless writing `path` (by renaming a new file onto it) replaces at most a regular file.
+
+    An atomic write renames its temporary file over the target: onto /dev/null or a FIFO that would put a
+    regular file in place of the device or the pipe. A symlink to a regular file is replaced by the file.
+    """
+    path = Path(path)
+    if not os.path.lexists(path):
+        return
+    try:
+        mode = os.stat(path).st_mode
+    except OSError as exc:         # a dangling or looping link
+        raise OutputError(f"{path}: cannot be written ({exc.strerror or exc}): choose another name") from None
+    other = _what_it_is(mode)
+    if other is not None:
+        raise OutputError(f"{path}: {other}, not a regular file: an output replaces only a regular file; "
+                          f"choose another name")
+
+
 def is_regular(path: str | Path) -> bool:
     """True for an existing regular file (after symlinks), without reading it."""
     try:

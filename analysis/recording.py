@@ -28,7 +28,7 @@ import numpy as np
 
 # The sidecar's vocabulary (FORMAT, UNITS, Channel, RecordingError) is defined there and importable from here.
 from analysis.bounds import CHANNEL_SCALE, PERIOD_SAMPLES, SAMPLE_RATE, SD
-from analysis.files import mapped, regular_file
+from analysis.files import check_output, mapped, regular_file
 from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
                                         RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
                                         show, sidecar_of, unit_wanted)
@@ -345,7 +345,8 @@ def _checked_mapping(mapping, reserved, label: str, prefix: str, whole_key: str 
 # --- files and small helpers -------------------------------------------------
 
 def _write_atomic(path: Path, payload: bytes) -> None:
-    """Write to a temporary file in the same folder, then rename over `path`."""
+    """Write to a temporary file in the same folder, then rename over `path` (never over a FIFO or device)."""
+    check_output(path)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:

@@ -72,11 +72,28 @@ def load_source(args):
     return m.result(), header, m.load_json("settings"), m.load_json("calibration")
 
 
+def _outputs_spare_the_inputs(args, outputs) -> None:
+    """CliError when an output file is one of the command's inputs (the recording, the limits, each other)."""
+    from analysis.recording import recording_paths
+    from app.cli import CliError
+    inputs = [*recording_paths(args.source), *([Path(args.limits)] if getattr(args, "limits", None) else [])]
+    seen = []
+    for option, path in outputs:
+        path = Path(path)
+        for other in [*inputs, *seen]:
+            if path.resolve() == Path(other).resolve() or (path.exists() and Path(other).exists()
+                                                           and path.samefile(other)):
+                raise CliError(f"{option} {path}: that file is an input of this command (or another output): "
+                               f"choose another name, nothing was written")
+        seen.append(path)
+
+
 def run(args: argparse.Namespace) -> int:
     from app.cli import CliError
     if args.command == "report":
         if not args.pdf and not args.html:
             raise CliError("report: give --pdf FILE and/or --html FILE")
+        _outputs_spare_the_inputs(args, [(o, p) for o, p in (("--pdf", args.pdf), ("--html", args.html)) if p])
         from analysis.limits import load_limits
         from analysis.report import build_report, write_report
         limits = load_limits(args.limits) if args.limits else None    # a bad file fails before the analysis
@@ -90,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
         if not targets:
             raise CliError("export: give at least one of " + ", ".join(
                 f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
+        _outputs_spare_the_inputs(args, [(f"--{k.replace('_', '-')}", p) for k, p in targets.items()])
         from analysis.export import write_exports
         stored, header, _, _ = load_source(args)
         written = write_exports(stored, targets, header)

@@ -193,3 +193,26 @@ def test_an_analysis_error_names_the_file(capsys, tmp_path):
     code, _, err = run(capsys, "stats", tmp_path / "three-lines")
     line = error_line(err)
     assert code == 2 and "three-lines.wav" in line and "impedance lines" in line
+
+
+@pytest.mark.parametrize("command", [["report", "REC", "--html", "OUT"], ["export", "REC", "--csv", "OUT"]])
+@pytest.mark.parametrize("kind", ["fifo", "device", "input"])
+def test_an_output_never_replaces_a_fifo_a_device_or_an_input(capsys, rec, tmp_path, command, kind):
+    work = tmp_path / "rec"
+    for suffix in (".wav", ".json"):
+        work.with_suffix(suffix).write_bytes(rec.with_suffix(suffix).read_bytes())
+    before = work.with_suffix(".wav").read_bytes()
+    if kind == "fifo":
+        out = tmp_path / "out"
+        os.mkfifo(out)
+    elif kind == "device":
+        out = tmp_path / "null"
+        out.symlink_to("/dev/null")           # as root, a rename onto it would replace the device
+    else:
+        out = work.with_suffix(".wav")
+    argv = [str(work) if a == "REC" else str(out) if a == "OUT" else a for a in command]
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and "choose another name" in error_line(err)
+    assert work.with_suffix(".wav").read_bytes() == before
+    if kind == "fifo":
+        assert os.path.exists(out) and not out.is_file()          # still the FIFO

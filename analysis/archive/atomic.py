@@ -5,6 +5,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from analysis.files import check_output
+
 # Read once (os.umask can only be read by setting it): new files get the
 # mode an ordinary open() would give them, not mkstemp's private 0600.
 _UMASK = os.umask(0o022)
@@ -16,6 +18,7 @@ DIR_MODE = 0o777 & ~_UMASK
 def write_atomic(path: str | Path, payload: bytes | str) -> Path:
     """Write to a temporary file in the same folder, flush it to disk, then rename it over `path`."""
     path = Path(path)
+    check_output(path)          # a FIFO or a device is never replaced by a file
     data = payload.encode("utf-8") if isinstance(payload, str) else payload
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:

@@ -201,7 +201,11 @@ def test_file_names_in_measurement_json_never_lead_outside_the_folder(tmp_path, 
     record["files"] = {role: evil for role in ("recording", "sidecar", "results", "settings", "calibration",
                                                 "laser_stream")}
     (folder / RECORD_FILE).write_text(json.dumps(record))
-    m = Archive(root).get(mid)
+    try:
+        m = Archive(root).get(mid)
+    except ArchiveError as exc:     # a name with a control character: the record is refused as it is read
+        assert "\n" not in str(exc) and "control character" in str(exc)
+        return
     for role in record["files"]:
         try:
             path = m.path(role)
