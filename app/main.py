@@ -35,6 +35,18 @@ def _exit_after_s() -> float | None:
     return max(seconds, 0.0)
 
 
+def _report_uncaught(window):
+    """sys.excepthook for the GUI: a bug in a slot is one message with its crash report, not a traceback on a
+    terminal the user may not see (the jobs' own errors go through app.job_book.failure_text)."""
+    def hook(kind, exc, tb):
+        if issubclass(kind, KeyboardInterrupt):
+            sys.__excepthook__(kind, exc, tb)
+            return
+        from app.job_book import failure_text
+        window.show_error("Internal error", failure_text(exc.with_traceback(tb), "working in the window"))
+    return hook
+
+
 def run_gui(path: str | None = None) -> int:
     if _no_display():
         print("linpar: error: no display (DISPLAY and WAYLAND_DISPLAY are unset); set DISPLAY, or "
@@ -55,6 +67,7 @@ def run_gui(path: str | None = None) -> int:
     QApplication.setApplicationName(APPLICATION)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     window = MainWindow()
+    sys.excepthook = _report_uncaught(window)
     window.show()
     QTimer.singleShot(0, window.offer_unfinished)     # measurements a crash cut short: keep, analyse, discard
     if path:

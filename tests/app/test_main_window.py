@@ -175,3 +175,14 @@ def test_dropping_something_else_is_refused(window, tmp_path):
 def test_file_menu_has_open_and_quit_shortcuts(window):
     assert window.open_action.shortcut().toString() == "Ctrl+O"
     assert window.quit_action.shortcut().toString() == "Ctrl+Q"
+
+
+def test_a_bug_in_a_slot_is_a_message_with_its_crash_report(window, dialogs):
+    from app.main import _report_uncaught
+    try:
+        1 / 0
+    except ZeroDivisionError as exc:
+        _report_uncaught(window)(type(exc), exc, exc.__traceback__)
+    (kind, title, text), = dialogs
+    assert title == "Internal error" and "internal error while working in the window: ZeroDivisionError" in text
+    assert "ZeroDivisionError" in Path(text.rsplit("(details in ", 1)[1].rstrip(")")).read_text(encoding="utf-8")
