@@ -147,3 +147,13 @@ def test_a_sample_rate_of_4_29_ghz_is_refused(capsys, recordings, tmp_path):
     assert code == 2
     assert "sample rate: found 4294967295, expected a sample rate: a whole number from 1000 to 1e+06 Hz" in \
         one_line(err)
+
+
+def test_frequencies_near_1e308_in_an_imported_curve_are_refused(capsys, tmp_path):
+    """They overflowed (2 pi f is infinite) into an OverflowError traceback."""
+    path = tmp_path / "huge.zma"
+    path.write_text("10 5 0\n20 6 10\n1e300 7 20\n1e307 8 30\n1.7e308 9 40\n1.79e308 9 40\n")
+    code, out, err = run(capsys, "analyze", "--impedance", path, "--json")
+    assert code == 2 and out == ""
+    assert "huge.zma: line 3: frequency 1e+300: expected a frequency: a number from 0.01 to 1e+06 Hz" in \
+        one_line(err)
