@@ -12,6 +12,7 @@ verdict: `linpar analyze --limits` is the command whose exit code is the verdict
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 from analysis.bounds import SD
@@ -81,11 +82,18 @@ def _outputs_spare_the_inputs(args, outputs) -> None:
     for option, path in outputs:
         path = Path(path)
         for other in [*inputs, *seen]:
-            if path.resolve() == Path(other).resolve() or (path.exists() and Path(other).exists()
-                                                           and path.samefile(other)):
+            # realpath, not resolve(): a symlink loop is a bad input to report, not a RuntimeError
+            if os.path.realpath(path) == os.path.realpath(other) or _same_file(path, other):
                 raise CliError(f"{option} {path}: that file is an input of this command (or another output): "
                                f"choose another name, nothing was written")
         seen.append(path)
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:         # one of them does not exist (yet), or cannot be reached
+        return False
 
 
 def run(args: argparse.Namespace) -> int:
