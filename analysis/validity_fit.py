@@ -27,7 +27,7 @@ from typing import Mapping
 from analysis.fit import FitResult
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity import ABSENT, Validity
-from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity
+from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
 
 # Findings after which a channel carries nothing a fit could use.
 UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)
@@ -80,6 +80,23 @@ def misfit_findings(fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS)
             f"limit: yellow from {th.misfit_yellow_chi2_red:g})", MISFIT_REMEDY,
             chi2_red if math.isfinite(chi2_red) else float("inf")))
     return found
+
+
+def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS) -> dict:
+    """A result's validity (as JSON) for another fit of the same recording: the old fit's misfit findings
+    replaced by the new one's, the lights redone (the Model lab's versions)."""
+    channels = {}
+    for name, channel in (validity.get("channels") or {}).items():
+        if channel.get("status") == ABSENT:
+            channels[name] = channel
+            continue
+        findings = [f for f in channel.get("findings") or () if f.get("code") != MODEL_MISFIT]
+        findings += [f.as_json() for f in misfit_findings(fit, th).get(name, ())]
+        channels[name] = {**channel, "findings": findings,
+                          "status": str(worst(Severity(f["severity"]) for f in findings))}
+    lights = [Severity(ch["status"]) for ch in channels.values() if ch.get("status") in set(Severity)]
+    return {**validity, "channels": channels, "overall": str(worst(lights)) if channels else
+            validity.get("overall", "unknown")}
 
 
 def qa_blocker(validity: Mapping) -> tuple[str, str] | None:

@@ -12,8 +12,8 @@ from analysis.fit import FitData, FitResult
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import judged_fit_data, resolve_sd
-from app.cli_json import dumps
 from analysis.recording import read_recording
+from app.cli_json import dumps
 
 
 def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:

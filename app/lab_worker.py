@@ -23,13 +23,14 @@ from analysis.derived import parameter_table
 from analysis.diagnosis import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
 from analysis.diagnosis_words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
+from analysis.errors import is_user_error
 from analysis.sites import SiteResult
 from analysis.fit import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
+from analysis.validity_fit import rejudged
 from app.result_curves import ResultCurves, result_curves
-from analysis.errors import is_user_error
 from app.job_book import JobBook, failure_text
 
 
@@ -51,7 +52,9 @@ class LabFit:
 
 def lab_fit(base: AnalysisResult, fit: FitResult) -> LabFit:
     """`fit` dressed for display; milliseconds, but run in the worker with the fit it follows."""
-    result = dataclasses.replace(base, fit=fit, parameters=parameter_table(fit, base.sd_m2))
+    # The validity goes with the fit: the base's misfit finding is the base model's, not this one's.
+    result = dataclasses.replace(base, fit=fit, parameters=parameter_table(fit, base.sd_m2),
+                                 validity=rejudged(base.validity, fit))
     return LabFit(result, result_curves(result), residuals.describe(fit))
 
 

@@ -129,3 +129,16 @@ def test_every_parameter_of_a_result_is_finite_or_null_with_a_reason(good):
                 variant(good, voltage=lambda d: np.zeros_like(d["voltage"]))):
         for p in analyze_recording(rec).parameters.values():
             assert (p.value is None and p.reason) or math.isfinite(p.value)
+
+
+def test_a_refit_that_fits_takes_the_misfit_finding_away(misfit):
+    """The Model lab's versions: the validity goes with the fit, not with the model first fitted."""
+    from analysis.effects import parse_effects
+    from analysis.fit import FitData, fit_model
+    from analysis.model import Model
+    from analysis.validity_fit import qa_blocker, rejudged
+    better = fit_model(FitData.from_spectra(misfit.spectra), Model(parse_effects("lr2,creep-log,delay-current")))
+    assert max(better.chi2_red_by_channel().values()) < 2
+    validity = rejudged(misfit.validity, better)
+    assert validity["overall"] == "green" and qa_blocker(validity) is None
+    assert rejudged(validity, misfit.fit)["overall"] == "yellow"          # and back
