@@ -45,6 +45,7 @@ def test_ctrl_c_during_measure_writes_the_periods_so_far(simulated_card, monkeyp
                 self.pressed = True
                 os.kill(os.getpid(), signal.SIGINT)       # as the terminal does
     monkeypatch.setattr(cli_measure, "_Progress", CtrlCAfterThreePeriods)
+    before = signal.getsignal(signal.SIGINT)      # SIG_IGN, not Python's handler, under a shell's `cmd &`
     code, out, err = run(capsys, "measure", "--out", tmp_path, "--name", "m", *SHORT)
     assert code == 130 and out == ""
     assert "Ctrl-C: stopping" in err and "linpar: interrupted: the measurement was cancelled" in err
@@ -52,7 +53,7 @@ def test_ctrl_c_during_measure_writes_the_periods_so_far(simulated_card, monkeyp
     rec = read_recording(tmp_path / "m")
     assert rec.extra["measurement"]["partial"] and 3 <= rec.n_periods < 6
     assert not list(tmp_path.glob("*.unfinished"))           # nothing left for `recover`
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert signal.getsignal(signal.SIGINT) is before          # the handler it found is back
 
 
 def test_a_second_ctrl_c_stops_at_once_and_recover_makes_the_journal_a_recording(simulated_card, monkeypatch,

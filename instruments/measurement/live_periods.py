@@ -44,7 +44,9 @@ class LivePeriods:
         self._inputs = cm.input_channels()
         has_x = displacement_of is not None or "displacement" in self._inputs
         signals = ("voltage", "current", "displacement") if has_x else ("voltage", "current")
-        self.accumulator = LiveAccumulator(timed.sample_rate, self.period, excited_bins, signals)
+        self._new_accumulator = lambda: LiveAccumulator(timed.sample_rate, self.period, excited_bins, signals)
+        self.accumulator = self._new_accumulator()
+        self.restarts = 0
         self._first_start: int | None = None
         self._pending: list[int] = []
         self._queued = 0
@@ -54,6 +56,8 @@ class LivePeriods:
 
     def on_progress(self, kept: int) -> None:
         """capture() kept ``kept`` periods so far; queue the new ones, emit what can be."""
+        if kept < self._queued:
+            self._restart()
         if not self.listeners or kept <= self._queued:
             return
         if self._first_start is None:
@@ -63,6 +67,13 @@ class LivePeriods:
             self._pending.append(self._first_start + index * self.period)
         self._queued = kept
         self.emit_ready()
+
+    def _restart(self) -> None:
+        """capture() discarded its periods after an xrun and averages again: so do the panels, from the
+        periods it keeps from now on (their places on the input grid are new)."""
+        self.restarts += 1
+        self.accumulator = self._new_accumulator()
+        self._first_start, self._pending, self._queued = None, [], 0
 
     def emit_ready(self) -> None:
         while self._pending:

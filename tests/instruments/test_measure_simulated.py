@@ -177,6 +177,25 @@ def test_with_on_xrun_restart_the_serial_laser_measurement_averages_again_after_
     assert_recovers(outcome.result)
 
 
+def test_after_an_xrun_restart_the_live_frames_average_again_from_the_new_periods(tmp_path):
+    """capture() discards its periods after an xrun and averages again; the live panels must follow (they
+    stopped at one frame: the new periods were looked for at the old periods' places)."""
+    rig = simulated(serial=False)
+    frames, injected = [], {}
+
+    def progress(p):
+        if p.periods_kept >= 2 and not injected:
+            injected["at"] = p.periods_kept
+            rig.audio.inject_xrun()
+
+    outcome = run_measurement(plan(on_xrun="restart"), rig.audio, None, tmp_path, name="m",
+                              listeners=[frames.append], progress=progress)
+    counts = [f.n_periods for f in frames]
+    assert outcome.periods == 4 and injected
+    restart = counts.index(1, 1)                  # the second time a frame rests on one period
+    assert counts[:restart] == list(range(1, restart + 1)) and counts[restart:] == [1, 2, 3, 4]
+
+
 def test_cancel_keeps_what_was_captured(tmp_path):
     rig = simulated()
     audio, laser = rig.audio, rig.laser
