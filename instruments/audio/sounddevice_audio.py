@@ -16,8 +16,12 @@ from instruments.audio.errors import AudioError
 from instruments.audio.interface import AudioDeviceInfo
 from instruments.audio.stream_core import DuplexCore, LoopedExcitation
 
-# How long stop() waits for PortAudio before it abandons the stream (see portaudio.py).
+# How long stop() waits for PortAudio before it abandons the stream (see portaudio.py): a fixed
+# allowance plus some callback blocks, since stopping and closing on JACK take effect at cycle
+# boundaries (measured on the rig: about 4 cycles, 100 ms at 1024 frames, 360 ms at 4096; 530 ms at
+# most with four CPU hogs on two cores).
 STOP_TIMEOUT_S = 0.7
+STOP_TIMEOUT_BLOCKS = 8
 
 
 def list_devices(refresh: bool = False) -> list[AudioDeviceInfo]:
@@ -65,6 +69,7 @@ class SoundDeviceAudio(CoreBackedDevice):
         self._stream = None
         self._device_info: AudioDeviceInfo | None = None
         self._finished = threading.Event()   # set by PortAudio's finished callback
+        self._callback_frames = 0            # frames per callback as PortAudio delivers them
 
     def start(self, excitation: LoopedExcitation) -> None:
         if self._stream is not None:
@@ -82,6 +87,7 @@ class SoundDeviceAudio(CoreBackedDevice):
         self._finished.clear()
 
         def callback(indata, outdata, frames, time_info, status):
+            self._callback_frames = frames
             core.process(indata, outdata, status._flags)
 
         try:
@@ -101,7 +107,7 @@ class SoundDeviceAudio(CoreBackedDevice):
         return stream is not None and not self._finished.is_set() and bool(stream.active)
 
     def stop(self) -> None:
-        """Stop and close; a PortAudio call that does not return in STOP_TIMEOUT_S is abandoned."""
+        """Stop and close; a PortAudio call that does not return in time (STOP_TIMEOUT_*) is abandoned."""
         stream, self._stream = self._stream, None
         if stream is None:
             return
@@ -116,7 +122,7 @@ class SoundDeviceAudio(CoreBackedDevice):
 
         closer = threading.Thread(target=close, name="audio-stream-close", daemon=True)
         closer.start()
-        closer.join(STOP_TIMEOUT_S)
+        closer.join(STOP_TIMEOUT_S + STOP_TIMEOUT_BLOCKS * self._callback_frames / self.sample_rate)
         if closer.is_alive():
             portaudio.mark_abandoned(f"closing the stream on {self._device_info.choice} hung")
 

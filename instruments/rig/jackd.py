@@ -20,6 +20,13 @@ from analysis.errors import LinparError
 from instruments.audio.portaudio import jack_server_alive
 
 CAPTURE_PORTS, PLAYBACK_PORTS = 4, 2
+# Frames per JACK cycle: the deadline of every client's process callback, the rig's and the
+# workstation's PortAudio stream alike. Both callbacks are Python and need the GIL; on a busy machine
+# the thread holding it may wait for a CPU while the callback waits for it (the GIL has no priority
+# inheritance). Measured with four CPU hogs on two cores and a Python-busy thread beside the
+# measurement (docs/timing.md): 1024 frames (21 ms) ended 5 of 5 measurements of 40 periods with an
+# xrun, 2048 (43 ms) and 4096 (85 ms) none and 1 of 5. 4096 leaves room for a busier machine still.
+RIG_PERIOD = 4096
 _PR_SET_PDEATHSIG = 1
 # JACK2's server registry (common/shm.h): a header of 24 bytes, then MAX_SERVERS = 8 entries of
 # {pid_t pid; char name[257]} padded to 264 bytes; the name is "jack-<uid>:<server name>:".
@@ -48,7 +55,7 @@ def _die_with_parent() -> None:   # runs in the child between fork and exec
 
 
 class JackServer:
-    def __init__(self, name: str, sample_rate: int = 48000, period: int = 1024, log: IO | None = None):
+    def __init__(self, name: str, sample_rate: int = 48000, period: int = RIG_PERIOD, log: IO | None = None):
         self.name, self.sample_rate, self.period = name, int(sample_rate), int(period)
         self._log = log
         self.process: subprocess.Popen | None = None
@@ -151,7 +158,7 @@ def reclaim_stale_slots(only: str | None = None) -> list[str]:
     for pid, name in registered_servers():
         if (only is not None and name != only) or _process_exists(pid) or jack_server_alive(name):
             continue
-        probe = subprocess.Popen([jackd_path(), "-n", name, "-d", "dummy", "-r", "48000", "-p", "1024"],
+        probe = subprocess.Popen([jackd_path(), "-n", name, "-d", "dummy", "-r", "48000", "-p", str(RIG_PERIOD)],
                                  stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                                  preexec_fn=_die_with_parent)
         deadline = time.monotonic() + 5.0

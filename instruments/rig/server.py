@@ -24,7 +24,7 @@ from typing import Any, Sequence
 from instruments.rig.control import ControlServer
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP, RigEngine, RigFaults, RigNoise, default_driver
 from instruments.rig.jack_rig import DEFAULT_CLIENT_PATTERN, PLAYED_CHANNEL, JackRig
-from instruments.rig.jackd import JackServer
+from instruments.rig.jackd import RIG_PERIOD, JackServer
 from instruments.rig.laser_feed import DisplacementFeed, RigLaser
 from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, write_atomic
 
@@ -40,14 +40,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fault", action="append", default=[],
                    help="disconnect=voltage|current|displacement, clip=VOLTS, noise=FACTOR (repeatable)")
     p.add_argument("--sample-rate", type=int, default=48000)
-    p.add_argument("--period", type=int, default=1024, help="JACK period (frames per cycle)")
+    p.add_argument("--period", type=int, default=RIG_PERIOD, help="JACK period (frames per cycle, default %(default)s)")
     p.add_argument("--runtime-dir", type=Path, help="folder holding the rig folders (default: see state.py)")
     p.add_argument("--client-pattern", default=DEFAULT_CLIENT_PATTERN,
                    help="regular expression of the JACK client names wired to the rig (default %(default)s)")
     p.add_argument("--seed", type=int, help="noise seed (default: random)")
     p.add_argument("--model", choices=("linear", "nonlinear"), default="linear",
                    help="the driver's simulation: linear FIRs, or Bl(x), Kms(x), Le(x) in the time domain "
-                        "(~2 ms of a 21 ms cycle)")
+                        "(about a tenth of a cycle)")
     p.add_argument("--no-laser", action="store_true", help="no serial laser emulator on a pty")
     p.add_argument("--laser-ppm", type=float, default=37.0, help="the serial laser's clock error (ppm)")
     p.add_argument("--laser-latency", type=float, default=0.02,
@@ -63,7 +63,7 @@ class OrderedJackRig(JackRig):
     they appear, the links rig -> workstation could be made before workstation
     -> rig. JACK makes the link that closes a loop its "feedback" link, so the
     order decides whether the rig runs before or after the workstation in a
-    cycle: one period (21 ms) of difference in when a displacement reaches the
+    cycle: one period (85 ms by default) of difference in when a displacement reaches the
     workstation, which the serial laser's time base (laser_feed.py) must know.
     Played channel first, always: the rig runs after the workstation.
     """

@@ -1,8 +1,6 @@
 """LinearBlockDriver: the FIR streaming simulator against the exact frequency-domain steady state."""
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -122,16 +120,3 @@ def test_reset_returns_to_rest_and_blocks_are_frozen(driver):
 def test_driver_block_refuses_arrays_of_different_lengths():
     with pytest.raises(ValueError, match="differ in length"):
         DriverBlock(np.zeros(3), np.zeros(3), np.zeros(4))
-
-
-def test_a_1024_sample_block_costs_well_under_its_real_time_budget(driver):
-    """The JACK callback has 21.3 ms per 1024 samples at 48 kHz; the driver must take a small share."""
-    u = np.random.default_rng(1).normal(size=1024)
-    for _ in range(20):
-        driver.process(u)
-    times = []
-    for _ in range(100):
-        t0 = time.perf_counter()
-        driver.process(u)
-        times.append(time.perf_counter() - t0)
-    assert np.median(times) < 0.25 * 1024 / FS
