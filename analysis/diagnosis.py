@@ -25,10 +25,10 @@ from typing import Callable
 
 from analysis import acceptance, residuals
 from analysis.acceptance import MIN_BIC_GAIN, Assessment, Flag
-from analysis.effects import CATALOGUE, Effect
+from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
-from analysis.model import Model
+from analysis.model import Model, ModelError
 from analysis.sites import SiteResult, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
@@ -105,19 +105,28 @@ class Diagnosis:
         return _model_flags(last.chosen.fit) if last.chosen is not None else last.flags
 
 
-def candidate_models(model: Model) -> list[tuple[str, Effect, Effect | None, Model]]:
-    """Every model one move away: add an effect of a new category, or swap one within its category."""
+def candidate_models(model: Model, effects: tuple[Effect, ...] | None = None
+                     ) -> list[tuple[str, Effect, Effect | None, Model]]:
+    """Every model one move away: add an effect of a new category, or swap one within its category.
+
+    `effects`: what may be tried (default: the catalogue and the registered effects of the user's own).
+    A move whose model cannot be composed (an effect of one's own reusing a parameter name of an effect
+    in the model) is left out.
+    """
     present = {e.category: e for e in model.effects}
     moves = []
-    for effect in CATALOGUE.values():
-        if not model.with_displacement and effect.site is Site.DISPLACEMENT:
+    for effect in available_effects() if effects is None else effects:
+        if not model.with_displacement and effect.needs_displacement:
             continue
         current = present.get(effect.category)
-        if current is None:
-            moves.append(("add", effect, None, model.with_effects(model.effects + (effect,))))
-        elif current.id != effect.id:
-            swapped = tuple(effect if e is current else e for e in model.effects)
-            moves.append(("replace", effect, current, model.with_effects(swapped)))
+        try:
+            if current is None:
+                moves.append(("add", effect, None, model.with_effects(model.effects + (effect,))))
+            elif current.id != effect.id:
+                swapped = tuple(effect if e is current else e for e in model.effects)
+                moves.append(("replace", effect, current, model.with_effects(swapped)))
+        except ModelError:
+            continue
     return moves
 
 

@@ -260,6 +260,7 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
     values = start_values(model, data)
     warm = dict(start or {})
     values.update({k: v for k, v in warm.items() if k in values})
+    _check_effects(model, data, values)
     nfev = 0
     displacement_only = {s.name for e in model.effects if e.site is Site.DISPLACEMENT for s in e.params}
     compliance = {s.name for e in model.effects if e.site is Site.COMPLIANCE for s in e.params}
@@ -291,6 +292,14 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
             nfev += result.nfev
             result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
+
+
+def _check_effects(model: Model, data: FitData, values: Mapping[str, float]) -> None:
+    """Each effect finite at the fitted lines with its start values (an effect file's formula may not be)."""
+    freqs = [data.impedance.freqs] + ([data.displacement.freqs] if model.with_displacement else [])
+    s = 2j * np.pi * np.unique(np.concatenate(freqs))
+    for effect in model.effects:
+        effect.check_finite(s, values, "the fitted lines")
 
 
 def _at_bounds(model: Model, params: lmfit.Parameters) -> set[str]:

@@ -59,6 +59,9 @@ class Model:
                     f"effects {seen_categories[effect.category]!r} and {effect.id!r} are both of category "
                     f"{effect.category!r}: keep one (swap instead of adding)")
             seen_categories[effect.category] = effect.id
+            if effect.needs_bl and not self.with_displacement:
+                raise ModelError(f"effect {effect.id!r} acts in kg/s or kg on the mechanical impedance, which needs "
+                                 "Bl: without the laser's displacement Bl is unknown")
             for name in effect.param_names:
                 if name in seen_names:
                     raise ModelError(f"effect {effect.id!r} adds parameter {name!r}, which the model already has")

@@ -7,7 +7,7 @@ from typing import Sequence
 
 from analysis.bounds import SD, SIZE_KINDS, size_limits_set
 from analysis.errors import LinparError, is_user_error, user_message
-from app import cli_import
+from app import cli_effects, cli_import
 from app.cli_options import number, size_limit
 
 # 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
@@ -40,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     analyze.add_argument("--limits", metavar="FILE",
                          help="QA limits (JSON): print pass/fail; exit 0 pass, 1 fail, 2 error")
     cli_import.add_analyze_options(analyze)
+    cli_effects.add_option(analyze)
 
     diagnose = sub.add_parser("diagnose", help="find which physical effect the model lacks")
     diagnose.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
@@ -48,6 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
     diagnose.add_argument("--sd", type=number(SD), metavar="M2")
     diagnose.add_argument("--json", action="store_true")
     cli_import.add_analyze_options(diagnose)
+    cli_effects.add_option(diagnose)
 
     cli_import.add_commands(sub)
 
@@ -65,8 +67,9 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_levels
     cli_levels.add_commands(sub)
 
-    effects = sub.add_parser("effects", help="list the effects catalogue")
+    effects = sub.add_parser("effects", help="list the effects catalogue and your own effects")
     effects.add_argument("--json", action="store_true")
+    cli_effects.add_option(effects)
 
     gui = sub.add_parser("gui", help="start the workstation window")
     gui.add_argument("path", nargs="?", help="a recording to open")
@@ -93,6 +96,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    if args.command in cli_effects.COMMANDS:
+        cli_effects.load(args)           # a bad effect file stops every command that builds models: one line
     if args.command == "rig":
         from app import cli_rig
         return cli_rig.run(args)

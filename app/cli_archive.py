@@ -50,6 +50,8 @@ def add_commands(sub) -> None:
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
     store.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
     store.add_argument("--model", metavar="EFFECTS", help="effect ids separated by commas (default lr2,creep-log)")
+    from app.cli_effects import add_option
+    add_option(store)
 
     compare = verbs.add_parser("compare", help="up to 8 measurements' parameters side by side")
     compare.add_argument("ids", nargs="+", metavar="ID")

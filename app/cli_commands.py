@@ -6,7 +6,7 @@ import json
 import sys
 
 from analysis.derived import ParameterValue
-from analysis.effects import CATALOGUE, UnknownEffectError, categories, parse_effects
+from analysis.effects import UnknownEffectError, parse_effects
 from analysis.limits import LimitsError
 from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult, analyze_path, result_json
@@ -27,6 +27,7 @@ def dispatch(args: argparse.Namespace) -> int:
         from app.cli_diagnose import cmd_diagnose
         return cmd_diagnose(args)
     if args.command == "effects":
+        from app.cli_effects import cmd_effects
         return cmd_effects(args)
     raise AssertionError(f"unknown command {args.command!r}")     # the parser allows no other
 
@@ -98,17 +99,3 @@ def format_result(result: AnalysisResult) -> str:
         for f in channel.get("findings") or ():
             lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
     return "\n".join(lines)
-
-
-def cmd_effects(args: argparse.Namespace) -> int:
-    if args.json:
-        print(json.dumps([e.describe() for e in CATALOGUE.values()], indent=1))
-        return 0
-    for category, effects in categories().items():
-        print(f"[{category}]")
-        for e in effects:
-            params = ", ".join(f"{p.name} [{p.display_unit}" + (f", typically {p.typical_text()}]" if p.typical else "]")
-                               for p in e.params)
-            print(f"  {e.id:<22} {e.title} ({params})")
-            print(f"  {'':<22} cures: {e.signature}")
-    return 0

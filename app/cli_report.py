@@ -31,6 +31,8 @@ def _source_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--sd", type=number(SD), metavar="M2",
                         help="effective radiating area in m^2 (recordings only)")
     parser.add_argument("--model", metavar="EFFECTS", help="effect ids for a recording (default lr2,creep-log)")
+    from app.cli_effects import add_option
+    add_option(parser)
 
 
 def add_commands(sub) -> None:

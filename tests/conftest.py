@@ -45,3 +45,16 @@ def virtual_rig(tmp_path_factory):
     finally:
         portaudio.release()
         stop_rig(name, runtime_dir=runtime_dir)
+
+
+@pytest.fixture(autouse=True)
+def _no_user_effects(tmp_path_factory, monkeypatch):
+    """Effects of the user's own come from an empty folder, never the real one, and none outlive a test.
+
+    The CLI registers the user folder's effects in the process (analysis.effects.registry), and tests
+    run it in-process: without this, one test's effect file would join the next test's diagnosis.
+    """
+    from analysis.effects import registry
+    monkeypatch.setenv(registry.FOLDER_ENV, str(tmp_path_factory.getbasetemp() / "no-user-effects"))
+    yield
+    registry.clear()

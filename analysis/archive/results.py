@@ -82,6 +82,7 @@ def results_document(result, recording=None) -> dict:
         "format": FORMAT,
         "parameters": parameters,
         "model": {"effects": list(fit.model.effect_ids), "with_displacement": fit.model.with_displacement,
+                  "user_effects": user_effects_json(fit.model.effects),
                   "values": {k: _num(v) for k, v in fit.values.items()},
                   "stderr": {k: _num(v) for k, v in fit.stderr.items()},
                   "chi2_red": {k: _num(v) for k, v in fit.chi2_red_by_channel().items()},
@@ -93,6 +94,31 @@ def results_document(result, recording=None) -> dict:
         "settings": _settings_of(recording, result),
         "curves": curves,
     }
+
+
+def user_effects_json(effects) -> list[dict]:
+    """Effects of the user's own, with their file's text: a stored result re-analyses the same way later,
+    whatever has become of the file."""
+    return [{"id": e.id, "file": e.source, "text": e.text} for e in effects if getattr(e, "text", "")]
+
+
+def _user_effects(model: Mapping) -> dict:
+    """The stored effects of the user's own, rebuilt from their text (by id)."""
+    from analysis.effects.user import EffectFileError, effect_from_text
+    stored = model.get("user_effects") or []
+    if not isinstance(stored, list):
+        raise ResultsFormatError("model.user_effects: expected a list")
+    effects = {}
+    for i, entry in enumerate(stored):
+        where = f"model.user_effects[{i}]"
+        if not isinstance(entry, Mapping) or not isinstance(entry.get("text"), str):
+            raise ResultsFormatError(f"{where}: expected an object with the effect file's text")
+        try:
+            effect = effect_from_text(entry["text"], str(entry.get("file") or "effect file"))
+        except EffectFileError as exc:
+            raise ResultsFormatError(f"{where}: {exc}") from None
+        effects[effect.id] = effect
+    return effects
 
 
 @dataclass(frozen=True)
@@ -170,6 +196,7 @@ class StoredResult:
     sd_m2: float | None
     settings: dict
     curves: dict[str, Curve] = field(default_factory=dict)
+    user_effects: dict = field(default_factory=dict)     # id -> the Effect rebuilt from its stored file text
 
     @classmethod
     def from_json(cls, doc: Mapping) -> "StoredResult":
@@ -215,13 +242,13 @@ class StoredResult:
         return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
                    dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
                    None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
-                   curves)
+                   curves, _user_effects(model))
 
     def model(self):
-        """The analysis.model.Model the values belong to (rebuilt from the effect ids)."""
+        """The analysis.model.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
         from analysis.effects import parse_effects
         from analysis.model import Model
-        return Model(parse_effects(",".join(self.effects) or "none"), self.with_displacement)
+        return Model(parse_effects(",".join(self.effects) or "none", self.user_effects), self.with_displacement)
 
     def model_curve(self, name: str, freqs: np.ndarray) -> np.ndarray:
         """The fitted model of 'impedance' (ohm) or 'displacement' (m/V) at any frequencies."""

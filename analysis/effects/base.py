@@ -110,6 +110,20 @@ class Effect:
     def param_names(self) -> tuple[str, ...]:
         return tuple(p.name for p in self.params)
 
+    @property
+    def needs_bl(self) -> bool:
+        """True when the response needs Bl (kg/s or kg turned into the model's admittance Zm / Bl^2): without
+        the laser Bl is unknown, so the effect needs the displacement channel."""
+        return False
+
+    @property
+    def needs_displacement(self) -> bool:
+        return self.site is Site.DISPLACEMENT or self.needs_bl
+
+    def check_finite(self, s: np.ndarray, p: Mapping[str, float], where: str) -> None:
+        """Raise a ValueError naming the effect when its response is not finite at `s` (effects of the
+        user's own check their formula; the catalogue's equations are tested instead)."""
+
     def response(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
         raise NotImplementedError
 

@@ -88,19 +88,25 @@ def _lights(validity: Mapping) -> tuple[Light, ...]:
     return tuple(lights)
 
 
-def _effect_title(effect_id: str) -> str:
+def _effect_title(effect_id: str, result: StoredResult) -> str:
     from analysis.effects import CATALOGUE
-    e = CATALOGUE.get(effect_id)
+    e = result.user_effects.get(effect_id) or CATALOGUE.get(effect_id)
     return f"{effect_id} ({e.title})" if e else effect_id
+
+
+def _user_effect_rows(result: StoredResult) -> list[tuple[str, str]]:
+    """Each effect of the user's own with its formula, site and file: the report says what was fitted."""
+    return [(f"Own effect {e.id}", f"{e.formula.text} at the {e.site.key} site ({e.acts_as}); file {e.source}")
+            for e in result.user_effects.values() if e.id in result.effects]
 
 
 def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     info = result.model_info
-    effects = ", ".join(_effect_title(e) for e in result.effects) or "none (the textbook lumped model)"
+    effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
     chi = info.get("chi2_red") or {}
     rows = [("Model", "lumped model of physics.md" + (" with Hx (laser)" if result.with_displacement else
                                                        ", impedance only")),
-            ("Effects", effects)]
+            ("Effects", effects)] + _user_effect_rows(result)
     for channel, value in chi.items():
         rows.append((f"Reduced χ² ({channel})", format_number(value) if value is not None else "n/a"))
     for key, label in (("aic", "AIC"), ("bic", "BIC")):

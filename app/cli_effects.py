@@ -1,0 +1,55 @@
+"""Effects of the user's own on the command line: --effects-file, the user folder, `linpar effects`.
+
+Every command that fits a model reads the user folder ($LINPAR_EFFECTS, else effects/ in the
+platform's configuration folder), the packages' `linpar.effects` entry points, and the files given
+with --effects-file, before it does anything else: a bad file stops it at once with one line.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+
+from analysis.effects import CATALOGUE, Effect, categories
+from analysis.effects import registry
+
+# The commands that build models from effect ids (and so may name effects of the user's own).
+COMMANDS = ("analyze", "diagnose", "effects", "report", "export", "archive", "addedmass", "stats", "levels")
+
+
+def add_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--effects-file", dest="effects_files", action="append", default=[], metavar="FILE",
+                        help="an effect of your own (TOML; repeatable), beside the catalogue and the user folder "
+                             f"(${registry.FOLDER_ENV} or {registry.config_folder() / 'effects'})")
+
+
+def load(args: argparse.Namespace) -> tuple[Effect, ...]:
+    """Read and register the user's effects (registry.EffectFileError, one line, when one is bad)."""
+    effects = registry.load_user_effects(getattr(args, "effects_files", None) or ())
+    registry.register(effects)
+    return effects
+
+
+def _parameters_text(effect: Effect) -> str:
+    return ", ".join(f"{p.name} [{p.display_unit}" + (f", typically {p.typical_text()}]" if p.typical else "]")
+                     for p in effect.params)
+
+
+def cmd_effects(args: argparse.Namespace) -> int:
+    users = registry.user_effects()
+    if args.json:
+        print(json.dumps([e.describe() for e in (*CATALOGUE.values(), *users)], indent=1))
+        return 0
+    for category, effects in categories().items():
+        print(f"[{category}]")
+        for e in effects:
+            print(f"  {e.id:<22} {e.title} ({_parameters_text(e)})")
+            print(f"  {'':<22} cures: {e.signature}")
+    print(f"[effects of your own] (folder: {registry.user_folder()})")
+    if not users:
+        print("  none: write a TOML file there, or give --effects-file FILE (docs/effects.md)")
+    for e in users:
+        formula = getattr(e, "formula", None)
+        print(f"  {e.id:<22} {e.title} ({_parameters_text(e)})")
+        print(f"  {'':<22} site: {e.site.key}" + (f"; formula: {formula.text}" if formula is not None else ""))
+        print(f"  {'':<22} from: {registry.source_of(e)}")
+    return 0
