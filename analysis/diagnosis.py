@@ -23,16 +23,24 @@ from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Callable
 
+import numpy as np
+
 from analysis import acceptance, residuals
 from analysis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
+from analysis.lumped import resonance_frequency
 from analysis.model import Model, ModelError
 from analysis.sites import SiteResult, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
+# A candidate's refit gets fewer evaluations than a fit of one's choice: the right effect converges in a
+# few hundred (at most 100 per parameter on the recordings of tests/analysis/test_diagnosis.py and
+# test_new_physics.py), while one the data do not ask for wanders along its undetermined parameters, or
+# crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
+CANDIDATE_EVALUATIONS_PER_PARAMETER = 120
 # Far from the data (reduced chi^2 above this) the current fit's parameters are bent: effects that bend
 # every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.
 FAR_CHI2 = 100.0
@@ -131,7 +139,7 @@ def candidate_models(model: Model, effects: tuple[Effect, ...] | None = None
 
 
 def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
-    return fit_model(data, model, start=start, cancel=cancel)
+    return fit_model(data, model, start=start, cancel=cancel, per_parameter=CANDIDATE_EVALUATIONS_PER_PARAMETER)
 
 
 def _run(calls, executor: Executor | None, cancel: threading.Event | None) -> list:
@@ -194,13 +202,17 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     screened = _best_starts(data, current, moves, ctx, executor, cancel)
     calls, owners = [], []
     far = current.chi2_red > FAR_CHI2
-    for index, (_, effect, _, model) in enumerate(moves):
+    for index, (_, effect, replaced, model) in enumerate(moves):
         # The new effect starts from its guess; the rest from the current fit.
         start = screened.get(index) or {**current.values, **effect.guess(ctx)}
+        if replaced is not None and effect.site is Site.COMPLIANCE:
+            start = _same_compliance_at_fs(current, model, start)
         calls.append((_refit, (data, model, start, None if executor else cancel)))
         owners.append(index)
         if far and effect.cold_start:
-            calls.append((_refit, (data, model, effect.guess(ctx), None if executor else cancel)))
+            # From the data's own start values, the effect from the best of its screened starts if it has any.
+            own = {name: start[name] for name in effect.param_names} if index in screened else effect.guess(ctx)
+            calls.append((_refit, (data, model, own, None if executor else cancel)))
             owners.append(index)
     outcomes: dict[int, tuple[FitResult | None, str | None]] = {}
     for index, (fit, error) in zip(owners, _run(calls, executor, cancel)):
@@ -215,6 +227,21 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
                                     (fit.bic - current.bic) if fit else float("inf"), error, flags,
                                     acceptance.assess(current, fit, effect, flags)))
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
+
+
+def _same_compliance_at_fs(current: FitResult, model: Model, start: dict) -> dict:
+    """A swapped creep law starts with the compliance the current fit has at fs.
+
+    The laws normalise LCES differently (the compliance at fs for the log laws, above the creep band for
+    creep-3p and creep-zener): started from the old LCES, a law whose factor at fs is far from 1 starts
+    far from the data and can crawl for thousands of evaluations into a poor minimum.
+    """
+    s = np.array([2j * np.pi * resonance_frequency(current.values)])
+    before = abs(current.model.motional_compliance_factor(s, current.values)[0])
+    after = abs(model.motional_compliance_factor(s, start)[0])
+    if not (np.isfinite(before) and np.isfinite(after) and after > 0):
+        return start
+    return {**start, "LCES": start["LCES"] * before / after}
 
 
 class _SiteFits:

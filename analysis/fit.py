@@ -198,6 +198,39 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
     return {_our_name(name): p.value for name, p in params.items()}
 
 
+# A fit whose chi^2 has not dropped by more than STALL_CHI2 (in noise units) and STALL_RELATIVE of itself
+# over STALL_ITERATIONS iterations has stopped: it wanders along a direction the data do not determine
+# (an effect that is not there) or crawls along a parameter held at its bound, which MINPACK's own tests
+# can follow for thousands of evaluations. At that pace halving chi^2 would take 10^5 iterations.
+STALL_CHI2 = 1e-3
+STALL_RELATIVE = 1e-5
+STALL_ITERATIONS = 10
+POLISH_TOLERANCE = 1e-8        # the short fit from a stalled fit's best point, for its covariance
+POLISH_PER_PARAMETER = 20
+
+
+class _StallWatch:
+    """Counts the evaluations since chi^2 last improved by more than STALL_CHI2; keeps the best point."""
+
+    def __init__(self, n_varying: int):
+        self.window = STALL_ITERATIONS * (n_varying + 1)      # an iteration costs a Jacobian: n + 1 evaluations
+        self.best = np.inf
+        self.best_params: lmfit.Parameters | None = None
+        self.since = 0
+        self.stalled = False
+
+    def seen(self, params: lmfit.Parameters, residual: np.ndarray) -> bool:
+        chi2 = float(np.dot(residual, residual))
+        if chi2 < self.best - max(STALL_CHI2, STALL_RELATIVE * self.best):
+            self.since = 0
+        else:
+            self.since += 1
+        if chi2 < self.best:
+            self.best, self.best_params = chi2, params.copy()
+        self.stalled = self.since > self.window
+        return self.stalled
+
+
 def _minimize(model, params, data, use_x, sigmas, cancel,
               per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
     def residual(prm):
@@ -206,18 +239,30 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
         # a fixed size keeps MINPACK's bookkeeping intact.
         return np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
 
+    n_varying = sum(1 for p in params.values() if p.vary)
+    watch = _StallWatch(n_varying)
+
     def iteration(prm, it, resid, *args, **kws):
-        return bool(cancel is not None and cancel.is_set())   # True aborts lmfit
+        if cancel is not None and cancel.is_set():
+            return True      # True aborts lmfit
+        return watch.seen(prm, resid)
 
     minimizer = lmfit.Minimizer(residual, params, iter_cb=iteration, scale_covar=False, nan_policy="propagate")
     # MINPACK's own default budget is 200*(k+1) evaluations; a well-posed fit
     # here needs far fewer. A candidate whose parameters are nearly degenerate
     # would otherwise wander for many thousands.
-    n_varying = sum(1 for p in params.values() if p.vary)
     result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12,
                                 max_nfev=per_parameter * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
+    if watch.stalled and watch.best_params is not None:
+        # Stopped where it had stopped improving: a short fit from its best point gives the covariance.
+        polish = lmfit.Minimizer(residual, watch.best_params, scale_covar=False, nan_policy="propagate")
+        polished = polish.minimize(method="leastsq", xtol=POLISH_TOLERANCE, ftol=POLISH_TOLERANCE,
+                                   max_nfev=POLISH_PER_PARAMETER * (n_varying + 1))
+        polished.nfev += result.nfev
+        if polished.covar is not None or polished.chisqr <= watch.best:
+            result = polished
     return result
 
 
@@ -252,8 +297,11 @@ def screen_fit(data: FitData, model: Model, start: Mapping[str, float], vary: se
 
 
 def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = None,
-              cancel: threading.Event | None = None) -> FitResult:
-    """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values."""
+              cancel: threading.Event | None = None, per_parameter: int = EVALUATIONS_PER_PARAMETER) -> FitResult:
+    """Fit `model` to `data`. `start` (e.g. the previous model's result) overrides start values.
+
+    per_parameter: the budget of model evaluations per varying parameter (and one) of each stage.
+    """
     use_x = model.with_displacement
     sigmas = channel_sigmas(data, use_x)
 
@@ -269,11 +317,11 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
     # Stage 1: Z alone. Creep barely shows in Z: hold it until Hx joins in.
     fixed = {"Bl"} | displacement_only | (compliance & cold if use_x else set())
     if cold - fixed:
-        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel)
+        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel, per_parameter)
         values = _values(r.params)
         nfev += r.nfev
         if compliance & cold and not use_x:
-            r = _minimize(model, _params(model, values, set()), data, False, sigmas, cancel)
+            r = _minimize(model, _params(model, values, set()), data, False, sigmas, cancel, per_parameter)
             values = _values(r.params)
             nfev += r.nfev
     # Stage 2: Bl is a pure gain on Hx: solve for it linearly.
@@ -283,14 +331,15 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
         inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
         values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
     # Stage 3: everything together.
-    result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel)
+    result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel, per_parameter)
     if result.covar is None:
         # lmfit gives no covariance when a parameter ends on a bound (its bound
         # transform has zero slope there): hold those at the bound, refit the rest.
         held = _at_bounds(model, result.params)
         if held:
             nfev += result.nfev
-            result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel)
+            result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel,
+                               per_parameter)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
 
 

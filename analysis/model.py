@@ -102,10 +102,15 @@ class Model:
             Ze = Ze + effect.response(s, p)
         return Ze
 
-    def motional_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+    def motional_compliance_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        """c(s): the product of the compliance-site factors (1 without any)."""
         compliance = np.ones_like(s)
         for effect in self._site(Site.COMPLIANCE):
             compliance = compliance * effect.response(s, p)
+        return compliance
+
+    def motional_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        compliance = self.motional_compliance_factor(s, p)
         Y = s * p["CMES"] + 1.0 / p["RES"] + 1.0 / (s * p["LCES"] * compliance)
         for effect in self._site(Site.MECHANICAL):
             Y = Y + effect.response(s, p)

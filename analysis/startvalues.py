@@ -13,7 +13,7 @@ full-range to an 18-inch woofer, so nothing here assumes a driver size:
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -38,6 +38,9 @@ class StartContext:
     # fitted (analysis.diagnosis sets them): where a delay should start. 0 before any fit.
     z_phase_slope: float = 0.0
     x_phase_slope: float = 0.0
+    # The measured impedance itself, for effects whose start needs more of it than these numbers
+    # (a vented box reads its two peaks). None when the context was made by hand.
+    impedance: TransferFunction | None = field(default=None, compare=False, repr=False)
 
     @property
     def CMES(self) -> float:
@@ -107,7 +110,21 @@ def start_context(z: TransferFunction) -> StartContext:
     top = slice(max(len(f) - 5, k + 1), None)
     LE = float(np.median(imag[top] / (2 * np.pi * f[top]))) if len(f[top]) else 0.0
     return StartContext(RE=RE, fs=fs, RES=RES, Qms=Qms, LE_high=max(LE, 1e-7),
-                        f_min=float(f[0]), f_max=float(f[-1]))
+                        f_min=float(f[0]), f_max=float(f[-1]), impedance=z)
+
+
+def impedance_peaks(ctx: StartContext, n: int = 2) -> tuple[np.ndarray, np.ndarray] | None:
+    """(frequencies, heights) of the n highest interior peaks of Re(Z) - RE, in rising frequency; None without them."""
+    z = ctx.impedance
+    if z is None or not z.has_phase:
+        return None
+    ok = np.isfinite(z.value)
+    f, excess = z.freqs[ok], z.value[ok].real - ctx.RE
+    interior = np.flatnonzero((excess[1:-1] >= excess[:-2]) & (excess[1:-1] >= excess[2:])) + 1
+    if interior.size < n:
+        return None
+    top = np.sort(interior[np.argsort(excess[interior])[-n:]])
+    return f[top], excess[top]
 
 
 def linear_gain(model_values: np.ndarray, measured: np.ndarray, std: np.ndarray) -> float:
