@@ -5,6 +5,9 @@ from typing import Mapping
 
 import numpy as np
 
+RHO = 1.18        # kg/m^3, air at 20 C (physics.md section 3)
+C_SOUND = 343.0   # m/s
+
 
 def resonance_frequency(p: Mapping[str, float]) -> float:
     """fs = 1 / (2*pi*sqrt(CMES*LCES)) = 1 / (2*pi*sqrt(Mms*Cms))."""

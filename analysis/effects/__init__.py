@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import Mapping
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.effects import breakup, channels, creep, inductance
+from analysis.effects import breakup, channels, creep, enclosure, forcefactor, inductance, mechanical
 from analysis.errors import LinparError
 
 # Grouped by category; within a category the effects are alternatives (one per model).
@@ -22,6 +22,8 @@ _ALL: tuple[Effect, ...] = (
     creep.creep_3p,
     creep.creep_fractional,
     creep.creep_rs,
+    creep.creep_kv,
+    creep.creep_zener,
     channels.delay_current,
     channels.lowpass_current,
     channels.delay_x,
@@ -29,6 +31,12 @@ _ALL: tuple[Effect, ...] = (
     channels.lowpass2_x,
     breakup.breakup,
     breakup.breakup_spot,
+    breakup.breakup_coil,
+    forcefactor.bl_eddy,
+    mechanical.air_load,
+    mechanical.damping_power,
+    enclosure.closed_box,
+    enclosure.vented_box,
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}

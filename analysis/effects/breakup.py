@@ -148,3 +148,82 @@ breakup_spot = SpotMode(
     notes=("An alternative to `breakup` in its category: choose it when Z shows no trace of the mode. Aim the "
            "laser at the dust cap or close to the coil to avoid it."),
 )
+
+
+# The coil's share of the moving mass and its decoupling frequency tried as starts: a voice coil, its
+# former and the dust cap are a fifth to a third of Mms; the joint resonates in the upper band. Its mode
+# is broad in Hx (the coil's motion rises for good above it), so starts an octave apart find it.
+COIL_SHARE_START = 0.25
+COIL_GRID_RATIO = 2.0
+
+
+@dataclass(frozen=True)
+class CoilDecoupling(Effect):
+    """The coil rides on the cone through the former's joint; the force and the laser are on the coil.
+
+    Network (velocities v of the coil, v_k of the cone). The coil and former, a mass m_c = mu_c*Mms,
+    carry the force Bl*i and the back-EMF; the cone, the rest Mms - m_c with the suspension on it,
+    hangs on the former's joint, a spring k_j and a damper r_j side by side. The coil then sees
+
+        Zm = s*m_c + 1 / (1/(r_j + k_j/s) + 1/(s*(Mms - m_c) + Rms + Kms/s))
+
+    and the laser on the coil or the dust cap (which sits on the former) sees the coil's motion: Hx
+    follows the same network as Z. With w_c^2 = k_j/m_c (the coil on the joint, the cone held) and
+    Q_c = w_c*m_c/r_j, in the model's admittance Y = Zm/Bl^2 the effect adds
+    Zm/Bl^2 - (s*CMES + 1/RES + 1/(s*LCES)), where m_c/Bl^2 = mu_c*CMES, (r_j + k_j/s)/Bl^2 =
+    mu_c*CMES*(w_c/Q_c + w_c^2/s). Zm is infinite where the cone resonates on the joint with the coil
+    held, f_c*sqrt(mu_c/(1 - mu_c)) (Z dips to Ze, Hx has a notch), and zero at f_c/sqrt(1 - mu_c)
+    where coil and cone move against each other (a peak); above both the coil moves as a mass m_c
+    alone, |Hx| 1/mu_c times the rigid cone's. The suspension's creep is taken on the coil's side (it
+    acts where the joint is stiff, far below f_c).
+    """
+
+    def response(self, s, p):
+        w_c = 2.0 * np.pi * p["f_c"]
+        coil = p["mu_c"] * p["CMES"]
+        rigid = s * p["CMES"] + 1.0 / p["RES"] + 1.0 / (s * p["LCES"])
+        joint = coil * (w_c / p["Q_c"] + w_c * w_c / s)
+        cone = s * (p["CMES"] - coil) + 1.0 / p["RES"] + 1.0 / (s * p["LCES"])
+        return s * coil + 1.0 / (1.0 / joint + 1.0 / cone) - rigid
+
+    def guess(self, ctx):
+        return {"f_c": min(20.0 * ctx.fs, 0.5 * ctx.f_max), "Q_c": START_Q2, "mu_c": COIL_SHARE_START}
+
+    def starts(self, ctx) -> list[dict[str, float]]:
+        """f_c stepped an octave at a time from 2*fs to just below the top line."""
+        lo, hi = 2.0 * ctx.fs, ctx.f_max / 1.2
+        if hi <= lo:
+            return [self.guess(ctx)]
+        n = int(np.ceil(np.log(hi / lo) / np.log(COIL_GRID_RATIO))) + 1
+        return [{"f_c": float(f), "Q_c": START_Q2, "mu_c": COIL_SHARE_START} for f in np.geomspace(lo, hi, n)]
+
+
+breakup_coil = CoilDecoupling(
+    id="breakup-coil",
+    category=CATEGORY,
+    title="Coil decoupling from the cone (laser on the coil or dust cap)",
+    site=Site.MECHANICAL,
+    params=(ParamSpec("f_c", "Hz", "Hz", 1.0, 20.0, 1e5, 3000.0,
+                      "resonance of the coil on the former's joint, the cone held", typical=(300.0, 3e4)),
+            ParamSpec("Q_c", "1", "-", 1.0, 0.1, 200.0, START_Q2, "quality factor of the joint", typical=(1.0, 50.0)),
+            ParamSpec("mu_c", "1", "%", 100.0, 0.01, 0.9, COIL_SHARE_START,
+                      "the coil, former and dust cap's share of Mms", typical=(0.03, 0.6))),
+    physics=("At high frequencies the joint between the coil former and the cone is no longer rigid: the coil, "
+             "which the force drives, starts to move on its own and the heavy cone lags behind. The laser on the "
+             "dust cap or the coil sees the coil, so the displacement shows the same mode as the impedance: a "
+             "notch, a peak, then a motion much larger than a rigid cone's."),
+    signature=("In the upper band a dip then a peak in |Z| and, at the same frequencies, a notch then a peak in "
+               "|Hx| after which |Hx| stays well above the model (the coil alone is light); `breakup`, whose "
+               "decoupling part is the outer cone, can match Z there but not this rise of Hx."),
+    typical="mu_c 0.1 to 0.4, f_c 1 to 10 kHz, Q_c 2 to 20",
+    reference=("W. Klippel, J. Schlechter, 'Distributed mechanical parameters of loudspeakers, part 1: measurements', "
+               "JAES 57(7/8), 2009 (modal vibration of cone and coil, measured by laser); J. P. Den Hartog, "
+               "'Mechanical Vibrations' (the two-mass system)"),
+    notes=("Mms stays the whole low-frequency moving mass and Kms the suspension's. breakup (the outer cone "
+           "decoupling, the laser on the coil) is the same two-mass network with the roles of the masses "
+           "exchanged, approximately: it reaches this mode only with mu2 = 1 - mu_c (above its typical range), "
+           "which is why the two are separate effects with their own starts."),
+    # Without it the model bends Mms, Bl and the creep to follow Hx's rise: far from the data the diagnosis
+    # also fits it from the data's own start (with the best of its screened starts for the mode).
+    cold_start=True,
+)

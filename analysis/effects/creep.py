@@ -214,3 +214,90 @@ creep_rs = CreepRetardationSpectrum(
     notes=("The upper end of the spectrum is fixed at w0 = 1.5*ws rather than fitted: a free w0 is "
            "identifiable only when it falls inside the measured band, and elsewhere trades against LCES."),
 )
+
+
+_FRACTIONAL_REFERENCE = ("W. King, F. T. Agerkvist, 'Fractional derivative loudspeaker models for nonlinear suspensions "
+                         "and voice coils', JAES 66(7/8), 525-536, 2018; R. L. Bagley, P. J. Torvik, 'On the "
+                         "fractional calculus model of viscoelastic behavior', J. Rheology 30(1), 1986")
+
+
+@dataclass(frozen=True)
+class CreepKelvinVoigtFractional(Effect):
+    """CMS(s) = CMS * (1 + kappa) / (1 + kappa*(s/ws)^beta), s = jw, ws = 2*pi*fs.
+
+    A spring in parallel with a springpot (King and Agerkvist): the stiffness is
+    K(jw) = KMS * (1 + kappa*(jw/ws)^beta) / (1 + kappa), whose inverse is this factor on the
+    compliance. At DC the compliance is finite, (1 + kappa)*CMS (the spring alone); above ws it keeps
+    falling as w^-beta (the springpot stiffens), with a loss angle that peaks between the two.
+    """
+
+    def response(self, s, p):
+        return (1.0 + p["kappa"]) / (1.0 + p["kappa"] * (s / _ws(p)) ** p["beta"])
+
+    def guess(self, ctx):
+        return {"kappa": 0.5, "beta": 0.3}
+
+
+creep_kv = CreepKelvinVoigtFractional(
+    id="creep-kv",
+    category=CATEGORY,
+    title="Fractional Kelvin-Voigt creep (spring parallel to a springpot)",
+    site=Site.COMPLIANCE,
+    params=(ParamSpec("kappa", "1", "%", 100.0, 1e-3, 50.0, 0.5,
+                      "the springpot's stiffness at fs relative to the parallel spring's", typical=(0.02, 10.0)),
+            ParamSpec("beta", "1", "-", 1.0, 0.01, 1.0, 0.3, "order of the springpot (0 a spring, 1 a damper)",
+                      typical=(0.05, 0.8))),
+    physics=("The suspension is a spring in parallel with a fractional element between a spring and a damper (a "
+             "springpot): under a slow force the springpot gives way and only the spring holds, so the "
+             "compliance levels off at (1 + kappa) times its value at fs instead of growing without end as in "
+             "the log laws; towards high frequencies the springpot stiffens the suspension."),
+    signature=("Displacement residual below fs that levels off towards the lowest lines (a finite static "
+               "compliance), with a loss (phase of Hx) spread over decades; above fs a stiffness still rising, "
+               "which the log laws and the three-parameter law cannot both follow."),
+    typical="kappa 0.1 to 3, beta 0.1 to 0.6",
+    reference=_FRACTIONAL_REFERENCE,
+    notes=("Written as the issue's K(jw) = K*(1 + kappa*(jw/ws)^beta)/(1 + kappa): KMS = 1/CMS is K, the stiffness "
+           "the law is normalised to at fs (exactly so for beta near 0); the static stiffness is KMS/(1 + kappa), and "
+           "at fs the stiffness is KMS*|1 + kappa*j^beta|/(1 + kappa). Causal by construction."),
+)
+
+
+@dataclass(frozen=True)
+class CreepZenerFractional(Effect):
+    """CMS(s) = CMS * [1 + kappa / (1 + (s*tau_r)^beta)]: the fractional standard linear solid (Zener).
+
+    A spring of compliance CMS in series with a fractional Kelvin-Voigt element (a spring of compliance
+    kappa*CMS parallel to a springpot): the extra compliance kappa*CMS yields around 1/tau_r, spread over
+    more decades the smaller beta is. beta = 1 is creep-3p; the static compliance is (1 + kappa)*CMS and
+    the high-frequency one CMS (LCES).
+    """
+
+    def response(self, s, p):
+        return 1.0 + p["kappa"] / (1.0 + (s * p["tau_r"]) ** p["beta"])
+
+    def guess(self, ctx):
+        f_mid = np.sqrt(max(ctx.f_min, 1e-3) * ctx.fs)
+        return {"kappa": 0.3, "tau_r": 1.0 / (2.0 * np.pi * f_mid), "beta": 0.6}
+
+
+creep_zener = CreepZenerFractional(
+    id="creep-zener",
+    category=CATEGORY,
+    title="Fractional standard-linear-solid creep (Zener)",
+    site=Site.COMPLIANCE,
+    params=(ParamSpec("kappa", "1", "%", 100.0, 0.0, 20.0, 0.3,
+                      "extra compliance at DC, relative to the high-frequency compliance", typical=(0.01, 5.0)),
+            ParamSpec("tau_r", "s", "ms", 1e3, 1e-5, 10.0, 5e-3, "retardation time of the creep",
+                      typical=(1e-4, 1.0)),
+            ParamSpec("beta", "1", "-", 1.0, 0.05, 1.0, 0.6, "order of the springpot (1: creep-3p)",
+                      typical=(0.1, 1.0))),
+    physics=("A spring in series with a spring and springpot in parallel: the suspension has a finite static "
+             "compliance, (1 + kappa) times its high-frequency one, and the change between them is spread over "
+             "decades around 1/(2*pi*tau_r) (a single retardation time when beta = 1)."),
+    signature=("Displacement residual below fs that levels off at the lowest lines like creep-3p's, but spread "
+               "over a wider band with a flatter phase bump in Hx than one retardation time gives."),
+    typical="kappa 0.1 to 2, tau_r 1 to 100 ms, beta 0.3 to 0.8",
+    reference=_FRACTIONAL_REFERENCE + "; C. Zener, 'Elasticity and anelasticity of metals', 1948 (the standard linear solid)",
+    notes=("LCES is the compliance above the creep band. beta = 1 is creep-3p: prefer that when BIC says the extra "
+           "parameter does not pay."),
+)
