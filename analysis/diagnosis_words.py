@@ -87,6 +87,9 @@ def drift_from_validity(validity: dict | None) -> str | None:
     channels = (validity or {}).get("channels") or {}
     found = [f"{name}: {f['message']}" for name, ch in channels.items() for f in (ch or {}).get("findings", [])
              if f.get("code") == "drift"]
+    heating = (validity or {}).get("heating") or {}
+    if heating.get("significant"):
+        found.append(heating["text"])
     return "; ".join(found) or None
 
 
@@ -161,6 +164,8 @@ def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
             + "): the noise estimate is inflated, not met. The scatter between periods is larger than what the "
               "model leaves, as when the driver drifts during the measurement (a voice coil warming up): see "
               "the drift finding of the validity check." + (f" It reports: {drift}" if drift else ""))
+    elif drift and "voice coil warmed" in drift:
+        parts.append("During the measurement " + drift[drift.index("the voice coil warmed"):] + ".")
     others = [f for f in result.final_flags if f.code not in (acceptance.NOISE_INFLATED, acceptance.STEP_CAP)]
     flags = _flag_sentence(others)
     if flags:

@@ -24,11 +24,13 @@ from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, u
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
 from analysis.fit import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.model import Model, ModelError
 from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
-from analysis.startvalues import StartValueError
+from analysis.startvalues import StartValueError, start_context
 from analysis.validity import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
+from analysis.validity_findings import DRIFT
 from analysis.validity_fit import FitChannels, fit_channels, misfit_findings
 
 
@@ -119,9 +121,27 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     model = Model(effects, with_displacement=data.displacement is not None)
     start = start_of(data, model, cancel) if start_of is not None else None
     fit = fit_model(data, model, start=start, cancel=cancel)
-    judged = validity.with_findings(misfit_findings(fit))
+    corrected, heating = without_coil_heating(recording, spectra, validity, fit.values["RE"])
+    if corrected is not spectra:        # the noise estimate was the drift's: fit again on the honest one
+        spectra = corrected
+        fit = fit_model(FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
+    judged = validity.with_findings(misfit_findings(fit)).as_json()
+    if heating is not None:
+        judged["heating"] = heating.as_json()
     parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
-    return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged.as_json())
+    return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged)
+
+
+def without_coil_heating(recording: Recording, spectra: Spectra, validity: Validity,
+                         re_fit: float) -> tuple[Spectra, CoilHeating | None]:
+    """The spectra with the voice coil's warming taken out of the noise estimate, and the heating found, when
+    the validity check found the current drifting (analysis.heating); the spectra as they are otherwise."""
+    if not any(f.code == DRIFT for f in validity.channels["current"].findings):
+        return spectra, None
+    heating = coil_heating(recording, spectra, re_fit)
+    if heating is None or not heating.significant:
+        return spectra, heating
+    return without_heating(recording, spectra, heating), heating
 
 
 def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChannels, Spectra]:
@@ -141,15 +161,22 @@ def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChanne
     return validity, usable, spectra
 
 
-def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, Validity]:
-    """The lines a fit of the recording may use and its judged channels (module doc); NotAnalysable naming
-    the file and `doing` when the impedance has none."""
+def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
+    """The lines a fit of the recording may use and its judged channels as JSON (module doc), the coil's
+    heating taken out of the noise (and said under "heating") when the current drifts; NotAnalysable
+    naming the file and `doing` when the impedance has none."""
     with naming_the_file(recording):
         validity, usable, spectra = _judged(recording, estimate_spectra(recording))
     if usable.impedance is not None:
         where = f"{recording.source}: " if recording.source is not None else ""
         raise NotAnalysable(f"{where}cannot {doing}: {usable.impedance}")
-    return FitData.from_spectra(spectra), validity
+    judged = validity.as_json()
+    if any(f.code == DRIFT for f in validity.channels["current"].findings):
+        # RE for the words only (the correction does not need it): the lowest real part of Z, as the fit starts
+        spectra, heating = without_coil_heating(recording, spectra, validity, start_context(spectra.impedance).RE)
+        if heating is not None:
+            judged["heating"] = heating.as_json()
+    return FitData.from_spectra(spectra), judged
 
 
 def checked_capture(recording: Recording) -> CaptureInfo | None:

@@ -12,7 +12,7 @@ channel in the time domain, independently per sample.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Callable, Mapping
 
 import numpy as np
 
@@ -50,14 +50,25 @@ def synthesize_recording(model: Model, values: Mapping[str, float], waveform: np
                          excited_bins: np.ndarray, sample_rate: int, n_periods: int,
                          settle_periods: int = 1, noise: ChannelNoise = ChannelNoise(),
                          seed: int | None = 0, write_excited_bins: bool = True,
-                         driver: Mapping | None = None) -> Recording:
-    """A recording of `n_periods` analysed periods after `settle_periods`, with noise."""
-    period = steady_state_period(model, values, waveform, excited_bins, sample_rate)
+                         driver: Mapping | None = None,
+                         drift: Callable[[int], Mapping[str, float]] | None = None) -> Recording:
+    """A recording of `n_periods` analysed periods after `settle_periods`, with noise.
+
+    drift(k): values that change from period k on (k = 0 the first settle period), e.g. the RE of a
+    voice coil warming up; each period is then the steady state of its own values (a drift slow
+    against a period, as heating is).
+    """
     total = n_periods + settle_periods
+    if drift is None:
+        period = steady_state_period(model, values, waveform, excited_bins, sample_rate)
+        tiled = {name: np.tile(one, total) for name, one in period.items()}
+    else:
+        periods = [steady_state_period(model, {**values, **drift(k)}, waveform, excited_bins, sample_rate)
+                   for k in range(total)]
+        tiled = {name: np.concatenate([p[name] for p in periods]) for name in periods[0]}
     rng = np.random.default_rng(seed)
     signals = {}
-    for name, one in period.items():
-        signal = np.tile(one, total)
+    for name, signal in tiled.items():
         sigma = getattr(noise, name)
         if sigma > 0:
             signal = signal + rng.normal(0.0, sigma, signal.shape)

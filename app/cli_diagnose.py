@@ -26,7 +26,7 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
         return data, args.sd, None
     recording = read_recording(args.path)
     data, validity = judged_fit_data(recording, "be diagnosed")
-    return data, resolve_sd(recording, args.sd), drift_from_validity(validity.as_json())
+    return data, resolve_sd(recording, args.sd), drift_from_validity(validity)
 
 
 def run_diagnosis(args: argparse.Namespace):
