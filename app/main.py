@@ -47,6 +47,17 @@ def _report_uncaught(window):
     return hook
 
 
+def _load_user_effects() -> list[str]:
+    """Register the effects of the user folder and of packages; the files that could not be read, one line each
+    (the window says them in the Model lab's User effects branch, and starts without them)."""
+    from analysis.effects import registry
+    problems: list[str] = []
+    registry.register(registry.load_user_effects(problems=problems))
+    for line in problems:
+        logging.getLogger(__name__).warning("effect file not read: %s", line)
+    return problems
+
+
 def run_gui(path: str | None = None) -> int:
     if _no_display():
         print("linpar: error: no display (DISPLAY and WAYLAND_DISPLAY are unset); set DISPLAY, or "
@@ -66,8 +77,10 @@ def run_gui(path: str | None = None) -> int:
     QApplication.setOrganizationName(ORGANIZATION)
     QApplication.setApplicationName(APPLICATION)
     app = QApplication.instance() or QApplication(sys.argv[:1])
+    problems = _load_user_effects()
     window = MainWindow()
     sys.excepthook = _report_uncaught(window)
+    window.model_lab.catalogue.set_problems(problems)
     window.show()
     QTimer.singleShot(0, window.offer_unfinished)     # measurements a crash cut short: keep, analyse, discard
     if path:

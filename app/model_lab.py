@@ -54,6 +54,7 @@ class ModelLab(QWidget):
         self.job: LabJob | None = None              # the job whose outcome will be shown
         self.diagnosis: DiagnosisOutcome | None = None
         self.diagnosis_version = 0                  # the version the shown candidates are one move from
+        self.new_effect_dialog = None               # the "New effect…" dialog while it is open
 
         self.empty = QLabel(EMPTY_TEXT)
         self.empty.setAlignment(Qt.AlignCenter)
@@ -117,6 +118,7 @@ class ModelLab(QWidget):
         layout.addWidget(self.stack)
 
         self.catalogue.selection_changed.connect(self.on_selection_changed)
+        self.catalogue.new_effect_requested.connect(self.on_new_effect)
         self.candidates.diagnose_button.clicked.connect(self.on_diagnose)
         self.candidates.apply_button.clicked.connect(self.on_apply)
         self.candidates.follow_button.clicked.connect(self.on_follow)
@@ -272,6 +274,22 @@ class ModelLab(QWidget):
             return
         self.job = self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values)
         self._set_busy(True, f"Refitting {model.describe()} ({move_text(current, model)})…")
+
+    @Slot()
+    def on_new_effect(self) -> None:
+        """The "New effect…" dialog, previewing on the current version; a saved effect joins the catalogue."""
+        from app.model_lab_new_effect import NewEffectDialog
+        dialog = NewEffectDialog(self.current.fitted.fit if self.current is not None else None, parent=self)
+        dialog.saved.connect(self.on_effect_saved)
+        self.new_effect_dialog = dialog
+        dialog.open()
+
+    @Slot(object)
+    def on_effect_saved(self, effect) -> None:
+        self.catalogue.refresh_user_effects()
+        self.catalogue.show_effect(effect.id)
+        self.status_label.setText(f"Saved {effect.id} to {effect.source}: check it under User effects to fit it; "
+                                  "the diagnosis now tries it too")
 
     @Slot()
     def on_diagnose(self) -> None:

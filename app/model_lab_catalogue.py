@@ -2,7 +2,9 @@
 
 Effects of one category are alternatives (analysis.model allows one per
 category): checking a second one swaps it for the first, like radio buttons
-that may also all be off.
+that may also all be off. Effects of the user's own (analysis.effects.registry:
+the user folder, packages) have a branch of their own, "User effects", with the
+"New effect…" button that writes one.
 """
 from __future__ import annotations
 
@@ -10,10 +12,10 @@ import html
 
 from PySide6.QtCore import QEvent, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter, QTextBrowser, QTreeWidget,
-                               QTreeWidgetItem, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QSplitter,
+                               QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
-from analysis.effects import Effect, Site, categories
+from analysis.effects import Effect, categories, registry
 from app import style
 
 EFFECT_ROLE = Qt.UserRole
@@ -23,8 +25,13 @@ CATEGORY_TITLES = {       # the ids are for code; these are for the reader
     "electrical-channel": "Current channel",
     "displacement-sensor": "Displacement sensor",
     "breakup": "Cone break-up",
+    "force-factor": "Force factor",
+    "air-load": "Air load",
+    "damping": "Mechanical damping",
+    "enclosure": "Enclosure (box)",
 }
 NO_DISPLACEMENT = "needs the displacement channel, which this recording does not have"
+USER_BRANCH = "User effects"
 HINT = ("Check an effect to add it to the model and refit; uncheck it to remove it. One effect per category: "
         "checking another swaps it. Point at an effect to read what it is.")
 
@@ -40,13 +47,21 @@ def effect_html(effect: Effect, available: bool = True) -> str:
         f"<tr><td><b>{e(p.name)}</b></td><td>{e(p.display_unit)}</td><td>{e(p.description)}"
         + (f"; typically {e(p.typical_text())} (a fit outside is flagged)" if p.typical else "") + "</td></tr>"
         for p in effect.params)
+    own = registry.is_user_effect(effect)
+    category = "a category of its own" if own and effect.category == effect.id else category_title(effect.category)
     parts = [
         f"<h3 style='margin-bottom:2px'>{e(effect.title)}</h3>",
-        f"<p style='margin-top:0'><code>{e(effect.id)}</code> · {e(category_title(effect.category))} · "
+        f"<p style='margin-top:0'><code>{e(effect.id)}</code> · {e(category)} · "
         f"acts on the {e(effect.site.value)}</p>",
     ]
     if not available:
         parts.append(f"<p style='color:{style.MISSING_TEXT}'><i>Not available: {e(NO_DISPLACEMENT)}.</i></p>")
+    formula = getattr(effect, "formula", None)
+    if formula is not None:
+        parts.append(f"<p><b>Your own effect.</b> <code>{e(formula.text)}</code>: {e(effect.acts_as)}. "
+                     f"From {e(registry.source_of(effect))}.</p>")
+    elif registry.source_of(effect):
+        parts.append(f"<p><b>From a package:</b> {e(registry.source_of(effect))}.</p>")
     parts += [
         f"<p><b>Physics.</b> {e(effect.physics)}</p>",
         f"<p><b>The residual it cures.</b> {e(effect.signature)}</p>",
@@ -54,7 +69,7 @@ def effect_html(effect: Effect, available: bool = True) -> str:
         f"<p><b>Parameters</b></p><table cellspacing='0' cellpadding='2'>{rows}</table>",
         f"<p><b>Reference.</b> {e(effect.reference)}</p>",
     ]
-    if effect.notes:
+    if effect.notes and formula is None:        # an own effect's notes repeat its formula and file, said above
         parts.append(f"<p><b>Notes.</b> {e(effect.notes)}</p>")
     return "".join(parts)
 
@@ -62,12 +77,14 @@ def effect_html(effect: Effect, available: bool = True) -> str:
 class EffectCatalogue(QWidget):
     # The user changed the checked effects: their ids, in catalogue order.
     selection_changed = Signal(tuple)
+    new_effect_requested = Signal()     # "New effect…" was clicked
 
     def __init__(self, parent=None):
         super().__init__(parent)
         self._items: dict[str, QTreeWidgetItem] = {}
         self._by_category: dict[str, list[str]] = {}
         self._available: dict[str, bool] = {}
+        self._displacement = True          # whether the recording has Hx (effects that need it are greyed)
         self._updating = False
 
         self.tree = QTreeWidget()
@@ -85,26 +102,16 @@ class EffectCatalogue(QWidget):
         self.tree.setIndentation(10)
         self.tree.header().setStretchLastSection(True)
         self.tree.viewport().installEventFilter(self)
-        bold = QFont()
-        bold.setBold(True)
+        self._bold = QFont()
+        self._bold.setBold(True)
         for category, effects in categories().items():
-            head = QTreeWidgetItem([category_title(category)])
-            head.setFont(0, bold)
-            head.setFlags(Qt.ItemIsEnabled)
-            head.setToolTip(0, f"{category_title(category)}: at most one of these in a model")
-            self.tree.addTopLevelItem(head)
-            head.setFirstColumnSpanned(True)
-            self._by_category[category] = []
+            head = self._heading(category_title(category), f"{category_title(category)}: at most one of these in a model")
             for effect in effects:
-                item = QTreeWidgetItem([effect.id, effect.title])
-                item.setData(0, EFFECT_ROLE, effect)
-                item.setFlags(Qt.ItemIsEnabled | Qt.ItemIsSelectable | Qt.ItemIsUserCheckable)
-                item.setCheckState(0, Qt.Unchecked)
-                self._set_tooltip(item, f"{effect.title}. Cures: {effect.signature}")
-                head.addChild(item)
-                self._items[effect.id] = item
-                self._by_category[category].append(effect.id)
-                self._available[effect.id] = True
+                self._add_item(head, effect)
+        self.user_head = self._heading(USER_BRANCH, "Effects of your own: files in the user folder, --effects-file, "
+                                                    "packages; New effect… writes one")
+        self._problems: list[str] = []
+        self.refresh_user_effects()
         self.tree.expandAll()
         self.tree.itemChanged.connect(self.on_item_changed)
         self.tree.itemEntered.connect(self.on_item_entered)
@@ -115,14 +122,81 @@ class EffectCatalogue(QWidget):
         self.detail.setHtml(f"<p>{html.escape(HINT)}</p>")
 
         title = QLabel("<b>Effects</b> (one per category)")
+        self.new_effect_button = QPushButton("New effect…")
+        self.new_effect_button.setToolTip("Write an effect of your own: its formula, site and parameters, checked as "
+                                          "you type, previewed on this recording; saved to the user folder")
+        self.new_effect_button.clicked.connect(self.new_effect_requested)
+        header = QHBoxLayout()
+        header.addWidget(title, 1)
+        header.addWidget(self.new_effect_button)
         splitter = QSplitter(Qt.Vertical)
         splitter.addWidget(self.tree)
         splitter.addWidget(self.detail)
         splitter.setSizes([320, 420])     # the list needs ~300 px; the rest goes to the explanation
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(title)
+        layout.addLayout(header)
         layout.addWidget(splitter, 1)
+
+    # -- building ----------------------------------------------------------
+    def _heading(self, text: str, tooltip: str) -> QTreeWidgetItem:
+        head = QTreeWidgetItem([text])
+        head.setFont(0, self._bold)
+        head.setFlags(Qt.ItemIsEnabled)
+        head.setToolTip(0, tooltip)
+        self.tree.addTopLevelItem(head)
+        head.setFirstColumnSpanned(True)
+        return head
+
+    def _add_item(self, head: QTreeWidgetItem, effect: Effect) -> None:
+        item = QTreeWidgetItem([effect.id, effect.title])
+        item.setData(0, EFFECT_ROLE, effect)
+        item.setFlags(Qt.ItemIsEnabled | Qt.ItemIsSelectable | Qt.ItemIsUserCheckable)
+        item.setCheckState(0, Qt.Unchecked)
+        self._set_tooltip(item, f"{effect.title}. Cures: {effect.signature}")
+        head.addChild(item)
+        self._items[effect.id] = item
+        self._by_category.setdefault(effect.category, []).append(effect.id)
+        self._available[effect.id] = True
+
+    def set_problems(self, problems: list[str]) -> None:
+        """Effect files of the user folder that could not be read (one line each): said in the branch."""
+        self._problems = list(problems)
+        self.refresh_user_effects()
+
+    def refresh_user_effects(self) -> None:
+        """Rebuild the "User effects" branch from the registry (after a new effect was saved)."""
+        checked = set(self.checked())
+        self._updating = True
+        try:
+            for i in reversed(range(self.user_head.childCount())):
+                effect = self.user_head.child(i).data(0, EFFECT_ROLE)
+                self.user_head.removeChild(self.user_head.child(i))
+                if effect is not None:
+                    self._items.pop(effect.id, None)
+                    self._available.pop(effect.id, None)
+                    self._by_category[effect.category].remove(effect.id)
+            for effect in registry.user_effects():
+                self._add_item(self.user_head, effect)
+                self._items[effect.id].setCheckState(0, Qt.Checked if effect.id in checked else Qt.Unchecked)
+            if not registry.user_effects():
+                note = QTreeWidgetItem(["none yet", "New effect… writes one to the user folder"])
+                note.setFlags(Qt.ItemIsEnabled)
+                note.setForeground(0, QBrush(QColor(style.MISSING_TEXT)))
+                note.setForeground(1, QBrush(QColor(style.MISSING_TEXT)))
+                self._set_tooltip(note, f"The user folder: {registry.user_folder()}")
+                self.user_head.addChild(note)
+            if self._problems:
+                bad = QTreeWidgetItem([f"{len(self._problems)} file(s) not read", self._problems[0]])
+                bad.setFlags(Qt.ItemIsEnabled)
+                for column in (0, 1):
+                    bad.setForeground(column, QBrush(QColor(style.MISSING_TEXT)))
+                self._set_tooltip(bad, "\n".join(self._problems))
+                self.user_head.addChild(bad)
+            self.user_head.setExpanded(True)
+        finally:
+            self._updating = False
+        self.set_displacement_available(self._displacement)
 
     # -- state -------------------------------------------------------------
     def checked(self) -> tuple[str, ...]:
@@ -142,12 +216,13 @@ class EffectCatalogue(QWidget):
             self._updating = False
 
     def set_displacement_available(self, available: bool) -> None:
-        """Without Hx, effects on the displacement channel have nothing to act on: shown, but not checkable."""
+        """Without Hx, effects on the displacement channel (or needing Bl) cannot act: shown, but not checkable."""
+        self._displacement = available
         self._updating = True
         try:
             for effect_id, item in self._items.items():
                 effect: Effect = item.data(0, EFFECT_ROLE)
-                ok = available or effect.site is not Site.DISPLACEMENT
+                ok = available or not effect.needs_displacement
                 self._available[effect_id] = ok
                 flags = Qt.ItemIsEnabled | Qt.ItemIsSelectable | (Qt.ItemIsUserCheckable if ok else Qt.NoItemFlags)
                 item.setFlags(flags)

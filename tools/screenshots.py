@@ -16,7 +16,11 @@ measurement, and qa-measured.png, qa-limits.png, qa-invalid.png: the QA page on
 the measured driver, with limits, and on a recording whose current input was
 disconnected; then archive-list.png and archive-compare.png: the Archive page
 with a batch of drivers stored (and the wizard's measurement), four of them
-compared (--only archive: just these two, without the wizard's measurement).
+compared (--only archive: just these two, without the wizard's measurement);
+model-lab-new-effect-1280x720.png and -1920x1080.png: the "New effect…" dialog
+with the effect a recording lacks written in it (damping rising as sqrt(f)),
+and model-lab-own-effect-*.png: the lab once it is saved and checked, reduced
+chi^2 down to 1 (--only new-effect: just these).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
 """
@@ -297,6 +301,72 @@ def archive_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
     return written
 
 
+def rms_sqrt_f_recording(folder: Path) -> Path:
+    """The paper's driver whose damping rises as sqrt(f) (resources/effects/rms-sqrt-f.toml with r = Rms)."""
+    from analysis.effects.user import load_effect_file
+    driver = load_driver("paper")
+    model = driver.model()
+    model = model.with_effects(model.effects + (load_effect_file(ROOT / "resources" / "effects" / "rms-sqrt-f.toml"),))
+    values = {**driver.parameters, "r": driver.parameters["Bl"] ** 2 / driver.parameters["RES"]}
+    mt = design_multitone(48000, 16384, 5.0, 10000.0, rms=1.0)
+    recording = synthesize_recording(model, values, mt.waveform, mt.excited_bins, mt.sample_rate, 8, 1,
+                                     ChannelNoise(1e-4, 1e-4, 1e-8), seed=3,
+                                     driver={"name": "paper (synthetic, damping rising as sqrt(f))",
+                                             "sd_m2": driver.sd_m2})
+    wav, _ = write_recording(folder / "paper-rms-sqrt-f", recording)
+    return wav
+
+
+def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The user writes the missing effect in the "New effect…" dialog (its signature drawn over the misfit), saves
+    it, checks it: reduced chi^2 falls to 1. At 1280x720 and 1920x1080 each."""
+    from PySide6.QtCore import Qt
+    os.environ["LINPAR_EFFECTS"] = str(folder / "effects")      # the dialog saves there, not in the user's folder
+    window.open_path(rms_sqrt_f_recording(folder))
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the sqrt(f) damping recording was not analysed in time", file=sys.stderr)
+        return []
+    lab = window.model_lab
+    window.pages.setCurrentWidget(lab)
+    settle(app)
+    lab.catalogue.new_effect_button.click()
+    dialog = lab.new_effect_dialog
+    dialog.id_edit.setText("rms-sqrt-f")
+    dialog.title_edit.setText("Viscous damping rising with the square root of frequency")
+    dialog.site_combo.setCurrentIndex(dialog.site_combo.findData("mechanical"))
+    dialog.physics_edit.setPlainText("Air pumped through the spider and the surround adds damping that grows "
+                                     "with frequency.")
+    dialog.set_parameter(0, "r", "kg/s", "0.5", "-10", "10")
+    dialog.formula_edit.setText("r * (sqrt(w / ws) - 1)")
+    dialog.formula_edit.setFocus()
+    dialog.formula_edit.setCursorPosition(len(dialog.formula_edit.text()))
+    written = []
+    for width, height in SMALL_AND_LARGE:
+        dialog.resize(width, height)
+        settle(app, 600)
+        path = out / f"model-lab-new-effect-{width}x{height}.png"
+        dialog.grab().save(str(path))
+        written.append(path)
+    dialog.save_button.click()
+    settle(app)
+    item = lab.catalogue.item("rms-sqrt-f")
+    lab.catalogue.tree.setCurrentItem(item)
+    lab.catalogue.tree.scrollToItem(item)
+    item.setCheckState(0, Qt.Checked)
+    if not wait_for(lab.version_added, ANALYSIS_TIMEOUT_S):
+        print("screenshots: the refit with the new effect did not finish in time", file=sys.stderr)
+        return written
+    for width, height in SMALL_AND_LARGE:
+        window.resize(width, height)
+        settle(app, 600)
+        path = out / f"model-lab-own-effect-{width}x{height}.png"
+        window.grab().save(str(path))
+        written.append(path)
+    window.resize(*SIZE)
+    settle(app)
+    return written
+
+
 def model_lab_only(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     """--only model-lab: the lab's page as the Results page hands it over, then its two diagnosis sessions."""
     window.open_path(synthetic_recording(folder))
@@ -346,14 +416,17 @@ def settle(app: QApplication, ms: int = 300) -> None:
     app.processEvents()
 
 
+ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots}
+
+
 def main(argv: list[str]) -> int:
     only = None
     if "--only" in argv:
         at = argv.index("--only")
         only = argv[at + 1] if at + 1 < len(argv) else ""
         argv = argv[:at] + argv[at + 2:]
-        if only not in ("archive", "model-lab"):
-            print("screenshots: --only takes 'archive' or 'model-lab'", file=sys.stderr)
+        if only not in ONLY:
+            print(f"screenshots: --only takes {', '.join(repr(k) for k in ONLY)}", file=sys.stderr)
             return 2
     out = Path(argv[1]) if len(argv) > 1 else ROOT / "docs" / "screenshots"
     out.mkdir(parents=True, exist_ok=True)
@@ -368,8 +441,8 @@ def main(argv: list[str]) -> int:
         window.archive.set_root(folder / "archive")      # the wizard's measurement is stored there too
         window.resize(*SIZE)
         window.show()
-        if only in ("archive", "model-lab"):
-            written = (archive_screenshots if only == "archive" else model_lab_only)(app, window, folder, out)
+        if only is not None:
+            written = ONLY[only](app, window, folder, out)
             window.close()
             for path in written:
                 print(path)
@@ -408,6 +481,7 @@ def main(argv: list[str]) -> int:
             written.append(path)
         written += model_lab_screenshots(app, window, folder, out)
         written += model_lab_unexplained_screenshots(app, window, folder, out)
+        written += new_effect_screenshots(app, window, folder, out)
         written += measure_screenshots(app, window, folder, out)
         written += series_screenshots(app, window, folder, out)
         written += archive_screenshots(app, window, folder, out)

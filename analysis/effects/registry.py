@@ -118,28 +118,51 @@ def _entry_point_effects(taken: dict[str, str], ids: set[str]) -> list[Effect]:
     return found
 
 
-def load_user_effects(files: Sequence[str | Path] = (), folder: Path | None = None,
-                      packages: bool = True) -> tuple[Effect, ...]:
+def load_user_effects(files: Sequence[str | Path] = (), folder: Path | None = None, packages: bool = True,
+                      problems: list[str] | None = None) -> tuple[Effect, ...]:
     """Every effect of the user folder (default: user_folder()), of `files` and of installed packages.
 
-    Raises EffectFileError (one line naming the file) on the first that cannot be used. Nothing is
+    Raises EffectFileError (one line naming the file) on the first that cannot be used; with a `problems`
+    list (the GUI's way), its line is added there and the file is left out instead. Nothing is
     registered: pass the result to register().
     """
     taken, builtin_ids = _builtin_names()
     ids = set(builtin_ids)
     loaded: list[Effect] = []
     seen: set[Path] = set()
-    for path in [*_folder_files(user_folder() if folder is None else folder), *map(Path, files)]:
+
+    def attempt(load):
+        try:
+            return load()
+        except EffectFileError as exc:
+            if problems is None:
+                raise
+            problems.append(str(exc))
+            return None
+
+    paths = attempt(lambda: _folder_files(user_folder() if folder is None else folder)) or []
+    for path in [*paths, *map(Path, files)]:
         key = path.resolve() if path.exists() else path
         if key in seen:
             continue
         seen.add(key)
-        effect = load_effect_file(path, taken, frozenset(ids))
-        _claim(effect, str(path), taken, ids)
-        loaded.append(effect)
+        effect = attempt(lambda: load_effect_file(path, taken, frozenset(ids)))
+        if effect is not None:
+            _claim(effect, str(path), taken, ids)
+            loaded.append(effect)
     if packages:
-        loaded += _entry_point_effects(taken, ids)
+        loaded += attempt(lambda: _entry_point_effects(taken, ids)) or []
     return tuple(loaded)
+
+
+def taken_names() -> tuple[dict[str, str], frozenset[str]]:
+    """Parameter names (with their owner) and effect ids in use by the catalogue and the registered effects:
+    what a new effect must not reuse."""
+    taken, ids = _builtin_names()
+    for effect in _USER.values():
+        for p in effect.params:
+            taken.setdefault(p.name, f"{effect.id} ({source_of(effect)})")
+    return taken, ids | frozenset(_USER)
 
 
 def save_effect_file(text: str, effect_id: str, folder: Path | None = None) -> Path:
@@ -163,15 +186,6 @@ def is_user_effect(effect: Effect) -> bool:
     return isinstance(effect, UserEffect) or effect.id in _USER
 
 
-def parameter_owner(name: str) -> str | None:
-    """Who uses a parameter name already (the base model, the catalogue, a registered effect), or None."""
-    taken, _ = _builtin_names()
-    for effect in _USER.values():
-        for p in effect.params:
-            taken.setdefault(p.name, effect.id)
-    return taken.get(name)
-
-
 __all__ = ["ENTRY_POINT_GROUP", "FOLDER_ENV", "EffectFileError", "ParamSpec", "clear", "config_folder",
-           "is_user_effect", "load_user_effects", "parameter_owner", "register", "save_effect_file",
-           "source_of", "user_effects", "user_folder"]
+           "is_user_effect", "load_user_effects", "register", "save_effect_file",
+           "source_of", "taken_names", "user_effects", "user_folder"]

@@ -32,6 +32,7 @@ column) and what was expected.
 """
 from __future__ import annotations
 
+import json
 import keyword
 import math
 import re
@@ -260,3 +261,38 @@ def load_effect_file(path: str | Path, taken: dict[str, str] | None = None,
     except OSError as exc:
         raise EffectFileError(f"{source}: cannot be read ({exc.strerror or exc})") from None
     return effect_from_text(text, source, taken, known_ids)
+
+
+@dataclass(frozen=True)
+class ParameterEntry:
+    """One parameter as a form holds it: text, so that a wrong entry reaches the file's checks, not a crash."""
+
+    name: str
+    unit: str
+    start: str
+    min: str
+    max: str
+
+
+def _toml_value(text: str) -> str:
+    """A number as TOML writes it, or the text as a TOML string (which the reader then refuses as not a number)."""
+    try:
+        value = float(text)
+    except ValueError:
+        return json.dumps(text)
+    return repr(value) if math.isfinite(value) else json.dumps(text)
+
+
+def effect_file_text(effect_id: str, title: str, site: str, formula: str, physics: str,
+                     parameters: list[ParameterEntry], extra: dict[str, str] | None = None) -> str:
+    """The TOML text of an effect file from a form's fields (the inverse of effect_from_text).
+
+    JSON's string escapes are valid TOML basic strings, so every text goes through json.dumps.
+    """
+    lines = [f"id = {json.dumps(effect_id)}", f"title = {json.dumps(title)}", f"site = {json.dumps(site)}",
+             f"formula = {json.dumps(formula)}", f"physics = {json.dumps(physics)}"]
+    lines += [f"{key} = {json.dumps(value)}" for key, value in (extra or {}).items() if value]
+    for p in parameters:
+        lines += ["", f"[parameters.{json.dumps(p.name)}]", f"unit = {json.dumps(p.unit)}"]
+        lines += [f"{key} = {_toml_value(getattr(p, key))}" for key in ("start", "min", "max") if getattr(p, key).strip()]
+    return "\n".join(lines) + "\n"

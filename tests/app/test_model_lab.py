@@ -95,9 +95,10 @@ def _parameter(lab: ModelLab, name: str) -> float:
 def test_the_catalogue_groups_every_effect_by_category_and_explains_it(qtbot, lab):
     tree = lab.catalogue.tree
     grouped = categories()
-    assert tree.topLevelItemCount() == len(grouped)
+    assert tree.topLevelItemCount() == len(grouped) + 1          # and the branch of the user's own effects
+    assert tree.topLevelItem(len(grouped)).text(0) == "User effects"
     listed = {}
-    for i in range(tree.topLevelItemCount()):
+    for i in range(len(grouped)):
         head = tree.topLevelItem(i)
         listed[head.text(0)] = [head.child(j).data(0, EFFECT_ROLE).id for j in range(head.childCount())]
     assert sorted(sum(listed.values(), [])) == sorted(CATALOGUE)
