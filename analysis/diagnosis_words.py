@@ -96,7 +96,7 @@ def drift_from_validity(validity: dict | None) -> str | None:
 def _next_step(sites: tuple[SiteResult, ...]) -> str:
     name, what = SITE_WORDS[sites[0].site]
     return (f"Next: write an effect of your own at the {name} site ({what}) that follows the correction's "
-            "shape, and fit it.")
+            f"shape (site = \"{sites[0].key}\" in an effect file, or the Model lab's New effect…), and fit it.")
 
 
 def _flag_sentence(flags: Iterable[acceptance.Flag]) -> str:
