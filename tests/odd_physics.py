@@ -49,11 +49,13 @@ ODD: dict[str, OddEffect] = {
                        lambda f, p: 0.025 * bump(f, 400.0, 0.8) + 0.015j * np.tanh(np.log(f / 400.0))),
     "force-factor": _odd(Site.FORCE_FACTOR, "bl", "Bl dips by 0.6 % around 150 Hz with a 23 degree phase twist",
                          lambda f, p: 1.0 - 0.006 * bump(f, 150.0, 0.7) * np.exp(0.4j)),
-    # A hump of damping alone is no longer odd: damping-power (damping rising with frequency) takes most of
-    # it. With a dip of damping below the hump no reasonable law follows it.
-    "mechanical": _odd(Site.MECHANICAL, "zm", "a hump of 0.15 kg/s of damping at 250 Hz, a dip of 0.08 kg/s at "
-                                              "100 Hz, and 0.08 kg/s of reactance at 350 Hz added to Zm",
-                       lambda f, p: (0.15 * bump(f, 250.0, 0.9) - 0.08 * bump(f, 100.0, 0.4)
+    # A broad hump of damping is no longer odd: damping-power (damping rising with frequency) takes most of
+    # it. A narrower one, as odd as before, no reasonable law follows.
+    # A hump of damping alone is no longer odd: damping-power (damping rising with frequency above fs) takes
+    # most of it. With a dip of damping on its way up (150 Hz), no reasonable law follows it.
+    "mechanical": _odd(Site.MECHANICAL, "zm", "a hump of 0.15 kg/s of damping at 250 Hz with a dip of 0.06 kg/s "
+                                              "at 150 Hz, and 0.08 kg/s of reactance at 350 Hz added to Zm",
+                       lambda f, p: (0.15 * bump(f, 250.0, 0.9) - 0.06 * bump(f, 150.0, 0.7)
                                      + 0.08j * bump(f, 350.0, 0.8)) / p["Bl"] ** 2),
     "compliance": _odd(Site.COMPLIANCE, "cms", "the compliance dips by 3 % around 25 Hz, with a phase, and "
                                                "comes back below",

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from analysis.effects import get_effect, parse_effects, registry
+from analysis.effects import UnknownEffectError, get_effect, parse_effects, registry
 from analysis.effects.base import Site
 from analysis.effects.formula import FUNCTIONS, FormulaError, parse_formula
 from analysis.effects.user import EffectFileError, UserEffect, effect_from_text, load_effect_file
@@ -194,6 +194,11 @@ def test_an_id_of_the_catalogue_or_of_another_file_is_refused(tmp_path):
                                    packages=False)
 
 
+def test_an_effect_file_error_is_a_linpar_error():
+    from analysis.errors import LinparError
+    assert issubclass(EffectFileError, LinparError) and issubclass(EffectFileError, ValueError)
+
+
 def test_missing_unreadable_and_non_regular_files_get_one_line(tmp_path):
     for path, words in ((tmp_path / "nope.toml", "no such effect file"), (tmp_path, "not a regular file")):
         with pytest.raises(EffectFileError, match=words):
@@ -262,7 +267,7 @@ def test_without_LINPAR_EFFECTS_the_folder_is_in_the_platforms_configuration_fol
 
 
 def test_an_unknown_effect_says_how_to_load_ones_own():
-    with pytest.raises(KeyError, match="--effects-file"):
+    with pytest.raises(UnknownEffectError, match="--effects-file"):
         get_effect("rms-sqrt-f")
 
 
