@@ -215,7 +215,7 @@ class _StallWatch:
     def __init__(self, n_varying: int):
         self.window = STALL_ITERATIONS * (n_varying + 1)      # an iteration costs a Jacobian: n + 1 evaluations
         self.best = np.inf
-        self.best_params: lmfit.Parameters | None = None
+        self.best_values: dict[str, float] | None = None      # plain floats: copying Parameters costs a fit
         self.since = 0
         self.stalled = False
 
@@ -226,9 +226,15 @@ class _StallWatch:
         else:
             self.since += 1
         if chi2 < self.best:
-            self.best, self.best_params = chi2, params.copy()
+            self.best, self.best_values = chi2, {name: p.value for name, p in params.items()}
         self.stalled = self.since > self.window
         return self.stalled
+
+    def best_params(self, params: lmfit.Parameters) -> lmfit.Parameters:
+        best = params.copy()
+        for name, value in self.best_values.items():
+            best[name].value = value
+        return best
 
 
 def _minimize(model, params, data, use_x, sigmas, cancel,
@@ -255,9 +261,9 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
                                 max_nfev=per_parameter * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
-    if watch.stalled and watch.best_params is not None:
+    if watch.stalled and watch.best_values is not None:
         # Stopped where it had stopped improving: a short fit from its best point gives the covariance.
-        polish = lmfit.Minimizer(residual, watch.best_params, scale_covar=False, nan_policy="propagate")
+        polish = lmfit.Minimizer(residual, watch.best_params(params), scale_covar=False, nan_policy="propagate")
         polished = polish.minimize(method="leastsq", xtol=POLISH_TOLERANCE, ftol=POLISH_TOLERANCE,
                                    max_nfev=POLISH_PER_PARAMETER * (n_varying + 1))
         polished.nfev += result.nfev
