@@ -36,10 +36,10 @@ from analysis.sites import SiteResult, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
-# A candidate's refit gets fewer evaluations than a fit of one's choice: the right effect converges in a
-# few hundred (at most 100 per parameter on the recordings of tests/analysis/test_diagnosis.py and
-# test_new_physics.py), while one the data do not ask for wanders along its undetermined parameters, or
-# crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
+# A candidate's refit gets fewer evaluations than a fit of one's choice: every candidate the path takes
+# on the recordings of tests/analysis/test_diagnosis.py and test_new_physics.py needs at most 91 per
+# parameter (the closed box), while one the data do not ask for wanders along its undetermined parameters,
+# or crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
 CANDIDATE_EVALUATIONS_PER_PARAMETER = 120
 # Far from the data (reduced chi^2 above this) the current fit's parameters are bent: effects that bend
 # every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.

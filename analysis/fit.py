@@ -323,7 +323,8 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
     # Stage 1: Z alone. Creep barely shows in Z: hold it until Hx joins in.
     fixed = {"Bl"} | displacement_only | (compliance & cold if use_x else set())
     if cold - fixed:
-        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel, per_parameter)
+        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel,
+                      per_parameter)
         values = _values(r.params)
         nfev += r.nfev
         if compliance & cold and not use_x:

@@ -216,8 +216,8 @@ creep_rs = CreepRetardationSpectrum(
 )
 
 
-_FRACTIONAL_REFERENCE = ("W. King, F. T. Agerkvist, 'Fractional derivative loudspeaker models for nonlinear suspensions "
-                         "and voice coils', JAES 66(7/8), 525-536, 2018; R. L. Bagley, P. J. Torvik, 'On the "
+_FRACTIONAL_REFERENCE = ("W. King, F. T. Agerkvist, 'Fractional derivative loudspeaker models for nonlinear "
+                         "suspensions and voice coils', JAES 66(7/8), 525-536, 2018; R. L. Bagley, P. J. Torvik, 'On the "
                          "fractional calculus model of viscoelastic behavior', J. Rheology 30(1), 1986")
 
 
@@ -297,7 +297,8 @@ creep_zener = CreepZenerFractional(
     signature=("Displacement residual below fs that levels off at the lowest lines like creep-3p's, but spread "
                "over a wider band with a flatter phase bump in Hx than one retardation time gives."),
     typical="kappa 0.1 to 2, tau_r 1 to 100 ms, beta 0.3 to 0.8",
-    reference=_FRACTIONAL_REFERENCE + "; C. Zener, 'Elasticity and anelasticity of metals', 1948 (the standard linear solid)",
+    reference=(_FRACTIONAL_REFERENCE + "; C. Zener, 'Elasticity and anelasticity of metals', 1948 (the standard "
+               "linear solid)"),
     notes=("LCES is the compliance above the creep band. beta = 1 is creep-3p: prefer that when BIC says the extra "
            "parameter does not pay."),
 )

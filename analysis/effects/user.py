@@ -69,7 +69,8 @@ CHECK_FREQS = np.geomspace(1.0, 20e3, 200)
 CHECK_FS = 50.0
 UNITS_AT_SITE = {Site.BLOCKED: "ohm added to Ze", Site.FORCE_FACTOR: "a factor on Bl",
                  Site.MECHANICAL: "kg/s added to Zm", Site.COMPLIANCE: "a factor on Cms",
-                 Site.CURRENT: "a factor on the measured current", Site.DISPLACEMENT: "a factor on the measured displacement"}
+                 Site.CURRENT: "a factor on the measured current",
+                 Site.DISPLACEMENT: "a factor on the measured displacement"}
 
 
 @dataclass(frozen=True)
@@ -294,5 +295,6 @@ def effect_file_text(effect_id: str, title: str, site: str, formula: str, physic
     lines += [f"{key} = {json.dumps(value)}" for key, value in (extra or {}).items() if value]
     for p in parameters:
         lines += ["", f"[parameters.{json.dumps(p.name)}]", f"unit = {json.dumps(p.unit)}"]
-        lines += [f"{key} = {_toml_value(getattr(p, key))}" for key in ("start", "min", "max") if getattr(p, key).strip()]
+        lines += [f"{key} = {_toml_value(getattr(p, key))}" for key in ("start", "min", "max")
+                  if getattr(p, key).strip()]
     return "\n".join(lines) + "\n"
