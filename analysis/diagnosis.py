@@ -41,6 +41,7 @@ MAX_STEPS = 6
 # parameter (the closed box), while one the data do not ask for wanders along its undetermined parameters,
 # or crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
 CANDIDATE_EVALUATIONS_PER_PARAMETER = 120
+SCREENS_PER_TASK = 5
 # Far from the data (reduced chi^2 above this) the current fit's parameters are bent: effects that bend
 # every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.
 FAR_CHI2 = 100.0
@@ -170,18 +171,33 @@ def residual_context(data: FitData, current: FitResult) -> StartContext:
     return dataclasses.replace(ctx, **slopes)
 
 
+def _screen_starts(data: FitData, model: Model, starts: list[dict], vary: set[str]) -> FitResult | None:
+    """The best of short fits of `vary` alone from each of `starts` (None when none ran)."""
+    best = None
+    for start in starts:
+        try:
+            fit = screen_fit(data, model, start, vary)
+        except (FitError, ValueError, ArithmeticError):
+            continue
+        if best is None or fit.chi2 < best.chi2:
+            best = fit
+    return best
+
+
 def _best_starts(data: FitData, current: FitResult, moves, ctx, executor, cancel) -> dict[int, dict]:
     """For effects that ask for several start points (a narrow resonance), the most promising one.
 
-    Each start is screened by a short fit of the new effect's parameters
-    alone; only the best goes on to the full refit.
+    Each start is screened by a short fit of the new effect's parameters alone; only the best goes on
+    to the full refit. A few starts go to the pool as one task: one screen is a few milliseconds, about
+    what handing a task to a process costs.
     """
     calls, owners = [], []
     for index, (_, effect, _, model) in enumerate(moves):
-        starts = effect.starts(ctx)
+        starts = [{**current.values, **start} for start in effect.starts(ctx)]
         if len(starts) > 1:
-            for start in starts:
-                calls.append((screen_fit, (data, model, {**current.values, **start}, set(effect.param_names))))
+            for chunk in range(0, len(starts), SCREENS_PER_TASK):
+                calls.append((_screen_starts, (data, model, starts[chunk:chunk + SCREENS_PER_TASK],
+                                               set(effect.param_names))))
                 owners.append(index)
     best: dict[int, tuple[float, dict]] = {}
     for index, (fit, _) in zip(owners, _run(calls, executor, cancel)):
