@@ -10,6 +10,7 @@ from analysis.effects import UnknownEffectError, parse_effects
 from analysis.limits import LimitsError
 from analysis.model import ModelError
 from analysis.pipeline import AnalysisResult, analyze_path, result_json
+from app.cli_effects import cmd_effects
 from app.cli_json import dumps
 
 EXIT_QA_FAIL = 1
@@ -27,7 +28,6 @@ def dispatch(args: argparse.Namespace) -> int:
         from app.cli_diagnose import cmd_diagnose
         return cmd_diagnose(args)
     if args.command == "effects":
-        from app.cli_effects import cmd_effects
         return cmd_effects(args)
     raise AssertionError(f"unknown command {args.command!r}")     # the parser allows no other
 

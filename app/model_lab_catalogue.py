@@ -12,8 +12,8 @@ import html
 
 from PySide6.QtCore import QEvent, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QSplitter,
-                               QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
+                               QSplitter, QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.effects import Effect, categories, registry
 from app import style
@@ -126,6 +126,8 @@ class EffectCatalogue(QWidget):
         self.new_effect_button.setToolTip("Write an effect of your own: its formula, site and parameters, checked as "
                                           "you type, previewed on this recording; saved to the user folder")
         self.new_effect_button.clicked.connect(self.new_effect_requested)
+        # The title gives way before the button: the lab's left pane must not widen the window's minimum.
+        title.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
         header = QHBoxLayout()
         header.addWidget(title, 1)
         header.addWidget(self.new_effect_button)

@@ -359,6 +359,8 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
     for width, height in SMALL_AND_LARGE:
         window.resize(width, height)
         settle(app, 600)
+        lab.catalogue.tree.scrollToItem(item)          # the User effects branch, with the effect checked
+        settle(app)
         path = out / f"model-lab-own-effect-{width}x{height}.png"
         window.grab().save(str(path))
         written.append(path)

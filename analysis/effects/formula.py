@@ -31,6 +31,8 @@ from typing import Mapping, Union
 
 import numpy as np
 
+from analysis.errors import LinparError
+
 MAX_LENGTH = 500            # characters: enough for any lumped formula, and the tree stays shallow
 VARIABLES = ("s", "w", "f", "ws")
 CONSTANTS = {"j": 1j, "pi": np.pi}
@@ -45,8 +47,10 @@ _REFUSED_OPERATORS = {ast.BitXor: "'^' is not a power here: write ** (x**2)", as
                       ast.Mod: "'%' is not allowed", ast.MatMult: "'@' is not allowed"}
 
 
-class FormulaError(ValueError):
-    """A formula outside the language; `column` (1-based, in characters) says where, when known."""
+class FormulaError(LinparError, ValueError):
+    """A formula outside the language; `column` (1-based, in characters) says where, when known.
+
+    analysis.effects.user turns it into the effect file's one line (EffectFileError), naming the file."""
 
     def __init__(self, message: str, column: int | None = None):
         super().__init__(message)
