@@ -253,8 +253,8 @@ def _same_compliance_at_fs(current: FitResult, model: Model, start: dict) -> dic
     far from the data and can crawl for thousands of evaluations into a poor minimum.
     """
     s = np.array([2j * np.pi * resonance_frequency(current.values)])
-    before = abs(current.model.motional_compliance_factor(s, current.values)[0])
-    after = abs(model.motional_compliance_factor(s, start)[0])
+    before = abs(np.atleast_1d(current.model.motional_compliance_factor(s, current.values))[0])
+    after = abs(np.atleast_1d(model.motional_compliance_factor(s, start))[0])
     if not (np.isfinite(before) and np.isfinite(after) and after > 0):
         return start
     return {**start, "LCES": start["LCES"] * before / after}

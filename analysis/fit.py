@@ -19,6 +19,7 @@ that does not fit never claims the precision of one that does.
 """
 from __future__ import annotations
 
+import functools
 import keyword
 import threading
 from dataclasses import dataclass, field
@@ -180,6 +181,7 @@ def _lm_name(name: str) -> str:
     return name + "_" if keyword.iskeyword(name) else name
 
 
+@functools.lru_cache(maxsize=None)
 def _our_name(lm_name: str) -> str:
     base = lm_name[:-1]
     return base if lm_name.endswith("_") and keyword.iskeyword(base) else lm_name
@@ -243,7 +245,7 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
         r = _residual_vector(model, _values(prm), data, use_x, sigmas)
         # A parameter set where the model is undefined is simply very bad:
         # a fixed size keeps MINPACK's bookkeeping intact.
-        return np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
+        return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
 
     n_varying = sum(1 for p in params.values() if p.vary)
     watch = _StallWatch(n_varying)

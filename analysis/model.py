@@ -16,7 +16,7 @@ g in Hx; with g = 1 Hx is the textbook ZR / (ZR + Ze) / (Bl*s).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -49,8 +49,11 @@ class Model:
 
     effects: tuple[Effect, ...] = ()
     with_displacement: bool = True
+    # The effects at each site, worked out once: a fit evaluates the model tens of thousands of times.
+    _by_site: dict = field(init=False, repr=False, compare=False, default_factory=dict)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "_by_site", {site: tuple(e for e in self.effects if e.site is site) for site in Site})
         seen_categories: dict[str, str] = {}
         seen_names = {p.name for p in self.base_params}
         for effect in self.effects:
@@ -93,8 +96,8 @@ class Model:
     def with_effects(self, effects: Iterable[Effect]) -> "Model":
         return Model(tuple(effects), self.with_displacement)
 
-    def _site(self, site: Site) -> list[Effect]:
-        return [e for e in self.effects if e.site is site]
+    def _site(self, site: Site) -> tuple[Effect, ...]:
+        return self._by_site[site]
 
     def blocked_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
         Ze = p["RE"] + s * p["LE"]
@@ -102,9 +105,9 @@ class Model:
             Ze = Ze + effect.response(s, p)
         return Ze
 
-    def motional_compliance_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
-        """c(s): the product of the compliance-site factors (1 without any)."""
-        compliance = np.ones_like(s)
+    def motional_compliance_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray | float:
+        """c(s): the product of the compliance-site factors (1.0 without any)."""
+        compliance = 1.0
         for effect in self._site(Site.COMPLIANCE):
             compliance = compliance * effect.response(s, p)
         return compliance
@@ -121,8 +124,8 @@ class Model:
         effects = self._site(Site.FORCE_FACTOR)
         if not effects:
             return None
-        g = np.ones_like(s)
-        for effect in effects:
+        g = effects[0].response(s, p)
+        for effect in effects[1:]:
             g = g * effect.response(s, p)
         return g
 
