@@ -30,6 +30,7 @@ import numpy as np
 
 from analysis.effects.base import Site
 from analysis.errors import LinparError
+from analysis.fit_stall import StallWatch
 from analysis.model import Model
 from analysis.spectra import Spectra, TransferFunction
 from analysis.startvalues import linear_gain, start_context
@@ -200,45 +201,6 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
     return {_our_name(name): p.value for name, p in params.items()}
 
 
-# A fit whose chi^2 has not dropped by more than STALL_CHI2 (in noise units) and STALL_RELATIVE of itself
-# over STALL_ITERATIONS iterations has stopped: it wanders along a direction the data do not determine
-# (an effect that is not there) or crawls along a parameter held at its bound, which MINPACK's own tests
-# can follow for thousands of evaluations. At that pace halving chi^2 would take 10^5 iterations.
-STALL_CHI2 = 1e-3
-STALL_RELATIVE = 1e-5
-STALL_ITERATIONS = 10
-POLISH_TOLERANCE = 1e-8        # the short fit from a stalled fit's best point, for its covariance
-POLISH_PER_PARAMETER = 20
-
-
-class _StallWatch:
-    """Counts the evaluations since chi^2 last improved by more than STALL_CHI2; keeps the best point."""
-
-    def __init__(self, n_varying: int):
-        self.window = STALL_ITERATIONS * (n_varying + 1)      # an iteration costs a Jacobian: n + 1 evaluations
-        self.best = np.inf
-        self.best_values: dict[str, float] | None = None      # plain floats: copying Parameters costs a fit
-        self.since = 0
-        self.stalled = False
-
-    def seen(self, params: lmfit.Parameters, residual: np.ndarray) -> bool:
-        chi2 = float(np.dot(residual, residual))
-        if chi2 < self.best - max(STALL_CHI2, STALL_RELATIVE * self.best):
-            self.since = 0
-        else:
-            self.since += 1
-        if chi2 < self.best:
-            self.best, self.best_values = chi2, {name: p.value for name, p in params.items()}
-        self.stalled = self.since > self.window
-        return self.stalled
-
-    def best_params(self, params: lmfit.Parameters) -> lmfit.Parameters:
-        best = params.copy()
-        for name, value in self.best_values.items():
-            best[name].value = value
-        return best
-
-
 def _minimize(model, params, data, use_x, sigmas, cancel,
               per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
     def residual(prm):
@@ -248,7 +210,7 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
         return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
 
     n_varying = sum(1 for p in params.values() if p.vary)
-    watch = _StallWatch(n_varying)
+    watch = StallWatch(n_varying)
 
     def iteration(prm, it, resid, *args, **kws):
         if cancel is not None and cancel.is_set():
@@ -263,15 +225,8 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
                                 max_nfev=per_parameter * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
-    if watch.stalled and watch.best_values is not None:
-        # Stopped where it had stopped improving: a short fit from its best point gives the covariance.
-        polish = lmfit.Minimizer(residual, watch.best_params(params), scale_covar=False, nan_policy="propagate")
-        polished = polish.minimize(method="leastsq", xtol=POLISH_TOLERANCE, ftol=POLISH_TOLERANCE,
-                                   max_nfev=POLISH_PER_PARAMETER * (n_varying + 1))
-        polished.nfev += result.nfev
-        if polished.covar is not None or polished.chisqr <= watch.best:
-            result = polished
-    return result
+    # Stopped where it had stopped improving (analysis.fit_stall): polished from its best point.
+    return watch.polished(residual, params, result)
 
 
 def start_values(model: Model, data: FitData) -> dict[str, float]:
