@@ -21,7 +21,7 @@ import uncertainties
 from uncertainties import umath
 
 from analysis.fit import FitResult
-from analysis.lumped import C_SOUND, RHO  # noqa: F401  (air at 20 C: kept where effects can use them too)
+from analysis.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
 
 P_REF = 20e-6     # Pa
 V_283 = 2.83      # V, the customary sensitivity drive (1 W into 8 ohm)

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.recording import Recording
-from analysis.spectra import Spectra, _displacement_noise_factor, _transfer, period_spectra
+from analysis.spectra import Spectra, displacement_noise_factor, period_spectra, transfer_from_periods
 
 COPPER_PER_K = 0.00393
 # The rise must stand this many standard errors above zero (and above MIN_RISE_K) to be reported and
@@ -115,11 +115,11 @@ def without_heating(recording: Recording, spectra: Spectra, heating: CoilHeating
     shift = (heating.re_periods - heating.re_fit)[:, None]
     u, i = periods["voltage"], periods["current"]
     excited = spectra.excited_bins
-    impedance = _transfer("impedance", "ohm", u - shift * i, i, excited, spectra.bin_width)
+    impedance = transfer_from_periods("impedance", "ohm", u - shift * i, i, excited, spectra.bin_width)
     displacement = spectra.displacement
     if displacement is not None and "displacement" in periods:
         in_band = np.isin(excited, displacement.bins)
         x = periods["displacement"] * (1.0 + shift / impedance.value[in_band])
-        displacement = _transfer("displacement", "m/V", x, u[:, in_band], displacement.bins, spectra.bin_width,
-                                 _displacement_noise_factor(recording))
+        displacement = transfer_from_periods("displacement", "m/V", x, u[:, in_band], displacement.bins,
+                                             spectra.bin_width, displacement_noise_factor(recording))
     return dataclasses.replace(spectra, impedance=impedance, displacement=displacement)

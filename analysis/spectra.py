@@ -31,7 +31,7 @@ ANALYSED_SIGNALS = ("voltage", "current", "displacement")
 # within this range of the strongest line (for recordings without excited_bins).
 DETECT_SNR_DB = 20.0
 DETECT_RANGE_DB = 60.0
-# Degrees of freedom each line's noise estimate should rest on (see _transfer).
+# Degrees of freedom each line's noise estimate should rest on (see transfer_from_periods).
 MIN_NOISE_DOF = 40
 
 
@@ -143,8 +143,8 @@ def _pooled(var: np.ndarray, window: int) -> np.ndarray:
     return np.convolve(padded, kernel, mode="valid") / window
 
 
-def _transfer(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.ndarray,
-              bin_width: float, noise_factor: float = 1.0) -> TransferFunction:
+def transfer_from_periods(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.ndarray,
+                          bin_width: float, noise_factor: float = 1.0) -> TransferFunction:
     """num / den at `bins` from per-period spectra (P x lines) with the propagated uncertainty.
 
     The variance of each line is estimated from only P periods. Its
@@ -169,7 +169,7 @@ def _transfer(name: str, unit: str, num: np.ndarray, den: np.ndarray, bins: np.n
     return TransferFunction(name, unit, bins * bin_width, bins, value, np.sqrt(var))
 
 
-def _displacement_noise_factor(recording: Recording) -> float:
+def displacement_noise_factor(recording: Recording) -> float:
     """How much the displacement's noise exceeds the scatter between periods, for the laser samples left
     out of the average (capture.laser_gaps, instruments/measurement/laser_gaps.py); 1 without gaps."""
     capture = recording.extra.get("capture") if recording.extra else None
@@ -221,7 +221,7 @@ def estimate_spectra(recording: Recording) -> Spectra:
 
     u = per_period["voltage"][:, excited]
     i = per_period["current"][:, excited]
-    impedance = _transfer("impedance", "ohm", u, i, excited, bin_width)
+    impedance = transfer_from_periods("impedance", "ohm", u, i, excited, bin_width)
     displacement = None
     if "displacement" in per_period:
         # A serial laser samples slower than the sound card: the sidecar's
@@ -229,7 +229,7 @@ def estimate_spectra(recording: Recording) -> Spectra:
         max_hz = _displacement_max_hz(recording)
         x_lines = excited if max_hz is None else excited[excited * bin_width <= max_hz]
         in_band = np.isin(excited, x_lines)
-        displacement = _transfer("displacement", "m/V", per_period["displacement"][:, x_lines],
-                                 u[:, in_band], x_lines, bin_width, _displacement_noise_factor(recording))
+        displacement = transfer_from_periods("displacement", "m/V", per_period["displacement"][:, x_lines],
+                                             u[:, in_band], x_lines, bin_width, displacement_noise_factor(recording))
     return Spectra(recording.sample_rate, n, recording.n_periods, excited, unexcited,
                    channels, impedance, displacement)

@@ -51,6 +51,16 @@ START_Q2 = 3.0      # broad enough to overlap a mode some way off, sharpened by 
 START_MU2 = 0.1
 
 
+def upper_band_grid(ctx, ratio: float) -> list[float] | None:
+    """Frequencies from 2*fs to just below the top line, `ratio` apart, where a mode's search starts;
+    None when the band holds no such span."""
+    lo, hi = 2.0 * ctx.fs, ctx.f_max / 1.2
+    if hi <= lo:
+        return None
+    n = int(np.ceil(np.log(hi / lo) / np.log(ratio))) + 1
+    return [float(f) for f in np.geomspace(lo, hi, n)]
+
+
 @dataclass(frozen=True)
 class Breakup(Effect):
     """Y2(s) = -mu2*CMES * s^3 / (s^2 + s*w2/Q2 + w2^2), w2 = 2*pi*f2, added to Y = Zm/Bl^2.
@@ -70,11 +80,10 @@ class Breakup(Effect):
 
     def starts(self, ctx) -> list[dict[str, float]]:
         """Start values stepping f2 across the band, for a search that keeps the lowest chi^2."""
-        lo, hi = 2.0 * ctx.fs, ctx.f_max / 1.2
-        if hi <= lo:
+        grid = upper_band_grid(ctx, START_GRID_RATIO)
+        if grid is None:
             return [self.guess(ctx)]
-        n = int(np.ceil(np.log(hi / lo) / np.log(START_GRID_RATIO))) + 1
-        return [{"f2": float(f2), "Q2": START_Q2, "mu2": START_MU2} for f2 in np.geomspace(lo, hi, n)]
+        return [{"f2": f2, "Q2": START_Q2, "mu2": START_MU2} for f2 in grid]
 
 
 breakup = Breakup(
@@ -191,11 +200,10 @@ class CoilDecoupling(Effect):
 
     def starts(self, ctx) -> list[dict[str, float]]:
         """f_c stepped an octave at a time from 2*fs to just below the top line."""
-        lo, hi = 2.0 * ctx.fs, ctx.f_max / 1.2
-        if hi <= lo:
+        grid = upper_band_grid(ctx, COIL_GRID_RATIO)
+        if grid is None:
             return [self.guess(ctx)]
-        n = int(np.ceil(np.log(hi / lo) / np.log(COIL_GRID_RATIO))) + 1
-        return [{"f_c": float(f), "Q_c": START_Q2, "mu_c": COIL_SHARE_START} for f in np.geomspace(lo, hi, n)]
+        return [{"f_c": f, "Q_c": START_Q2, "mu_c": COIL_SHARE_START} for f in grid]
 
 
 breakup_coil = CoilDecoupling(

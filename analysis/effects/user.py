@@ -180,7 +180,7 @@ def _parameter(name: str, table, source: str, taken: dict[str, str]) -> ParamSpe
                 or not pair[0] < pair[1]):
             raise _fail(source, f"{where}.typical", "expected [low, high], two finite numbers, low < high")
         typical = (float(pair[0]), float(pair[1]))
-    description = table.get("description", f"parameter of the user effect's formula")
+    description = table.get("description", "parameter of the user effect's formula")
     if not isinstance(description, str):
         raise _fail(source, f"{where}.description", "expected a string")
     unit = unit.strip()
