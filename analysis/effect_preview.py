@@ -30,6 +30,14 @@ def with_effect(model: Model, effect: Effect) -> Model:
     return model.with_effects(kept + (effect,))
 
 
+def channel_misfit(channel) -> np.ndarray:
+    """measured / model - 1 of a fitted channel: complex, or of the sizes alone for a magnitude-only channel."""
+    with np.errstate(all="ignore"):
+        if channel.has_phase:
+            return channel.measured / channel.model - 1.0
+        return np.abs(channel.measured) / np.abs(channel.model) - 1.0
+
+
 def signature(fit: FitResult, effect: Effect) -> tuple[ChannelSignature, ...]:
     """Each channel of `fit` with the change `effect` makes at its start values, and the misfit left."""
     model = with_effect(fit.model, effect)
@@ -40,6 +48,5 @@ def signature(fit: FitResult, effect: Effect) -> tuple[ChannelSignature, ...]:
         with np.errstate(all="ignore"):
             changed = model.impedance(s, values) if name == "impedance" else model.displacement(s, values)
             change = changed / ch.model - 1.0
-            misfit = ch.measured / ch.model - 1.0 if ch.has_phase else np.abs(ch.measured) / np.abs(ch.model) - 1.0
-        out.append(ChannelSignature(name, ch.freqs, change, misfit))
+        out.append(ChannelSignature(name, ch.freqs, change, channel_misfit(ch)))
     return tuple(out)

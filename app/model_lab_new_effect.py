@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (QComboBox, QDialog, QDialogButtonBox, QFormLayout
                                QLineEdit, QPlainTextEdit, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout,
                                QWidget)
 
-from analysis.effect_preview import signature
+from analysis.effect_preview import channel_misfit, signature
 from analysis.effects import registry
 from analysis.effects.base import SITE_KEYS, Site
 from analysis.effects.formula import FUNCTIONS
@@ -29,8 +29,7 @@ from analysis.effects.user import (UNITS_AT_SITE, EffectFileError, ParameterEntr
 from analysis.fit import FitResult
 from analysis.model import ModelError
 from app import style
-from app.grid_axis import show_grid
-from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
+from app.plots import LogFrequencyAxis, style_plot
 
 CHECK_DELAY_MS = 200            # a pause in typing, then the check
 SOURCE = "the new effect"       # how the checks name the form (their lines start with it)
@@ -49,13 +48,9 @@ class SignaturePlot(pg.PlotWidget):
     def __init__(self, channel: str, parent=None):
         super().__init__(parent=parent, axisItems={"bottom": LogFrequencyAxis("bottom")})
         plot = self.getPlotItem()
-        plot.setLogMode(x=True, y=False)
-        show_grid(plot)
+        style_plot(plot, "change of size (%)", bottom="frequency (Hz)")
         plot.setMenuEnabled(False)
-        plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
         plot.getAxis("left").enableAutoSIPrefix(False)
-        plot.setLabel("left", "change of size (%)")
-        plot.setLabel("bottom", "frequency (Hz)")
         plot.setTitle(f"{CHANNEL_TITLES.get(channel, channel)}: <span style='color:{MISFIT_COLOUR}'>● misfit now</span>"
                       f" &nbsp; <span style='color:{CHANGE_COLOUR}'>━ the new effect at its start values</span>",
                       size="9pt")
@@ -66,7 +61,8 @@ class SignaturePlot(pg.PlotWidget):
         plot.addItem(self.misfit)
         plot.addItem(self.change)
 
-    def show(self, freqs: np.ndarray, misfit: np.ndarray, change: np.ndarray | None) -> None:
+    def draw(self, freqs: np.ndarray, misfit: np.ndarray, change: np.ndarray | None) -> None:
+        """The misfit left and the effect's change (None: not drawn), as changes of size in %."""
         size = lambda x: 100.0 * (np.abs(1.0 + x) - 1.0)
         self.misfit.setData(freqs, size(misfit))
         self.change.setData(freqs, size(change) if change is not None else np.full(len(freqs), np.nan),
@@ -231,8 +227,7 @@ class NewEffectDialog(QDialog):
             channels = None
         if channels is None:
             for name, ch in self.fit.channels.items():
-                self.plots[name].show(ch.freqs, ch.measured / ch.model - 1.0 if ch.has_phase else
-                                      np.abs(ch.measured) / np.abs(ch.model) - 1.0, None)
+                self.plots[name].draw(ch.freqs, channel_misfit(ch), None)
             if effect is None:
                 self.preview_note.setText("The misfit of the current version; the new effect's change is drawn "
                                           "over it once the form reads as a valid effect.")
@@ -240,7 +235,7 @@ class NewEffectDialog(QDialog):
         self.preview_note.setText(f"What {effect.id} changes at its start values (the rest at the current version's "
                                   f"fit, {self.fit.model.describe()}), over the misfit that version leaves.")
         for ch in channels:
-            self.plots[ch.channel].show(ch.freqs, ch.misfit, ch.change)
+            self.plots[ch.channel].draw(ch.freqs, ch.misfit, ch.change)
 
     # -- buttons -------------------------------------------------------------
     @Slot()
