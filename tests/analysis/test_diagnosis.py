@@ -13,9 +13,8 @@ from analysis.diagnosis import diagnose
 from analysis.effects import parse_effects
 from analysis.fit import FitData
 from analysis.model import Model
-from analysis.parallel import fit_executor
 from analysis.spectra import estimate_spectra
-from tests.builders import PAPER, TYPICAL_NOISE, multitone, recording
+from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 BASE = "lr2,creep-log"
 
@@ -46,17 +45,6 @@ CASES = [
 
 # The stages of LR-3 are interchangeable: compare them as a set.
 EXCHANGEABLE = {("L2", "R2"): ("L3", "R3")}
-
-
-@pytest.fixture(scope="module")
-def pool():
-    with fit_executor() as executor:
-        yield executor
-
-
-@pytest.fixture(scope="module")
-def mt():
-    return multitone()
 
 
 def _truth(effects: str, values: dict) -> dict:

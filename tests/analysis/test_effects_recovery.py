@@ -13,7 +13,7 @@ from analysis.fit import FitData, fit_model
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from analysis.startvalues import start_context
-from tests.builders import PAPER, TYPICAL_NOISE, multitone, recording
+from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 CASES = {
     "lr2": {},
@@ -47,11 +47,6 @@ IMPEDANCE_ONLY = ("lr2", "lr3", "leach", "wright", "delay-current", "lowpass-cur
 SEED = 7
 MAX_Z = 4.0
 MAX_CHI2_RED = 1.5
-
-
-@pytest.fixture(scope="module")
-def mt():
-    return multitone()
 
 
 def _case(effect_id, with_displacement):

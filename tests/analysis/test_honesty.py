@@ -16,7 +16,6 @@ from analysis.diagnosis import diagnose
 from analysis.effects import get_effect, parse_effects
 from analysis.fit import FitData, FitResult
 from analysis.model import Model
-from analysis.parallel import fit_executor
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER
 from tests.odd_physics import ODD, odd_recording
@@ -24,12 +23,6 @@ from tests.odd_physics import ODD, odd_recording
 DEFAULT = "lr2,creep-log"
 COMPARED = ("RE", "LE", "Bl", "Mms", "Cms", "Kms", "Rms", "fs", "Qms", "Qes", "Qts", "Vas")
 SD = 0.0133
-
-
-@pytest.fixture(scope="module")
-def pool():
-    with fit_executor() as executor:
-        yield executor
 
 
 def _truth_table() -> dict:

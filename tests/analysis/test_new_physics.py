@@ -15,9 +15,8 @@ from analysis.diagnosis import diagnose
 from analysis.effects import parse_effects
 from analysis.fit import FitData
 from analysis.model import Model
-from analysis.parallel import fit_executor
 from analysis.spectra import estimate_spectra
-from tests.builders import PAPER, TYPICAL_NOISE, multitone, recording
+from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 START = "lr2,creep-log"
 
@@ -38,17 +37,6 @@ CASES = [
     ("breakup-coil", "lr2,creep-log,breakup-coil", {"f_c": 3000.0, "Q_c": 5.0, "mu_c": 0.25}, 21),
     ("breakup-coil", "lr2,creep-log,breakup-coil", {"f_c": 1500.0, "Q_c": 8.0, "mu_c": 0.3}, 22),
 ]
-
-
-@pytest.fixture(scope="module")
-def pool():
-    with fit_executor() as executor:
-        yield executor
-
-
-@pytest.fixture(scope="module")
-def mt():
-    return multitone()
 
 
 def _mechanical(v: dict) -> dict:
