@@ -83,13 +83,9 @@ def hidden_delay_recording(folder: Path) -> Path:
 
 def model_lab_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     """The Model lab diagnosing a missing effect: before and after applying the top candidate."""
-    window.open_path(hidden_delay_recording(folder))
-    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
-        print("screenshots: the laser-late recording was not analysed in time", file=sys.stderr)
+    if not open_in_lab(app, window, hidden_delay_recording(folder), "laser-late"):
         return []
     lab = window.model_lab
-    window.pages.setCurrentWidget(lab)
-    settle(app)
     lab.candidates.diagnose_button.click()
     if not wait_for(lab.diagnosis_shown, ANALYSIS_TIMEOUT_S):
         print("screenshots: the diagnosis did not finish in time", file=sys.stderr)
@@ -114,13 +110,9 @@ def odd_mechanical_recording(folder: Path) -> Path:
 def model_lab_unexplained_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     """The Model lab following the greedy path on physics the catalogue lacks: it ends "unexplained", pointing
     at the mechanical site, with that site's correction plotted; at 1280x720 and at 1920x1080."""
-    window.open_path(odd_mechanical_recording(folder))
-    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
-        print("screenshots: the odd-damping recording was not analysed in time", file=sys.stderr)
+    if not open_in_lab(app, window, odd_mechanical_recording(folder), "odd-damping"):
         return []
     lab = window.model_lab
-    window.pages.setCurrentWidget(lab)
-    settle(app)
     lab.candidates.follow_button.click()
     if not wait_for(lab.diagnosis_shown, ANALYSIS_TIMEOUT_S):
         print("screenshots: the diagnosis of the odd-damping recording did not finish in time", file=sys.stderr)
@@ -322,13 +314,9 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
     it, checks it: reduced chi^2 falls to 1. At 1280x720 and 1920x1080 each."""
     from PySide6.QtCore import Qt
     os.environ["LINPAR_EFFECTS"] = str(folder / "effects")      # the dialog saves there, not in the user's folder
-    window.open_path(rms_sqrt_f_recording(folder))
-    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
-        print("screenshots: the sqrt(f) damping recording was not analysed in time", file=sys.stderr)
+    if not open_in_lab(app, window, rms_sqrt_f_recording(folder), "sqrt(f) damping"):
         return []
     lab = window.model_lab
-    window.pages.setCurrentWidget(lab)
-    settle(app)
     lab.catalogue.new_effect_button.click()
     dialog = lab.new_effect_dialog
     dialog.id_edit.setText("rms-sqrt-f")
@@ -371,17 +359,24 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
 
 def model_lab_only(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     """--only model-lab: the lab's page as the Results page hands it over, then its two diagnosis sessions."""
-    window.open_path(synthetic_recording(folder))
-    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
-        print("screenshots: the synthetic recording was not analysed in time", file=sys.stderr)
+    if not open_in_lab(app, window, synthetic_recording(folder), "synthetic"):
         return []
-    window.pages.setCurrentWidget(window.model_lab)
-    settle(app)
     written = [out / "model-lab.png"]
     window.grab().save(str(written[0]))
     written += model_lab_screenshots(app, window, folder, out)
     written += model_lab_unexplained_screenshots(app, window, folder, out)
     return written
+
+
+def open_in_lab(app: QApplication, window, wav: Path, what: str) -> bool:
+    """Open a recording and show the Model lab once it is analysed; False (said on stderr) if it was not in time."""
+    window.open_path(wav)
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        print(f"screenshots: the {what} recording was not analysed in time", file=sys.stderr)
+        return False
+    window.pages.setCurrentWidget(window.model_lab)
+    settle(app)
+    return True
 
 
 def wait_for_click(button, busy_changed, timeout_s: float = ANALYSIS_TIMEOUT_S) -> bool:
