@@ -118,3 +118,50 @@ def test_shapes_that_cannot_be_simulated_are_refused(kwargs, words):
 def test_values_without_the_electrical_analogues_are_refused():
     with pytest.raises(ValueError, match="RES"):
         NonlinearBlockDriver({k: v for k, v in PAPER.parameters.items() if k != "RES"}, FS)
+
+
+# --- the terms a large-signal identification claims: L2(x), Le(i), Rms(v); and the substeps -------------------
+
+ALL_TERMS = dict(bl_poly=(-30.0, -1e4), kms_poly=(40.0, 5e4), le_poly=(-10.0,), l2_poly=(-30.0, 2e3),
+                 le_i_poly=(0.0, -0.003), rms_v2=0.1, i_range_a=5.0, x_range_m=0.008)
+
+
+def _sine_period(driver, k, amplitude, n=4096, periods=6):
+    driver.reset()
+    u = amplitude * np.sin(2 * np.pi * k * np.arange(n) / n)
+    block = driver.process(np.tile(u, periods))
+    return u, block.current[-n:], block.displacement[-n:]
+
+
+def test_with_flat_curves_and_substeps_it_is_still_the_linear_model():
+    driver = NonlinearBlockDriver(PAPER.parameters, FS, bl_poly=(), kms_poly=(), le_poly=(), fir_length=N,
+                                  substeps=4)
+    current, displacement = _steady(driver, 10.0)
+    ref = steady_state_period(PAPER.model(), PAPER.parameters, MT.scaled(rms=10.0).waveform, MT.excited_bins, FS)
+    np.testing.assert_allclose(current, ref["current"], atol=1e-9 * np.max(np.abs(ref["current"])))
+    np.testing.assert_allclose(displacement, ref["displacement"], atol=1e-9 * np.max(np.abs(ref["displacement"])))
+
+
+@pytest.mark.parametrize("term", [{"l2_poly": (-30.0, 2e3)}, {"le_i_poly": (0.0, -0.003)}, {"rms_v2": 0.1}])
+def test_each_new_term_changes_the_large_signal_and_not_the_small_signal(term):
+    common = dict(fir_length=N, i_range_a=5.0, le_poly=(-10.0,), x_range_m=0.008)
+    plain = NonlinearBlockDriver(PAPER.parameters, FS, **common)
+    other = NonlinearBlockDriver(PAPER.parameters, FS, **common, **term)
+    for rms, changed in ((1e-3, False), (8.0, True)):
+        a, b = _steady(plain, rms)[0], _steady(other, rms)[0]
+        deviation = np.max(np.abs(a - b)) / np.max(np.abs(a))
+        assert (deviation > 1e-4) == changed, (term, rms, deviation)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"l2_poly": (-30.0,), "values": "no LR-2"}, "eddy branch"),
+    ({"le_i_poly": (0.0, -0.05), "i_range_a": 10.0}, "incremental inductance"),
+    ({"substeps": 0}, "substeps"),
+    ({"rms_v2": -1.0}, "rms_v2"),
+])
+def test_new_terms_that_cannot_be_simulated_are_refused(kwargs, words):
+    values = dict(PAPER.parameters)
+    if kwargs.pop("values", None):
+        values = {k: v for k, v in values.items() if k not in ("L2", "R2")}
+    with pytest.raises(ValueError, match=words):
+        NonlinearBlockDriver(values, FS, fir_length=N, **kwargs)
