@@ -153,6 +153,24 @@ def test_each_new_term_changes_the_large_signal_and_not_the_small_signal(term):
         assert (deviation > 1e-4) == changed, (term, rms, deviation)
 
 
+def test_the_time_steps_agree_with_the_periodic_steady_state_of_the_same_equations():
+    """Two solvers of the module's equations, written apart: this ETD2 stepper and analysis.large_signal's
+    harmonic balance. Every term on; H2 and H3 of current and displacement, and the cone's mean shift."""
+    from analysis.large_signal.simulate import steady_state
+    from tests.large_signal_truth import truth_model
+    no_creep = {k: v for k, v in PAPER.parameters.items() if k != "lambda"}     # see truth_model
+    driver = NonlinearBlockDriver(no_creep, FS, fir_length=4096, substeps=4, **ALL_TERMS)
+    model = truth_model(driver)
+    for k, amplitude in ((2, 5.0), (4, 8.0), (20, 10.0)):
+        u, current, displacement = _sine_period(driver, k, amplitude)
+        periodic = steady_state(model, u, FS)
+        for measured, solved in ((current, periodic.current), (displacement, periodic.displacement)):
+            a, b = np.abs(np.fft.rfft(measured)), np.abs(np.fft.rfft(solved))
+            for h in (2, 3):
+                assert 20 * np.log10(a[h * k] / b[h * k]) == pytest.approx(0.0, abs=0.05), (k, h)
+        assert np.mean(displacement) == pytest.approx(np.mean(periodic.displacement), rel=0.01, abs=1e-7)
+
+
 @pytest.mark.parametrize("kwargs, words", [
     ({"l2_poly": (-30.0,), "values": "no LR-2"}, "eddy branch"),
     ({"le_i_poly": (0.0, -0.05), "i_range_a": 10.0}, "incremental inductance"),

@@ -1,0 +1,109 @@
+"""What a large-signal identification reads from a recording: its periods of u, i and x, and their bands.
+
+Each recording gives its analysed periods (P x N) of voltage, current and
+displacement, and the frequencies at which each equation is trusted:
+
+- the electrical equation, from the first bin to the highest excited line
+  (the excitation's band; beyond it there is only noise);
+- the mechanical equation, up to the laser's band as well (the sidecar's
+  displacement_max_hz, with the serial laser), since it is written on x.
+
+The displacement is band-limited to the excitation's band before it is
+differentiated (v = dx/dt, a = dv/dt in the frequency domain, exact for a
+periodic signal): the laser's noise above it would otherwise rise as f and
+f^2 into the velocity and the acceleration, where no signal is.
+
+x is taken as the laser gives it: an arbitrary offset (the serial laser's
+stream has its mean removed) is the identification's to find (identify.py:
+the rest position from the static force balance).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.recording import MIN_PERIODS, Recording
+
+
+class LargeSignalError(ValueError):
+    """Recordings that cannot give large-signal curves (no laser, too few periods, ...). One line."""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RecordingData:
+    """The periods of one recording, in SI units, ready for the regressors."""
+
+    label: str
+    sample_rate: float
+    u: np.ndarray               # (P, N) V
+    i: np.ndarray               # (P, N) A
+    x: np.ndarray               # (P, N) m, as measured (offset unknown), band-limited
+    electrical_bins: np.ndarray  # 1 .. highest excited bin
+    mechanical_bins: np.ndarray  # the same, cut at the laser's band
+    excited_bins: np.ndarray
+    laser_delay_possible: bool  # the displacement came from a serial laser, on a clock of its own
+
+    @property
+    def n_periods(self) -> int:
+        return self.u.shape[0]
+
+    @property
+    def period_samples(self) -> int:
+        return self.u.shape[1]
+
+    @property
+    def bin_width(self) -> float:
+        return self.sample_rate / self.period_samples
+
+    def mean(self, name: str) -> np.ndarray:
+        return getattr(self, name).mean(axis=0)
+
+
+def recording_data(recording: Recording, label: str | None = None) -> RecordingData:
+    """The periods and bands of one recording; LargeSignalError when it cannot serve (one line)."""
+    name = label or (recording.source.name if recording.source else "recording")
+    if recording.signal("displacement") is None:
+        raise LargeSignalError(f"{name}: no displacement channel: the large-signal curves are identified "
+                               f"from the measured cone position, which needs the laser")
+    if recording.n_periods < MIN_PERIODS:
+        raise LargeSignalError(f"{name}: {recording.n_periods} analysed period(s); at least {MIN_PERIODS} are "
+                               f"needed for the noise of each line")
+    if recording.excited_bins is None or len(recording.excited_bins) == 0:
+        raise LargeSignalError(f"{name}: the sidecar lists no excited lines; a large-signal identification "
+                               f"needs the multitone's lines (a recording made by linpar has them)")
+    u, i, x = (np.array(recording.periods(s), dtype=np.float64) for s in ("voltage", "current", "displacement"))
+    for signal, values in (("voltage", u), ("current", i), ("displacement", x)):
+        if not np.all(np.isfinite(values)):
+            raise LargeSignalError(f"{name}: the {signal} holds samples that are not finite numbers")
+    n = recording.period_samples
+    excited = np.sort(np.asarray(recording.excited_bins, dtype=np.int64))
+    top = int(excited[-1])
+    bin_width = recording.sample_rate / n
+    x_max_hz = _displacement_max_hz(recording)
+    x_top = top if x_max_hz is None else min(top, int(math.floor(x_max_hz / bin_width)))
+    if x_top < 4:
+        raise LargeSignalError(f"{name}: the displacement's band ({x_max_hz} Hz) holds no line of the excitation")
+    spectrum = np.fft.rfft(x, axis=1)
+    spectrum[:, top + 1:] = 0.0           # nothing of the driver's motion is measured beyond the excitation
+    x = np.fft.irfft(spectrum, n, axis=1)
+    measurement = recording.extra.get("measurement") if recording.extra else None
+    serial = isinstance(measurement, dict) and measurement.get("displacement_source") == "serial laser"
+    return RecordingData(name, float(recording.sample_rate), u, i, x, np.arange(1, top + 1),
+                         np.arange(1, x_top + 1), excited, serial or x_max_hz is not None)
+
+
+def peak_to_peak(data: RecordingData, offset: float = 0.0) -> tuple[float, float]:
+    """(min, max) of the coherent mean period's x + offset, m: the range the curves rest on."""
+    x = data.mean("x") + offset
+    return float(x.min()), float(x.max())
+
+
+def _displacement_max_hz(recording: Recording) -> float | None:
+    value = recording.extra.get("displacement_max_hz") if recording.extra else None
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
+        raise LargeSignalError(f"sidecar key displacement_max_hz: found {value!r}, expected a positive number in Hz")
+    return float(value)
