@@ -21,6 +21,7 @@ from analysis.large_signal.solve import Block, Solution, solution, solve, solve_
 from analysis.large_signal.weights import misfit_variance, noise_variance
 
 DELAY_LIMIT_S = 1e-3
+DELAY_SCAN_S = 25e-6
 LAMBDA_MAX = 0.8
 TAU2_RANGE_S = (1e-6, 1e-2)
 MECHANICAL_ONLY = ("Mms", "Rms", "Kms", "Rv", "creep")
@@ -238,17 +239,24 @@ class FitState:
                 along("lam", (0.0, _lambda_limit(self.data, nu.ws)), 1e-4, False)
         return nu if orders.creep else dataclasses.replace(nu, lam=0.0)
 
-    def fit_delays(self, orders: Orders, nu: Nuisance) -> None:
+    def fit_delays(self, orders: Orders, nu: Nuisance, coarse: bool) -> None:
+        """Each serial laser's delay: chi^2 against the delay is not unimodal over +-1 ms (the lines of x
+        turn through whole cycles), so a coarse scan first (``coarse``), then a bounded Brent search within a
+        step of the best."""
         for k, d in enumerate(self.data):
             if not d.laser_delay_possible:
                 continue
 
             def chi2(delay):
-                self.delays[k] = delay
+                self.delays[k] = float(delay)
                 self.rebuild(k)
                 return self.solve(orders, nu).chi2
-            best = scipy.optimize.minimize_scalar(chi2, bounds=(-DELAY_LIMIT_S, DELAY_LIMIT_S), method="bounded",
-                                                  options={"xatol": 2e-7})
+            centre = self.delays[k]
+            if coarse:
+                grid = np.arange(-DELAY_LIMIT_S, DELAY_LIMIT_S + DELAY_SCAN_S / 2, DELAY_SCAN_S)
+                centre = float(grid[int(np.argmin([chi2(t) for t in grid]))])
+            best = scipy.optimize.minimize_scalar(chi2, bounds=(centre - DELAY_SCAN_S, centre + DELAY_SCAN_S),
+                                                  method="bounded", options={"xatol": 2e-7})
             self.delays[k] = float(best.x)
             self.rebuild(k)
 

@@ -89,10 +89,10 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
     nu = Nuisance()
     theta = fit.mechanical_start(top, nu, solve(fit.blocks(top, nu, only=ELECTRICAL)).theta)
     nu = _with_ws(nu, top, theta)
-    for _ in range(_REFINEMENTS):
+    for refinement in range(_REFINEMENTS):
         fit.update_weights(top, nu, theta)
-        fit.fit_delays(top, nu)
-        nu = fit.nuisance(top, nu)
+        nu = fit.nuisance(top, nu)          # first: tau2 far off would pull the delay with it
+        fit.fit_delays(top, nu, coarse=refinement == 0)
         fit.fit_offsets(top, nu, fit.solve(top, nu).theta)
         theta = fit.solve(top, nu).theta
         nu = _with_ws(nu, top, theta)
