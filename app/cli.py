@@ -67,6 +67,9 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_levels
     cli_levels.add_commands(sub)
 
+    from app import cli_large_signal
+    cli_large_signal.add_commands(sub)
+
     effects = sub.add_parser("effects", help="list the effects catalogue and your own effects")
     effects.add_argument("--json", action="store_true")
     cli_effects.add_option(effects)
@@ -107,6 +110,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "levels":
         from app import cli_levels
         return cli_levels.run(args)
+    if args.command == "large-signal" or getattr(args, "plan", None) == "large-signal":
+        from app import cli_large_signal
+        return cli_large_signal.run(args) if args.command == "large-signal" else cli_large_signal.run_plan(args)
     if args.command == "measure":
         from app import cli_measure
         return cli_measure.run(args)

@@ -5,6 +5,7 @@
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
                    [--on-xrun end|restart] [--serial TEXT] [--operator TEXT] [--station TEXT]
                    [--archive-root DIR | --no-archive] [--json]
+                   [--plan single|large-signal [the plan's limits: app/cli_large_signal.py]]
 
 With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
 used, started first if it is not running and stopped at the end if this
@@ -69,7 +70,8 @@ def add_commands(sub) -> None:
                    help='JSON {"calibration": {...}, "channel_map": {...}} of the sound card (--rig soundcard)')
     m.add_argument("--laser", metavar="URL", help="serial laser port or pyserial URL; 'analog': the laser's "
                                                   "analog output on the sound card; 'none': no displacement")
-    m.add_argument("--template", choices=tuple(TEMPLATES), default="woofer", help="driver class (default woofer)")
+    m.add_argument("--template", choices=tuple(TEMPLATES),
+                   help="driver class (default woofer; large-signal with --plan large-signal)")
     m.add_argument("--level", type=number(LEVEL_V_RMS), metavar="VOLT",
                    help="excitation level, V RMS at the terminals")
     m.add_argument("--periods", type=number(PERIODS), metavar="N", help="periods averaged")
@@ -88,6 +90,8 @@ def add_commands(sub) -> None:
                             "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
     where.add_argument("--no-archive", action="store_true", help="do not store the measurement in the archive")
     m.add_argument("--json", action="store_true", help="print one JSON object")
+    from app import cli_large_signal
+    cli_large_signal.add_plan_options(m)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -101,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
         _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
              f"('linpar recover {args.out}' keeps, analyses or discards it)")
     # The plan first: a plan that cannot work must not start a rig.
-    plan = MeasurementPlan.from_template(args.template, level_v_rms=args.level, n_periods=args.periods,
+    plan = MeasurementPlan.from_template(args.template or "woofer", level_v_rms=args.level, n_periods=args.periods,
                                          period_samples=args.period, on_xrun=args.on_xrun)
     with ExitStack() as stack:
         audio, laser, driver = _devices(args, stack)

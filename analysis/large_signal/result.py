@@ -25,6 +25,7 @@ from analysis.large_signal.identify import MAX_ORDER, Identification, describe_o
 from analysis.large_signal.limits import Derived, LimitThresholds, derived
 from analysis.large_signal.model import LargeSignalModel, model_of
 from analysis.large_signal.simulate import SimulationDiverged
+from analysis.large_signal.stepping import VOLTAGE_DISTORTION_DB, clipped_inputs, distortion_db
 from analysis.recording import Recording, read_recording
 
 # Flags: a misfit this many times the noise; explained distortion below this; a band wider than this at the edges.
@@ -111,6 +112,15 @@ def large_signal(items: Sequence[Recording | str | Path], max_order: int = MAX_O
                  for k, d in enumerate(data))
     done = [_prediction(model, data, p) for p in predictions]
     flags = _flags(model, ident, limits, fits) + [p["failed"] for p in done if p.get("failed")]
+    for recording, d, fit in zip(recordings, data, fits):
+        clipped = clipped_inputs(recording)
+        if clipped:
+            flags.append(f"{d.label}: the {' and '.join(clipped)} input reached its converter's full scale: the "
+                         f"curves are wrong where it clipped; lower the sense gain or the level and measure again")
+        distorted = distortion_db(np.fft.rfft(d.u, axis=1), d.excited_bins)
+        if distorted >= VOLTAGE_DISTORTION_DB:
+            flags.append(f"{d.label}: the voltage itself is distorted ({distorted:.0f} dB): the amplifier or the "
+                         f"sound card limits at {fit.drive_rms_v:.3g} V (the curves rest on the voltage measured)")
     return LargeSignalResult(model, ident, limits, thresholds, fits, tuple(flags), tuple(done), driver)
 
 

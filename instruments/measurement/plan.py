@@ -52,6 +52,9 @@ TEMPLATES: Mapping[str, MeasurementTemplate] = {t.name: t for t in (
                         0.5, 16),
     MeasurementTemplate("microspeaker", "micro speakers and receivers, fs 300 Hz - 1.5 kHz", 50.0, 20000.0,
                         16384, 0.3, 16),
+    # The large-signal plan's steps (large_signal_plan.py): short periods, few of them, from a small-signal level.
+    MeasurementTemplate("large-signal", "large-signal steps of woofers and midranges, fs 20 - 200 Hz", 5.0, 10000.0,
+                        16384, 0.5, 4),
 )}
 
 

@@ -44,6 +44,9 @@ class LaserTruth:
 class InProcessRig:
     """A simulated sound card and, optionally, a laser on the same cone; ``close()`` releases the laser's pty.
 
+    ``calibration``: the chain's (instruments.audio.Calibration); the rig's own by default, whose amplifier
+    gives 10 V at full scale (a multitone of ~7 V RMS at most).
+
     ``laser``: one of KINDS. The laser's ``ppm``, ``start_latency_s`` (switch-on
     to first measurement), ``link_latency_s`` (measurement to arrival, which no
     host time shows) and ``error_plan`` apply to every laser ``new_laser`` makes.
@@ -51,12 +54,12 @@ class InProcessRig:
 
     def __init__(self, driver: BlockDriver, laser: str = "simulated", *, ppm: float = 25.0,
                  start_latency_s: float = 0.0, link_latency_s: float = 0.0, error_plan=None, seed: int = 2,
-                 blocksize: int = 2048, realtime: bool | None = None):
+                 blocksize: int = 2048, realtime: bool | None = None, calibration=RIG_CALIBRATION):
         if laser not in KINDS:
             raise ValueError(f"laser: {laser!r}, expected one of {', '.join(KINDS)}")
         self.kind = laser
         self.feed = DisplacementFeed(driver.sample_rate)
-        self.audio = SimulatedAudio(calibration=RIG_CALIBRATION,
+        self.audio = SimulatedAudio(calibration=calibration,
                                     channel_map=RIG_CHANNEL_MAP if laser in ("analog", "none") else
                                     SERIAL_CHANNEL_MAP,
                                     sample_rate=driver.sample_rate, driver=driver, blocksize=blocksize,

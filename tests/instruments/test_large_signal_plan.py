@@ -1,0 +1,136 @@
+"""The large-signal plan and the identification through the virtual rig's nonlinear model, with the serial laser.
+
+In-process (instruments.rig.in_process): SimulatedAudio in real time drives
+the nonlinear simulator with the issue's known polynomials, and the cone is
+read by the byte-level laser emulator on a pseudo-terminal through the real
+ILD1420 driver, on a clock of its own: the identification meets the serial
+laser's band (1.76 kHz), its alignment and its leftover delay. The JACK rig
+runs the plan end to end from the command line in test_cli_large_signal_rig.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from analysis.large_signal import large_signal
+from analysis.large_signal.stepping import StepLimits
+from instruments.measurement import MeasurementPlan, run_measurement
+from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
+from instruments.rig.engine import RIG_CALIBRATION
+from instruments.rig.in_process import InProcessRig
+from tests.large_signal_truth import KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, known_driver
+
+pytestmark = pytest.mark.timeout(240)
+# +-4 mm needs ~10.5 V RMS of multitone, 22 V peak, and ~5 A peak: the rig's chain (10 V out, 20 V and 2 A in at
+# full scale) would clip. This one has a 30 V amplifier, 40 V and 10 A inputs.
+LARGE_SIGNAL_CHAIN = dataclasses.replace(RIG_CALIBRATION, volts_per_fs_out=30.0, volts_per_fs_voltage_sense=40.0,
+                                         current_amp_gain=1.0)
+
+
+def plan(period=16384, periods=4, **changes) -> MeasurementPlan:
+    # The driver's FIR spans one period: two settle it, one more for the audio's round trip.
+    return MeasurementPlan.from_template("large-signal", period_samples=period, n_periods=periods,
+                                         settle_periods=3, driver={"name": "known polynomials"}, **changes)
+
+
+def test_the_known_polynomials_come_back_through_the_rig_with_the_serial_laser(tmp_path, record_property):
+    rig = InProcessRig(known_driver(16384), "serial", ppm=40.0, start_latency_s=0.02, calibration=LARGE_SIGNAL_CHAIN)
+    try:
+        outcome = run_measurement(plan(level_v_rms=KNOWN_LEVEL_V), rig.audio, rig.laser, tmp_path, name="m",
+                                  analyse=False)
+    finally:
+        rig.close()
+    truth = known_driver(16384)
+    result = large_signal([outcome.recording_path])
+    lo, hi = result.model.x_range
+    assert lo < -3.5e-3 and hi > 3.5e-3
+    margin = 0.1 * (hi - lo)
+    x = np.linspace(lo + margin, hi - margin, 81)
+    for name, curve_truth in (("Bl", truth.bl), ("Kms", truth.kms)):
+        curve = result.model.curves[name]
+        worst = float(np.max(np.abs(curve(x) / curve_truth(x) - 1.0)))
+        at_rest = float(curve(0.0) / curve_truth(0.0) - 1.0)
+        record_property(f"rig_{name}_worst_error_80_percent", worst)
+        record_property(f"rig_{name}_0_error", at_rest)
+        assert worst < 0.03 and abs(at_rest) < 0.01, name
+    record_property("rig_offset_m", result.derived.offset_m)
+    record_property("rig_X_Bl_m", result.derived.limits["X_Bl"].value)
+    record_property("rig_laser_delay_s", result.identification.delays[0])
+    assert result.derived.offset_m == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
+    assert result.derived.limits["X_Bl"].value == pytest.approx(KNOWN_X_BL_M, abs=1e-4)
+    assert result.identification.data[0].laser_delay_possible
+
+
+def test_the_plan_steps_up_to_the_excursion_limit_and_keeps_every_step(tmp_path):
+    rig = InProcessRig(known_driver(8192), "simulated", calibration=LARGE_SIGNAL_CHAIN)
+    limits = StepLimits(max_excursion_m=2.0e-3, max_voltage_v=20.0)
+    steps_seen = []
+    try:
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 1.0, step=2.0, limits=limits), rig.audio,
+                                   rig.laser, tmp_path, name="ls", on_step=steps_seen.append,
+                                   measure=run_measurement)
+    finally:
+        rig.close()
+    assert outcome.stopped_by == "excursion", outcome.message
+    levels = [s.level_v for s in outcome.steps]
+    assert levels[0] == 1.0 and all(b > a for a, b in zip(levels, levels[1:]))
+    last = outcome.steps[-1].measures
+    assert 0.98 * 2.0e-3 <= last.peak_m <= 2.3e-3          # shortened near the limit, not overshot
+    assert [s.index for s in steps_seen] == [s.index for s in outcome.steps]
+    assert len(outcome.recordings) == len(outcome.steps) and all(p.is_file() for p in outcome.recordings)
+    summary = json.loads(outcome.summary_path.read_text())
+    assert summary["stopped_by"] == "excursion"
+    assert [s["recording"] for s in summary["steps"]] == [p.name for p in outcome.recordings]
+    assert all(len(s["measures"]["re_ohm_per_period"]) == 2 for s in summary["steps"])
+
+
+def test_the_plan_stops_at_the_voltage_limit(tmp_path):
+    rig = InProcessRig(known_driver(8192), "analog", realtime=False, calibration=LARGE_SIGNAL_CHAIN)
+    limits = StepLimits(max_excursion_m=10e-3, max_voltage_v=2.0)
+    try:
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 1.0, step=1.5, limits=limits), rig.audio,
+                                   None, tmp_path, name="ls", measure=run_measurement)
+    finally:
+        rig.close()
+    assert outcome.stopped_by == "voltage" and [s.level_v for s in outcome.steps] == [1.0, 1.5, 2.0]
+
+
+def test_an_input_at_full_scale_stops_the_plan(tmp_path):
+    """The rig's own chain: its current input reads 2 A at full scale, which the driver passes near 5 V."""
+    rig = InProcessRig(known_driver(8192), "analog", realtime=False)
+    try:
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0), rig.audio, None, tmp_path,
+                                   name="ls", measure=run_measurement)
+    finally:
+        rig.close()
+    assert outcome.stopped_by == "clipping" and "current" in outcome.message
+    assert outcome.steps[-1].measures.clipped == ("current",)
+    assert all(not s.measures.clipped for s in outcome.steps[:-1])
+
+
+def test_a_fault_mid_plan_stops_it_safely_keeping_what_it_has(tmp_path):
+    """The laser's cable pulled during the second step: the first step stays complete, the second's whole
+    periods stay as a partial recording, and the summary says what happened."""
+    rig = InProcessRig(known_driver(8192), "simulated")
+    pulled = {}
+
+    def progress(p):
+        if "step 2" in p.message and p.periods_kept >= 1 and not pulled:
+            pulled["at"] = p.periods_kept
+            rig.laser.disconnect()
+
+    try:
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 4), 1.0, step=1.5), rig.audio, rig.laser, tmp_path,
+                                   name="ls", progress=progress, measure=run_measurement)
+    finally:
+        rig.close()
+    assert pulled and outcome.stopped_by == "fault" and "laser" in outcome.message
+    first, second = outcome.steps
+    assert not first.partial and first.recording_path.is_file()
+    assert second.partial and second.measures is None
+    assert outcome.recordings == [first.recording_path]
+    summary = json.loads(outcome.summary_path.read_text())
+    assert summary["stopped_by"] == "fault" and summary["steps"][1]["partial"] is True

@@ -1,0 +1,90 @@
+"""`linpar large-signal`: text, the JSON contract, a plan's summary as input, and bad input in one line (exit 2)."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from analysis.recording import make_recording, write_recording
+from app.cli import main
+from tests.large_signal_truth import KNOWN_OFFSET_M, clean_periods, known_driver, noisy_recording
+
+
+@pytest.fixture(scope="module")
+def recordings(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("large-signal")
+    driver = known_driver(8192)
+    paths = []
+    for level in (5.0, 9.0):
+        block, mt = clean_periods(driver, level, 4)
+        paths.append(write_recording(folder / f"step-{level:g}V", noisy_recording(block, mt))[0])
+    return folder, paths
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_is_one_object_with_the_contract(recordings, capsys):
+    _, paths = recordings
+    code, out, err = run(["large-signal", *map(str, paths), "--json", "--predict", "6", "--sine", "40"], capsys)
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["x_unit"] == "m"
+    for name, unit in (("Bl", "T*m"), ("Kms", "N/m"), ("Le", "H")):
+        curve = doc["curves"][name]
+        assert curve["unit"] == unit and len(curve["coefficients"]) == len(curve["std"])
+        assert curve["x_range"][0] < 0 < curve["x_range"][1]
+    assert doc["offset_m"] == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
+    assert doc["limits"]["X_Bl"]["criterion"] == "Bl >= 82 %" and "value" in doc["limits"]["X_C"]
+    assert {"electrical", "mechanical", "total"} <= set(doc["model"]["chi2_red"])
+    assert len(doc["validity"]["recordings"]) == 2
+    assert doc["distortion"]["predictions"][0]["sine"]["current"]["H3_db"] < 0
+
+
+def test_text_names_the_offset_and_the_limits_and_thresholds_are_settable(recordings, capsys):
+    _, paths = recordings
+    code, out, _ = run(["large-signal", str(paths[1]), "--bl-min", "90", "--cms-min", "80"], capsys)
+    assert code == 0
+    assert "move the coil 1.50 mm in" in out
+    assert "X_Bl (Bl >= 90 %): 2.00 mm" in out and "X_C (Cms >= 80 %)" in out
+
+
+def test_a_plans_summary_stands_for_its_complete_steps(recordings, capsys):
+    folder, paths = recordings
+    summary = folder / "plan.large-signal.json"
+    summary.write_text(json.dumps({"steps": [{"recording": paths[0].name, "partial": False},
+                                             {"recording": paths[1].name, "partial": False},
+                                             {"recording": "broken.wav", "partial": True}]}))
+    code, out, err = run(["large-signal", str(summary), "--json"], capsys)
+    assert code == 0, err
+    assert [r["source"] for r in json.loads(out)["validity"]["recordings"]] == [p.name for p in paths]
+
+
+def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
+    _, paths = recordings
+    good = str(paths[1])
+    rec = make_recording(48000, {"voltage": np.ones(8192 * 3), "current": np.ones(8192 * 3)}, 8192, 1, (3, 5))
+    no_laser = write_recording(tmp_path / "no-laser", rec)[0]
+    (tmp_path / "empty.large-signal.json").write_text('{"steps": []}')
+    cases = [
+        (["large-signal", str(tmp_path / "missing")], "missing"),
+        (["large-signal", str(no_laser)], "no displacement"),
+        (["large-signal", good, "--order", "12"], "order"),
+        (["large-signal", good, "--bl-min", "nan"], "percentage"),
+        (["large-signal", good, "--le-change", "150"], "percentage"),
+        (["large-signal", good, "--sine", "40"], "--predict"),
+        (["large-signal", good, "--predict", "6", "--two-tones", "500,30"], "F1 < F2"),
+        (["large-signal", good, "--predict", "inf"], "level"),
+        (["large-signal", str(tmp_path / "empty.large-signal.json")], "no complete step"),
+        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--max-excursion", "-1"], "excursion"),
+        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--step", "9"], "factor"),
+    ]
+    for argv, words in cases:
+        code, out, err = run(argv, capsys)
+        assert code == 2, argv
+        assert err.count("\n") == 1 and words in err, (argv, err)
+        assert "Traceback" not in err
