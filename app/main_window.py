@@ -12,6 +12,7 @@ from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QP
 from app import style
 from app.archive_page import ArchivePage
 from app.job_book import failure_text
+from app.large_signal_page import LargeSignalPage
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
 from app.qa_view import QAView
@@ -24,7 +25,7 @@ from app.workers import AnalysisJob, AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
-PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "QA", "Archive")
+PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "Large signal", "QA", "Archive")
 CLOSE_WAIT_MS = 5000        # a cancelled fit stops at its next iteration; this is ample
 
 
@@ -69,6 +70,8 @@ class MainWindow(QMainWindow):
         self.result_pages = StagedFanOut([self.model_lab.set_result, self.qa.set_result], self)
         self.results.result_changed.connect(self.result_pages.send)
         self.series = SeriesPage()
+        self.large_signal = LargeSignalPage()
+        self.series.large_signal_requested.connect(self.on_large_signal_requested)
         # Every measurement the wizard finishes is stored in the archive; an archived one opens like a file.
         self.archive = ArchivePage(self.settings)
         self.archive.open_requested.connect(self.on_open_archived)
@@ -76,7 +79,7 @@ class MainWindow(QMainWindow):
         self.archive.store_failed.connect(self.on_archive_failed)
         self._titles: dict[Path, str] = {}      # recording path -> what the title bar calls it (archived ones)
         built = {"Measure": self.wizard, "Results": self.results, "Model lab": self.model_lab,
-                 "Series": self.series, "QA": self.qa, "Archive": self.archive}
+                 "Series": self.series, "Large signal": self.large_signal, "QA": self.qa, "Archive": self.archive}
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
@@ -143,6 +146,12 @@ class MainWindow(QMainWindow):
     @property
     def busy(self) -> bool:
         return self.job is not None
+
+    @Slot(list)
+    def on_large_signal_requested(self, paths: list) -> None:
+        """The Series page's level series, identified on the Large-signal page."""
+        self.pages.setCurrentWidget(self.large_signal)
+        self.large_signal.analyse(paths)
 
     def open_path(self, path: str | Path) -> None:
         """Analyse `path` in a worker thread; a running analysis is cancelled and its outcome ignored."""

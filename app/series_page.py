@@ -143,9 +143,13 @@ class _SetPanel(QWidget):
 class SeriesPage(QTabWidget):
     """Repeatability and level series of several recordings."""
 
+    # The level series' recordings, for the Large-signal page (the drift's reason: Bl(x), Kms(x), Le(x)).
+    large_signal_requested = Signal(list)
+
     def __init__(self, parent=None):
         super().__init__(parent)
         self.worker = SeriesWorker(self)
+        self.level_paths: list[Path] = []
         self.repeat_table = RepeatabilityTable()
         self.levels_view = LevelSeriesView()
         self.panels = {
@@ -158,6 +162,12 @@ class SeriesPage(QTabWidget):
                                 "(Table II) and fs against excursion (Fig. 14).",
                                 self.levels_view, lambda: self.on_choose("levels"), self.worker.cancel),
         }
+        self.large_signal_button = QPushButton("Large-signal curves of these recordings…")
+        self.large_signal_button.setToolTip("Bl(x), Kms(x) and Le(x) behind the drift, the coil's rest offset and the "
+                                            "excursion limits, on the Large-signal page")
+        self.large_signal_button.setEnabled(False)
+        self.large_signal_button.clicked.connect(lambda: self.large_signal_requested.emit(list(self.level_paths)))
+        self.panels["levels"].layout().itemAt(0).layout().insertWidget(2, self.large_signal_button)
         self.addTab(self.panels["repeatability"], "Repeatability (Table I)")
         self.addTab(self.panels["levels"], "Level series (Table II)")
         self.worker.progress.connect(self.on_progress)
@@ -175,6 +185,9 @@ class SeriesPage(QTabWidget):
             self.panels[kind].idle("Choose at least two recordings: a spread needs more than one.")
             return
         self.panels[kind].busy(0, len(stems))
+        if kind == "levels":
+            self.level_paths = list(stems)
+            self.large_signal_button.setEnabled(False)
         self.worker.start(kind, stems)
 
     def on_progress(self, kind: str, done: int, total: int) -> None:
@@ -188,6 +201,7 @@ class SeriesPage(QTabWidget):
         else:
             self.levels_view.set_series(outcome)
             self.panels[kind].idle(f"{len(outcome.levels)} levels analysed.")
+            self.large_signal_button.setEnabled(True)
 
     def on_failed(self, kind: str, message: str) -> None:
         self.panels[kind].idle(f"Not analysed: {message}")

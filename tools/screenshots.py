@@ -1,6 +1,6 @@
 """Screenshots of the main window on a synthetic recording, for docs and for looking at.
 
-    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] [--only archive]
+    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] [--only archive|model-lab|large-signal]
 
 Writes results.png (and one PNG per Results plot tab and per other page) to
 docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
@@ -21,6 +21,8 @@ model-lab-new-effect-1280x720.png and -1920x1080.png: the "New effect…" dialog
 with the effect a recording lacks written in it (damping rising as sqrt(f)),
 and model-lab-own-effect-*.png: the lab once it is saved and checked, reduced
 chi^2 down to 1 (--only new-effect: just these).
+large-signal-1280x720.png and -1920x1080.png: the Large-signal page on the
+known-polynomial driver at three levels (--only large-signal: just these).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
 """
@@ -229,6 +231,35 @@ def series_screenshots(app: QApplication, window, folder: Path, out: Path) -> li
     return [path]
 
 
+def large_signal_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Large-signal page: the issue's known-polynomial driver at three levels up to +-4 mm, identified;
+    at 1280x720 and at 1920x1080."""
+    from tests.large_signal_truth import clean_periods, known_driver, noisy_recording
+
+    driver = known_driver(16384)
+    paths = []
+    for level in (3.0, 6.0, 10.5):
+        block, mt = clean_periods(driver, level, 4)
+        paths.append(write_recording(folder / f"large-signal-{level:g}V",
+                                     noisy_recording(block, mt, driver_name="demo driver (known curves)"))[0])
+    page = window.large_signal
+    window.pages.setCurrentWidget(page)
+    page.analyse(paths)
+    if not wait_for(page.result_shown, 4 * ANALYSIS_TIMEOUT_S):
+        print("screenshots: the large-signal identification did not finish", file=sys.stderr)
+        return []
+    written = []
+    for width, height in SMALL_AND_LARGE:
+        window.resize(width, height)
+        settle(app, 600)
+        path = out / f"large-signal-{width}x{height}.png"
+        window.grab().save(str(path))
+        written.append(path)
+    window.resize(*SIZE)
+    settle(app)
+    return written
+
+
 # A production batch of the paper's driver measured in the days before: (serial, operator, station, days and
 # hours before now, relative change of Bl, Mms, Cms, RE). Electrical analogues: CMES = Mms/Bl^2, LCES = Cms*Bl^2,
 # RES = Bl^2/Rms.
@@ -413,7 +444,8 @@ def settle(app: QApplication, ms: int = 300) -> None:
     app.processEvents()
 
 
-ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots}
+ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
+        "large-signal": large_signal_screenshots}
 
 
 def main(argv: list[str]) -> int:
@@ -481,6 +513,7 @@ def main(argv: list[str]) -> int:
         written += new_effect_screenshots(app, window, folder, out)
         written += measure_screenshots(app, window, folder, out)
         written += series_screenshots(app, window, folder, out)
+        written += large_signal_screenshots(app, window, folder, out)
         written += archive_screenshots(app, window, folder, out)
         window.close()
     for path in written:

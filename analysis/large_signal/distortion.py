@@ -120,7 +120,9 @@ def _channel_fit(name: str, periods: np.ndarray, simulated: np.ndarray, excited:
     for members in bands:
         density = _density(np.abs(mean[exc]) ** 2, exc, members)
         band_hz.append(float(np.exp(np.mean(np.log(members * bin_width)))))
-        band_m.append(_db(np.mean(np.abs(mean[members]) ** 2 - var[members]) / density))
+        power, floor = np.mean(np.abs(mean[members]) ** 2), np.mean(var[members])
+        # Shown only where it stands clear of the noise (3 dB): below, the "distortion" is the noise's.
+        band_m.append(_db((power - floor) / density) if power > 2.0 * floor else float("nan"))
         band_p.append(_db(np.mean(np.abs(model[members]) ** 2) / density))
         band_n.append(_db(np.mean(var[members]) / density))
     return ChannelFit(name, time_rms, misfit, _db(measured / signal) if significant else float("nan"),

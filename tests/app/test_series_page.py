@@ -34,6 +34,11 @@ def test_level_series_shows_fs_falling_with_excursion(qtbot, page, tmp_path):
         page.analyse("levels", paths)
     x, fs = page.levels_view.plot.line.getData()
     assert len(fs) == 2 and x[1] > x[0] and fs[1] < fs[0]
+    # The drift's reason is one click away: the same recordings, for the Large-signal page.
+    assert page.large_signal_button.isEnabled()
+    with qtbot.waitSignal(page.large_signal_requested) as requested:
+        page.large_signal_button.click()
+    assert requested.args[0] == sorted(p.with_suffix("") for p in paths)
 
 
 def test_one_recording_is_not_a_series(qtbot, page, tmp_path):
