@@ -2,6 +2,7 @@
 
     linpar large-signal REC... [--order N] [--json] [--bl-min PCT] [--cms-min PCT] [--le-change PCT]
                         [--predict VOLT [--sine HZ] [--two-tones F1,F2]]
+                        [--pdf FILE] [--html FILE] [--csv FILE] [--export-json FILE]
     linpar measure --plan large-signal --out DIR [--level VOLT] [--max-excursion MM] [--max-voltage VOLT]
                    [--max-distortion DB] [--max-temperature-rise K] [--step FACTOR] [measure's options]
 
@@ -10,7 +11,11 @@ REC is a recording (NAME, NAME.wav or NAME.json) or a plan's summary
 (analysis.large_signal) prints the curves, the coil's rest offset and the
 excursion limits, or with --json one object (the contract in
 analysis/large_signal/result.py). --order is the highest order BIC may
-choose for Bl, Kms and Le (default 6).
+choose for Bl, Kms and Le (default 6). --pdf/--html write the report,
+--csv/--export-json the curves (analysis/report/large_signal.py,
+analysis/export/large_signal.py); an output that would replace one of the
+recordings read, or something not a regular file, is refused before the
+identification runs.
 
 The plan steps the level up from --level (default: the large-signal
 template's 0.5 V) until a limit, each step a recording in --out (see
@@ -32,6 +37,9 @@ from pathlib import Path
 
 PLANS = ("single", "large-signal")
 SUMMARY_SUFFIX = ".large-signal.json"
+OUTPUTS = (("pdf", "write the report as PDF"), ("html", "write the report as HTML (self-contained)"),
+           ("csv", "write the curves as CSV (x, Bl, Kms, Cms, Le with 1-sigma across the measured range)"),
+           ("export-json", "write the JSON (as --json prints it) to FILE"))
 
 
 def _number(low: float, high: float, what: str):
@@ -88,6 +96,8 @@ def add_commands(sub) -> None:
     c.add_argument("--two-tones", type=_two_tones, metavar="F1,F2",
                    help="with --predict: IMD2 and IMD3 for two tones F1 + F2 (amplitudes 4:1)")
     c.add_argument("--json", action="store_true", help="print one JSON object")
+    for option, what in OUTPUTS:
+        c.add_argument(f"--{option}", type=Path, metavar="FILE", help=what)
 
 
 def add_plan_options(measure: argparse.ArgumentParser) -> None:
@@ -126,12 +136,51 @@ def run(args: argparse.Namespace) -> int:
         raise CliError("--sine and --two-tones need --predict VOLT (the level to predict at)")
     thresholds = LimitThresholds(args.bl_min / 100.0, args.cms_min / 100.0, args.le_change / 100.0)
     predictions = [] if args.predict is None else [Prediction(args.predict, args.sine, args.two_tones)]
-    result = large_signal(expand(args.paths), args.order, thresholds, predictions)
+    inputs = expand(args.paths)
+    outputs = checked_outputs(args, inputs)          # before the identification: a mistake costs nothing
+    result = large_signal(inputs, args.order, thresholds, predictions)
     if args.json:
         _print_json(result.as_json())
     else:
         print(format_large_signal(result))
+    for path in write_outputs(result, outputs):
+        print(f"written: {path}", file=sys.stderr)
     return 0
+
+
+def checked_outputs(args: argparse.Namespace, inputs) -> dict[str, Path]:
+    """The files to write, refused (ValueError, one line) when one would replace an input of this command or
+    something that is not a regular file."""
+    from analysis.recording import recording_paths
+    taken = set()
+    for path in inputs:
+        try:
+            taken.update(p.resolve() for p in recording_paths(path))
+        except (OSError, ValueError):
+            taken.add(Path(path).resolve())
+    outputs = {}
+    for option, _ in OUTPUTS:
+        path = getattr(args, option.replace("-", "_"))
+        if path is None:
+            continue
+        if path.resolve() in taken:
+            raise ValueError(f"--{option} {path}: that is one of the recordings read: choose another file")
+        if path.exists() and not path.is_file():
+            raise ValueError(f"--{option} {path}: not a regular file")
+        if path.resolve() in {p.resolve() for p in outputs.values()}:
+            raise ValueError(f"--{option} {path}: already named for another output")
+        outputs[option] = path
+    return outputs
+
+
+def write_outputs(result, outputs: dict[str, Path]) -> list[Path]:
+    """The report and exports asked for, each written atomically."""
+    from analysis.archive.atomic import write_atomic
+    from analysis.export.large_signal import curves_csv, curves_json
+    from analysis.report.large_signal import render_large_signal_html, render_large_signal_pdf
+    render = {"pdf": render_large_signal_pdf, "html": render_large_signal_html, "csv": curves_csv,
+              "export-json": curves_json}
+    return [write_atomic(path, render[option](result)) for option, path in outputs.items()]
 
 
 def expand(paths) -> list[Path]:

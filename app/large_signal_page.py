@@ -25,6 +25,7 @@ from app.workers import USER_ERRORS
 
 log = logging.getLogger(__name__)
 RECORDING_FILTER = "Recordings (*.wav *.json)"
+SAVE_FILTER = "PDF report (*.pdf);;HTML report (*.html);;Curves as CSV (*.csv);;Curves as JSON (*.json)"
 EMPTY_TEXT = ("No large-signal curves yet: choose recordings of one driver at large signal (a level series, or "
               "the steps of a large-signal measurement).")
 
@@ -80,6 +81,9 @@ class LargeSignalPage(QWidget):
         self.choose_button.setToolTip("Recordings of one driver at large signal, with the laser")
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.setEnabled(False)
+        self.save_button = QPushButton("Save report or curves…")
+        self.save_button.setToolTip("The report as PDF or HTML, the curves as CSV or JSON")
+        self.save_button.setEnabled(False)
         self.progress = QProgressBar()
         self.progress.setRange(0, 0)
         self.progress.setMaximumWidth(160)
@@ -98,7 +102,7 @@ class LargeSignalPage(QWidget):
         self.level_choice = QComboBox()
         self.level_choice.setToolTip("The recording whose measured distortion the prediction is compared with")
         controls = QHBoxLayout()
-        for w in (self.choose_button, self.cancel_button, self.progress):
+        for w in (self.choose_button, self.cancel_button, self.save_button, self.progress):
             controls.addWidget(w)
         controls.addWidget(self.status, 1)
         grid = QGridLayout()
@@ -120,6 +124,7 @@ class LargeSignalPage(QWidget):
         layout.addWidget(splitter, 1)
         self.choose_button.clicked.connect(self.on_choose)
         self.cancel_button.clicked.connect(self.on_cancel)
+        self.save_button.clicked.connect(self.on_save)
         self.level_choice.currentIndexChanged.connect(self.on_level_chosen)
         self.worker.finished.connect(self.on_finished)
         self.worker.failed.connect(self.on_failed)
@@ -150,6 +155,32 @@ class LargeSignalPage(QWidget):
     def on_failed(self, message: str) -> None:
         if message != "cancelled":
             self._idle(f"Not identified: {message}")
+
+    def on_save(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(self, "Save the large-signal report or curves", "", SAVE_FILTER)
+        if path:
+            self.save(Path(path))
+
+    def save(self, path: Path) -> None:
+        """Write the report (.pdf, .html) or the curves (.csv, .json), by the file's suffix; the outcome is said
+        on the status line."""
+        from analysis.archive.atomic import write_atomic
+        from analysis.export.large_signal import curves_csv, curves_json
+        from analysis.report.large_signal import render_large_signal_html, render_large_signal_pdf
+        render = {".pdf": render_large_signal_pdf, ".html": render_large_signal_html, ".csv": curves_csv,
+                  ".json": curves_json}.get(path.suffix.lower())
+        if self.result is None or render is None:
+            self.status.setText(f"Not saved: {path.name}: name a .pdf, .html, .csv or .json file")
+            return
+        if path.exists() and not path.is_file():
+            self.status.setText(f"Not saved: {path} is not a regular file")
+            return
+        try:
+            write_atomic(path, render(self.result))
+        except OSError as exc:
+            self.status.setText(f"Not saved: {exc}")
+            return
+        self.status.setText(f"Saved {path}")
 
     def on_level_chosen(self, index: int) -> None:
         if self.result is not None and 0 <= index < len(self.result.fits):
@@ -185,6 +216,7 @@ class LargeSignalPage(QWidget):
         self.level_choice.blockSignals(False)
         self.distortion.set_fit(result.fits[-1] if result.fits else None)
         self.summary.setText(summary_html(result))
+        self.save_button.setEnabled(True)
         self.result_shown.emit(result)
 
     def _idle(self, message: str) -> None:

@@ -64,6 +64,22 @@ def test_a_plans_summary_stands_for_its_complete_steps(recordings, capsys):
     assert [r["source"] for r in json.loads(out)["validity"]["recordings"]] == [p.name for p in paths]
 
 
+def test_the_report_and_the_curves_are_written_and_never_over_an_input(recordings, capsys, tmp_path):
+    _, paths = recordings
+    files = {o: tmp_path / f"out.{o.split('-')[-1]}" for o in ("pdf", "html", "csv")}
+    files["export-json"] = tmp_path / "curves.json"
+    code, out, err = run(["large-signal", str(paths[1])] + [a for o, p in files.items() for a in (f"--{o}", str(p))],
+                         capsys)
+    assert code == 0, err
+    assert all(p.stat().st_size > 1000 for p in files.values())
+    assert json.loads(files["export-json"].read_text())["x_unit"] == "m"
+    assert files["csv"].read_text().count("\n") > 100
+    sidecar = paths[1].with_suffix(".json")
+    before = sidecar.read_bytes()
+    code, _, err = run(["large-signal", str(paths[1]), "--csv", str(sidecar)], capsys)
+    assert code == 2 and "one of the recordings read" in err and sidecar.read_bytes() == before
+
+
 def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
     _, paths = recordings
     good = str(paths[1])
@@ -80,6 +96,7 @@ def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
         (["large-signal", good, "--predict", "6", "--two-tones", "500,30"], "F1 < F2"),
         (["large-signal", good, "--predict", "inf"], "level"),
         (["large-signal", str(tmp_path / "empty.large-signal.json")], "no complete step"),
+        (["large-signal", good, "--pdf", str(tmp_path)], "not a regular file"),
         (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--max-excursion", "-1"], "excursion"),
         (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--step", "9"], "factor"),
     ]

@@ -90,3 +90,18 @@ def test_the_series_pages_level_series_opens_here(qtbot, settings, steps, monkey
     window.series.large_signal_button.setEnabled(True)
     window.series.large_signal_button.click()
     assert window.pages.currentWidget() is window.large_signal and asked == [list(steps)]
+
+
+def test_the_report_and_the_curves_are_saved_by_their_suffix(page, result, tmp_path):
+    import json
+    page.show_result(result)
+    for name in ("r.pdf", "r.html", "r.csv", "r.json"):
+        page.save(tmp_path / name)
+        assert (tmp_path / name).stat().st_size > 1000 and "Saved" in page.status.text()
+    assert json.loads((tmp_path / "r.json").read_text())["x_unit"] == "m"
+    assert (tmp_path / "r.pdf").read_bytes().startswith(b"%PDF")
+    assert "x_m,Bl_Tm" in (tmp_path / "r.csv").read_text()
+    page.save(tmp_path / "r.txt")
+    assert "Not saved" in page.status.text() and not (tmp_path / "r.txt").exists()
+    page.save(tmp_path)
+    assert "Not saved" in page.status.text()
