@@ -195,7 +195,7 @@ def expand(paths) -> list[Path]:
             continue
         try:
             doc = json.loads(path.read_text(encoding="utf-8"))
-            steps = [s for s in doc["steps"] if s.get("recording") and not s.get("partial")]
+            steps = [s for s in doc["steps"] if s.get("recording") and s.get("usable", not s.get("partial"))]
         except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError) as exc:
             raise LargeSignalError(f"{path}: not a readable large-signal plan summary ({exc})") from None
         if not steps:

@@ -234,9 +234,10 @@ class FitState:
 
         rounds = 2 if orders.creep else 1
         for _ in range(rounds):
-            along("tau2", tuple(np.log10(TAU2_RANGE_S)), 1e-3, True)
+            # tau2 to 1 %, lambda to 0.001: their own uncertainty enters the covariance anyway (covariance.py).
+            along("tau2", tuple(np.log10(TAU2_RANGE_S)), 4e-3, True)
             if orders.creep:
-                along("lam", (0.0, _lambda_limit(self.data, nu.ws)), 1e-4, False)
+                along("lam", (0.0, _lambda_limit(self.data, nu.ws)), 1e-3, False)
         return nu if orders.creep else dataclasses.replace(nu, lam=0.0)
 
     def fit_delays(self, orders: Orders, nu: Nuisance, coarse: bool) -> None:

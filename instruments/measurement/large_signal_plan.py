@@ -69,6 +69,11 @@ class PlanStep:
     partial: bool = False
     message: str = ""
 
+    @property
+    def usable(self) -> bool:
+        """Complete and no input clipped: a step the identification may take (the others stay on disk)."""
+        return not self.partial and self.measures is not None and not self.measures.clipped
+
 
 @dataclass(frozen=True, slots=True)
 class LargeSignalOutcome:
@@ -79,8 +84,8 @@ class LargeSignalOutcome:
 
     @property
     def recordings(self) -> list[Path]:
-        """The complete steps' recordings, by rising level."""
-        return [s.recording_path for s in self.steps if s.recording_path is not None and not s.partial]
+        """The usable steps' recordings, by rising level."""
+        return [s.recording_path for s in self.steps if s.recording_path is not None and s.usable]
 
 
 StepListener = Callable[[PlanStep], None]
@@ -163,7 +168,8 @@ def _write_summary(path: Path, plan: LargeSignalPlan, steps: list[PlanStep], sto
                    re_reference: float) -> None:
     doc = {"format": "linpar-large-signal-plan/1", "plan": plan.as_json(), "stopped_by": stopped,
            "message": message, "steps": [
-               {"index": s.index, "level_v": s.level_v, "partial": s.partial, "message": s.message,
+               {"index": s.index, "level_v": s.level_v, "partial": s.partial, "usable": s.usable,
+                "message": s.message,
                 "recording": None if s.recording_path is None else s.recording_path.name,
                 "measures": None if s.measures is None else s.measures.as_json(re_reference)} for s in steps]}
     write_atomic(path, json.dumps(doc, indent=1, allow_nan=False, default=str) + "\n")

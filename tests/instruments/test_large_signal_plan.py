@@ -109,6 +109,9 @@ def test_an_input_at_full_scale_stops_the_plan(tmp_path):
     assert outcome.stopped_by == "clipping" and "current" in outcome.message
     assert outcome.steps[-1].measures.clipped == ("current",)
     assert all(not s.measures.clipped for s in outcome.steps[:-1])
+    # Kept on disk, left out of what is identified.
+    assert outcome.steps[-1].recording_path.is_file() and outcome.steps[-1].recording_path not in outcome.recordings
+    assert json.loads(outcome.summary_path.read_text())["steps"][-1]["usable"] is False
 
 
 def test_a_fault_mid_plan_stops_it_safely_keeping_what_it_has(tmp_path):
