@@ -72,6 +72,7 @@ class MainWindow(QMainWindow):
         self.series = SeriesPage()
         self.large_signal = LargeSignalPage()
         self.series.large_signal_requested.connect(self.on_large_signal_requested)
+        self.wizard.large_signal_finished.connect(self.on_large_signal_measured)
         # Every measurement the wizard finishes is stored in the archive; an archived one opens like a file.
         self.archive = ArchivePage(self.settings)
         self.archive.open_requested.connect(self.on_open_archived)
@@ -152,6 +153,12 @@ class MainWindow(QMainWindow):
         """The Series page's level series, identified on the Large-signal page."""
         self.pages.setCurrentWidget(self.large_signal)
         self.large_signal.analyse(paths)
+
+    @Slot(object)
+    def on_large_signal_measured(self, done) -> None:
+        """The wizard's large-signal plan, identified: shown on the Large-signal page."""
+        self.large_signal.show_result(done.result)
+        self.pages.setCurrentWidget(self.large_signal)
 
     def open_path(self, path: str | Path) -> None:
         """Analyse `path` in a worker thread; a running analysis is cancelled and its outcome ignored."""

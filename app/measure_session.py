@@ -173,6 +173,13 @@ class MeasureSession(QObject, JobBook):
             return MeasureOutcome(AnalysisOutcome(job.id, wav, result, result_curves(result)), request)
         return self._launch("measurement", work)
 
+    def measure_large_signal(self, request) -> SessionJob:
+        def work(job):
+            from app.wizard.tasks import run_large_signal_plan
+            job.progress(0.0, "designing the multitone")
+            return run_large_signal_plan(request, job.frame, job.cancel_event, job.progress)
+        return self._launch("large-signal measurement", work)
+
     # -- bookkeeping -----------------------------------------------------------
     def _launch(self, kind: str, work: Callable[[SessionJob], object]) -> SessionJob:
         return self._start(SessionJob(self._next_id(), kind, work, self))

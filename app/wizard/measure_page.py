@@ -5,12 +5,12 @@ import html
 from pathlib import Path
 
 from PySide6.QtCore import QStandardPaths, Signal
-from PySide6.QtWidgets import QFileDialog, QHBoxLayout, QPushButton, QVBoxLayout
+from PySide6.QtWidgets import QDoubleSpinBox, QFileDialog, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.live_panels import LivePanels
 from app.measure_session import runner_name
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
-from app.wizard.plans import TEMPLATES
+from app.wizard.plans import LARGE_SIGNAL, TEMPLATES
 from app.wizard.tasks import MeasurementRequest
 
 OUT_DIR_KEY = "measure/out_dir"
@@ -32,10 +32,41 @@ def _table(left: list[tuple[str, str]], right: list[tuple[str, str]]) -> str:
     return f"<table>{body}</table>"
 
 
+class LargeSignalLimits(QWidget):
+    """The large-signal plan's limits the user sets here (the others keep their defaults: -20 dB of current
+    distortion, 20 K of coil heating)."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.excursion = _spin(0.1, 20.0, 4.0, " mm", "The plan stops once the peak excursion reaches this")
+        self.voltage = _spin(0.1, 100.0, 10.0, " V rms", "The plan never drives above this level")
+        row = QHBoxLayout(self)
+        row.setContentsMargins(0, 0, 0, 0)
+        for text, box in (("Large-signal plan: stop at", self.excursion), ("or", self.voltage)):
+            row.addWidget(QLabel(text))
+            row.addWidget(box)
+        row.addStretch(1)
+
+    def limits(self):
+        from analysis.large_signal.stepping import StepLimits
+        return StepLimits(max_excursion_m=self.excursion.value() * 1e-3, max_voltage_v=self.voltage.value())
+
+
+def _spin(low: float, high: float, value: float, suffix: str, tip: str) -> QDoubleSpinBox:
+    box = QDoubleSpinBox()
+    box.setRange(low, high)
+    box.setDecimals(1)
+    box.setValue(value)
+    box.setSuffix(suffix)
+    box.setToolTip(tip)
+    return box
+
+
 class MeasurePage(WizardPage):
     title = "Measure"
     subtitle = "The recording is written first, then analysed; the spectra show each period as it is averaged."
     measured = Signal(object)           # MeasureOutcome
+    large_signal_measured = Signal(object)      # app.wizard.tasks.LargeSignalMeasured
 
     def __init__(self, state, session, parent=None):
         super().__init__(state, session, parent)
@@ -45,6 +76,9 @@ class MeasurePage(WizardPage):
         self.start_button = QPushButton("Start the measurement")
         self.jobs = JobControls(session)
         self.result = rich_label(selectable=True)
+        self.large_signal = LargeSignalLimits()
+        self.large_signal.setVisible(False)
+        self.large_signal_done = None           # the last large-signal plan's LargeSignalMeasured
         self.panels = LivePanels()
         top = QHBoxLayout()
         top.addWidget(self.summary, 1)
@@ -55,6 +89,7 @@ class MeasurePage(WizardPage):
         layout = QVBoxLayout(self)
         layout.addLayout(top)
         layout.addLayout(run)
+        layout.addWidget(self.large_signal)
         layout.addWidget(self.result)
         layout.addWidget(self.panels, 1)
         self.start_button.clicked.connect(self.on_start)
@@ -67,8 +102,12 @@ class MeasurePage(WizardPage):
 
     def request(self) -> MeasurementRequest:
         s = self.state
+        limits = self.large_signal.limits() if self.is_large_signal() else None
         return MeasurementRequest(s.driver, s.hardware, TEMPLATES[s.driver.template], s.corrections, s.level_v,
-                                  s.level_reason, self.out_dir())
+                                  s.level_reason, self.out_dir(), limits)
+
+    def is_large_signal(self) -> bool:
+        return self.state.driver is not None and self.state.driver.template == LARGE_SIGNAL
 
     def enter(self) -> None:
         s = self.state
@@ -85,12 +124,18 @@ class MeasurePage(WizardPage):
         right = [("Level", f"{s.level_v:.4g} V rms ({s.level_words})"), ("Excitation", t.describe().split(";")[0]),
                  ("Recording to", str(self.out_dir()))]
         self.summary.setText(_table(left, right))
+        self.large_signal.setVisible(self.is_large_signal())
+        self.start_button.setText("Start the large-signal plan" if self.is_large_signal() else
+                                  "Start the measurement")
         self.summary.setToolTip(f"Level: {s.level_reason}\nMeasured by {runner_name()}")
         self.changed.emit()
 
     def missing(self) -> str | None:
         if self.jobs.busy:
             return "Wait for the measurement to finish, or cancel it."
+        if self.is_large_signal():
+            return ("The curves are on the Large-signal page." if self.large_signal_done is not None
+                    else "Start the large-signal plan.")
         if self.state.outcome is None:
             return "Start the measurement."
         return None
@@ -106,6 +151,9 @@ class MeasurePage(WizardPage):
             self.enter()
 
     def on_start(self) -> None:
+        if self.is_large_signal():
+            self.start_large_signal()
+            return
         self.state.outcome = None
         self.result.setText("")
         self.panels.clear(band_hz=self.request().template.band_hz)
@@ -121,6 +169,28 @@ class MeasurePage(WizardPage):
         self.result.setText(coloured(f"Written {outcome.path} and analysed (validity {overall}). ", OK_COLOUR)
                             + "Next shows the parameters.")
         self.measured.emit(outcome)
+        self.changed.emit()
+
+    def start_large_signal(self) -> None:
+        self.large_signal_done = None
+        self.result.setText("")
+        self.panels.clear(band_hz=self.request().template.band_hz)
+        self.jobs.run(self.session.measure_large_signal(self.request()), "Starting…", self.on_large_signal,
+                      lambda message: self.result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
+                      lambda: self.result.setText("Large-signal plan cancelled: its steps so far are kept."),
+                      frame=self.panels.set_frame)
+        self.changed.emit()
+
+    def on_large_signal(self, done) -> None:
+        self.large_signal_done = done
+        plan = done.plan
+        steps = f"{len(plan.steps)} step(s) recorded in {html.escape(str(self.out_dir()))}; stopped: " \
+                f"{html.escape(plan.message)}. "
+        if done.result is None:
+            self.result.setText(coloured(steps + "Not identified: " + html.escape(done.error), ERROR_COLOUR))
+        else:
+            self.result.setText(coloured(steps, OK_COLOUR) + "The curves are on the Large-signal page.")
+            self.large_signal_measured.emit(done)
         self.changed.emit()
 
     def on_busy_changed(self, busy: bool) -> None:

@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass
 from analysis.multitone import Multitone, design_multitone
 
 SAMPLE_RATE = 48000
+LARGE_SIGNAL = "large-signal"       # the template whose measurement is the large-signal plan, not one recording
 PROBE_SECONDS = 1.0         # averaged per level-check probe: enough for the SNR statistics, not more
 
 
@@ -76,6 +77,8 @@ LEVEL_LIMITS = {
     "midrange": ("Midrange (fs 100–500 Hz)", 0.05, 4.0, 0.3e-3),
     "tweeter": ("Tweeter (fs above 500 Hz)", 0.02, 2.0, 0.05e-3),
     "microspeaker": ("Microspeaker (fs 300 Hz – 1.5 kHz)", 0.01, 1.0, 0.1e-3),
+    # The level check finds the small-signal level the large-signal plan starts from (app/wizard/tasks.py).
+    LARGE_SIGNAL: ("Large signal: Bl(x), Kms(x), Le(x) (woofers, midranges)", 0.05, 5.0, 0.5e-3),
 }
 # key: (f_min, f_max, period, periods, settle) when instruments.measurement is not installed.
 FALLBACK = {
@@ -83,6 +86,7 @@ FALLBACK = {
     "midrange": (20.0, 20000.0, 16384, 16, 5),
     "tweeter": (200.0, 20000.0, 16384, 16, 5),
     "microspeaker": (50.0, 20000.0, 16384, 16, 5),
+    "large-signal": (5.0, 10000.0, 16384, 4, 5),
 }
 
 

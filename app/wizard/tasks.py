@@ -48,6 +48,7 @@ class MeasurementRequest:
     level_v: float
     level_reason: str
     out_dir: Path
+    limits: object = None           # analysis.large_signal.stepping.StepLimits, for the large-signal template
 
 
 def recording_stem(driver: DriverInfo) -> str:
@@ -225,3 +226,55 @@ def run_measurement_fallback(request: MeasurementRequest, on_frame: FrameSink | 
         progress(STAGE_FRACTION["analysing"], f"analysing {wav.name}")
     # Read back: the analysis sees exactly what the file holds (float32), and knows its source.
     return wav, analyze_recording(read_recording(wav), request.driver.sd_m2, cancel=cancel)
+
+
+# --- the large-signal plan ---------------------------------------------------------------------------
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class LargeSignalMeasured:
+    """The plan's outcome (instruments.measurement.large_signal_plan) and the identification of its steps."""
+
+    plan: object                    # LargeSignalOutcome
+    result: object | None           # analysis.large_signal.LargeSignalResult, None when it could not be made
+    error: str = ""                 # why not
+    request: object = None
+
+
+def run_large_signal_plan(request: MeasurementRequest, on_frame: FrameSink | None = None,
+                          cancel: threading.Event | None = None, progress: Progress | None = None
+                          ) -> LargeSignalMeasured:
+    """The large-signal plan from the level check's level, each step's periods to the live panels, then the
+    identification of the usable steps."""
+    from analysis.large_signal import LargeSignalError, large_signal
+    from analysis.large_signal.stepping import StepLimits
+    from instruments.measurement import MeasurementPlan
+    from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
+    hw = request.hardware
+    base = MeasurementPlan.from_template(request.template.key, driver=request.driver.as_json(),
+                                         laser_rate_hz=hw.laser_rate_hz,
+                                         calibration={"corrections": request.corrections.to_dict()})
+    limits = request.limits or StepLimits()
+    if request.level_v > limits.max_voltage_v:
+        from instruments.measurement import MeasurementError
+        raise MeasurementError(f"the level {request.level_v:.3g} V is above the plan's maximum voltage "
+                               f"{limits.max_voltage_v:.3g} V: raise the maximum, or choose a lower level")
+    plan = LargeSignalPlan(base, request.level_v, limits=limits)
+    audio, laser = open_devices(hw, request.corrections)
+    steps = [0]
+
+    def measure(*args, **kwargs):
+        steps[0] += 1
+        fraction = 1.0 - 0.85 ** steps[0]           # the number of steps is not known: the bar never fills
+        return find_runner()(*args, listeners=[on_frame] if on_frame else (),
+                             **{**kwargs, "progress": runner_progress(
+                                 None if progress is None else lambda f, text: progress(fraction, text))})
+    outcome = run_large_signal(plan, audio, laser, request.out_dir, name=recording_stem(request.driver),
+                               cancel=cancel, measure=measure)
+    if not outcome.recordings:
+        return LargeSignalMeasured(outcome, None, f"no usable step: {outcome.message}", request)
+    if progress is not None:
+        progress(0.97, f"identifying Bl(x), Kms(x), Le(x) from {len(outcome.recordings)} step(s)")
+    try:
+        return LargeSignalMeasured(outcome, large_signal(outcome.recordings), "", request)
+    except LargeSignalError as exc:
+        return LargeSignalMeasured(outcome, None, str(exc), request)

@@ -25,6 +25,7 @@ from instruments.rig.state import DEFAULT_NAME
 
 class MeasureWizard(QWidget):
     measurement_finished = Signal(object)        # app.measure_session.MeasureOutcome
+    large_signal_finished = Signal(object)       # app.wizard.tasks.LargeSignalMeasured (with a result)
     open_results_requested = Signal(object)      # app.workers.AnalysisOutcome
 
     def __init__(self, settings: QSettings, session: MeasureSession | None = None, parent=None, *,
@@ -73,6 +74,7 @@ class MeasureWizard(QWidget):
         self.back_button.clicked.connect(self.on_back)
         self.next_button.clicked.connect(self.on_next)
         self.measure_page.measured.connect(self.measurement_finished)
+        self.measure_page.large_signal_measured.connect(self.large_signal_finished)
         self.results_page.open_requested.connect(self.open_results_requested)
         self.results_page.again_requested.connect(self.on_again)
         self.go_to(0)

@@ -148,3 +148,20 @@ def test_a_failing_device_is_a_message_not_a_crash(qtbot, wizard, monkeypatch):
     run_job(qtbot, page.test_audio_button, page.audio_jobs)
     assert "Failed: sound card 'X' not found" in plain(page.audio_result)
     assert wizard.next_button.isEnabled()          # a test is advice; the user may go on
+
+
+def test_the_large_signal_template_runs_the_plan_and_hands_the_curves_over(qtbot, wizard):
+    """On the simulator (the paper's driver, linear): the plan steps up to the excursion set here, each step a
+    recording, and the identification of the steps goes to the Large-signal page (flat curves: no nonlinearity)."""
+    skip_to_measure(qtbot, wizard, realtime=False, level=0.5, template="large-signal")
+    page = wizard.measure_page
+    assert page.large_signal.isVisible() and "large-signal plan" in page.start_button.text()
+    page.large_signal.excursion.setValue(1.0)
+    with qtbot.waitSignal(page.large_signal_measured, timeout=4 * JOB_TIMEOUT_MS) as handed:
+        page.start_button.click()
+    done = handed.args[0]
+    assert done.plan.stopped_by == "excursion" and len(done.plan.steps) >= 2
+    assert all(p.is_file() for p in done.plan.recordings)
+    assert done.result.model.Bl.coefficients[0] == pytest.approx(5.23, rel=0.01)
+    assert "step(s) recorded" in plain(page.result)
+    assert page.missing() == "The curves are on the Large-signal page."
