@@ -122,9 +122,24 @@ PARAMETER = Bound("a parameter value", "SI", -1e30, 1e30,
                   "fitted and derived values as stored in an archive record: finite, not astronomical")
 LASER_RANGE_M = Bound("a laser measuring range", "m", 1e-4, 10.0,
                       "the sensor's reply: 10 mm (ILD1420-10) to 500 mm; garbage otherwise")
+# The large-signal identification and plan (analysis/large_signal/, docs/large-signal.md).
+EXCURSION_MM = Bound("a peak excursion", "mm", 0.01, 50.0,
+                     "the large-signal plan's limit: a micro speaker's tenth of a mm to a subwoofer's 50 mm")
+TEMPERATURE_RISE_K = Bound("a temperature rise", "K", 0.1, 200.0,
+                           "the voice coil's warming the plan allows; coils are rated to 150 - 250 C")
+DISTORTION_DB = Bound("a distortion level", "dB", -80.0, 0.0,
+                      "the current's distortion re the signal at which the plan stops: inaudible to all distortion")
+LEVEL_STEP = Bound("a level factor", "", 1.05, 4.0, "the plan's steps: +0.4 dB to +12 dB each")
+LIMIT_PERCENT = Bound("a limit's threshold", "%", 1.0, 99.0,
+                      "X_Bl, X_C, X_L: the published 82 %, 75 %, 10 % and any threshold that is a fraction")
+POLYNOMIAL_ORDER = Bound("a polynomial order", "", 0, 8,
+                         "Bl(x), Kms(x), Le(x): beyond 8 the powers of x are too alike to tell apart", integer=True)
+AUDIO_FREQUENCY = Bound("an audio frequency", "Hz", 1.0, 20000.0,
+                        "a distortion prediction's sine or tones: within the band a multitone measures")
 
 BOUNDS = (SAMPLE_RATE, PERIOD_SAMPLES, SD, FREQUENCY, IMPEDANCE, HX, PHASE_DEG, CHANNEL_SCALE, LEVEL_V_RMS,
-          PERIODS, ADDED_MASS_G, XRUN_S, LIST_LIMIT, YEAR, PARAMETER, LASER_RANGE_M)
+          PERIODS, ADDED_MASS_G, XRUN_S, LIST_LIMIT, YEAR, PARAMETER, LASER_RANGE_M, EXCURSION_MM,
+          TEMPERATURE_RISE_K, DISTORTION_DB, LEVEL_STEP, LIMIT_PERCENT, POLYNOMIAL_ORDER, AUDIO_FREQUENCY)
 
 
 # --- file sizes ------------------------------------------------------------------------------------------------

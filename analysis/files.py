@@ -133,6 +133,27 @@ def check_output(path: str | Path) -> None:
                           f"choose another name")
 
 
+def check_outputs_spare_inputs(outputs, inputs) -> None:
+    """OutputError when an output (option, path) is one of the command's inputs or an earlier output: the same
+    path after links (realpath, not resolve(): a symlink loop is a bad input, not a RuntimeError) or the same
+    file by another name (a hard link)."""
+    seen: list[Path] = []
+    for option, path in outputs:
+        path = Path(path)
+        for other in [*inputs, *seen]:
+            if os.path.realpath(path) == os.path.realpath(other) or _same_file(path, other):
+                raise OutputError(f"{option} {path}: that file is an input of this command (or another output): "
+                                  f"choose another name, nothing was written")
+        seen.append(path)
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:         # one of them does not exist (yet), or cannot be reached
+        return False
+
+
 def is_regular(path: str | Path) -> bool:
     """True for an existing regular file (after symlinks), without reading it."""
     try:

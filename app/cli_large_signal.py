@@ -31,43 +31,22 @@ command runs.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
+from analysis.bounds import (AUDIO_FREQUENCY, DISTORTION_DB, EXCURSION_MM, LEVEL_STEP, LEVEL_V_RMS, LIMIT_PERCENT,
+                             POLYNOMIAL_ORDER, TEMPERATURE_RISE_K)
+from app.cli_options import number
+
 PLANS = ("single", "large-signal")
-SUMMARY_SUFFIX = ".large-signal.json"
 OUTPUTS = (("pdf", "write the report as PDF"), ("html", "write the report as HTML (self-contained)"),
            ("csv", "write the curves as CSV (x, Bl, Kms, Cms, Le with 1-sigma across the measured range)"),
            ("export-json", "write the JSON (as --json prints it) to FILE"))
 
 
-def _number(low: float, high: float, what: str):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}") from None
-        if not (math.isfinite(value) and low <= value <= high):
-            raise argparse.ArgumentTypeError(f"expected {what} from {low:g} to {high:g}, got {text!r}")
-        return value
-    return parse
-
-
-def _order(text: str) -> int:
-    from analysis.large_signal.identify import HIGHEST_ORDER
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if not 0 <= value <= HIGHEST_ORDER:
-        raise argparse.ArgumentTypeError(f"expected an order from 0 to {HIGHEST_ORDER}, got {text!r}")
-    return value
-
-
 def _two_tones(text: str) -> tuple[float, float]:
+    parse = number(AUDIO_FREQUENCY)
     parts = [p for p in text.split(",") if p.strip()]
-    parse = _number(1.0, 20000.0, "a frequency in Hz")
     if len(parts) != 2:
         raise argparse.ArgumentTypeError(f"expected two frequencies F1,F2 in Hz (F1 < F2), got {text!r}")
     f1, f2 = (parse(p) for p in parts)
@@ -81,17 +60,17 @@ def add_commands(sub) -> None:
     c.add_argument("paths", nargs="+", metavar="REC",
                    help="recordings of one driver at large signal (NAME, NAME.wav or NAME.json), or a plan's "
                         "NAME.large-signal.json")
-    c.add_argument("--order", type=_order, default=6, metavar="N",
+    c.add_argument("--order", type=number(POLYNOMIAL_ORDER), default=6, metavar="N",
                    help="highest polynomial order BIC may choose for Bl, Kms, Le (default %(default)s)")
-    c.add_argument("--bl-min", type=_number(1.0, 99.0, "a percentage"), default=82.0, metavar="PCT",
+    c.add_argument("--bl-min", type=number(LIMIT_PERCENT), default=82.0, metavar="PCT",
                    help="X_Bl: the excursion where Bl falls to PCT %% of Bl(0) (default %(default)g, Klippel)")
-    c.add_argument("--cms-min", type=_number(1.0, 99.0, "a percentage"), default=75.0, metavar="PCT",
+    c.add_argument("--cms-min", type=number(LIMIT_PERCENT), default=75.0, metavar="PCT",
                    help="X_C: where the compliance falls to PCT %% of Cms(0) (default %(default)g)")
-    c.add_argument("--le-change", type=_number(1.0, 99.0, "a percentage"), default=10.0, metavar="PCT",
+    c.add_argument("--le-change", type=number(LIMIT_PERCENT), default=10.0, metavar="PCT",
                    help="X_L: where Le leaves Le(0) by PCT %% (default %(default)g, after IEC 62458)")
-    c.add_argument("--predict", type=_number(1e-3, 200.0, "a level in V RMS"), metavar="VOLT",
+    c.add_argument("--predict", type=number(LEVEL_V_RMS), metavar="VOLT",
                    help="predict the distortion at this level (V RMS): the multitone, and --sine / --two-tones")
-    c.add_argument("--sine", type=_number(1.0, 20000.0, "a frequency in Hz"), metavar="HZ",
+    c.add_argument("--sine", type=number(AUDIO_FREQUENCY), metavar="HZ",
                    help="with --predict: H2 and H3 of current and displacement for a sine at HZ")
     c.add_argument("--two-tones", type=_two_tones, metavar="F1,F2",
                    help="with --predict: IMD2 and IMD3 for two tones F1 + F2 (amplitudes 4:1)")
@@ -100,31 +79,40 @@ def add_commands(sub) -> None:
         c.add_argument(f"--{option}", type=Path, metavar="FILE", help=what)
 
 
+# The large-signal plan's limits: (option, bound, default, help). Their defaults are filled in by run_plan, so
+# that a limit given to the single plan, which would ignore it, is seen and refused (plan_options_checked).
+PLAN_LIMITS = (
+    ("max-excursion", EXCURSION_MM, 4.0, "MM", "stop at this peak excursion (default %g mm)"),
+    ("max-voltage", LEVEL_V_RMS, 10.0, "VOLT", "never above this level (default %g V RMS)"),
+    ("max-distortion", DISTORTION_DB, -20.0, "DB", "stop when the current's distortion reaches DB re the signal "
+                                                   "(default %g dB)"),
+    ("max-temperature-rise", TEMPERATURE_RISE_K, 20.0, "K", "stop when the voice coil warmed by K kelvin (RE per "
+                                                            "period; default %g K)"),
+    ("step", LEVEL_STEP, 1.41, "FACTOR", "level factor per step (default %g, +3 dB)"),
+)
+
+
 def add_plan_options(measure: argparse.ArgumentParser) -> None:
     """measure's --plan and the large-signal plan's limits."""
     measure.add_argument("--plan", choices=PLANS, default="single",
                          help="'single': one measurement (default); 'large-signal': steps up the level until a "
                               "limit, each step a recording, then identifies Bl(x), Kms(x), Le(x)")
-    measure.add_argument("--max-excursion", type=_number(0.01, 50.0, "a peak excursion in mm"), default=4.0,
-                         metavar="MM", help="large-signal plan: stop at this peak excursion (default %(default)g mm)")
-    measure.add_argument("--max-voltage", type=_number(0.001, 200.0, "a level in V RMS"), default=10.0,
-                         metavar="VOLT", help="large-signal plan: never above this level (default %(default)g V RMS)")
-    measure.add_argument("--max-distortion", type=_number(-80.0, 0.0, "a level in dB"), default=-20.0,
-                         metavar="DB", help="large-signal plan: stop when the current's distortion reaches DB re "
-                                            "the signal (default %(default)g dB)")
-    measure.add_argument("--max-temperature-rise", type=_number(0.1, 200.0, "a temperature rise in K"),
-                         default=20.0, metavar="K",
-                         help="large-signal plan: stop when the voice coil warmed by K kelvin (RE per period; "
-                              "default %(default)g K)")
-    measure.add_argument("--step", type=_number(1.05, 4.0, "a factor"), default=1.41, metavar="FACTOR",
-                         help="large-signal plan: level factor per step (default %(default)g, +3 dB)")
+    for option, bound, default, metavar, what in PLAN_LIMITS:
+        measure.add_argument(f"--{option}", type=number(bound), metavar=metavar,
+                             help=f"large-signal plan: {what % default}")
 
 
-def user_errors() -> tuple[type[BaseException], ...]:
-    """Errors shown to the user as one line (exit 2) by app.cli."""
-    from analysis.large_signal import LargeSignalError
-    from analysis.recording import RecordingError
-    return (LargeSignalError, RecordingError, ValueError, OSError)
+def plan_options_checked(args: argparse.Namespace) -> None:
+    """CliError when the single plan is given a large-signal limit; otherwise each limit not given gets its
+    default."""
+    from app.cli import CliError
+    for option, _, default, _, _ in PLAN_LIMITS:
+        attribute = option.replace("-", "_")
+        if getattr(args, attribute) is None:
+            setattr(args, attribute, default)
+        elif args.plan != "large-signal":
+            raise CliError(f"--{option} is a limit of the large-signal plan: add --plan large-signal, or leave it "
+                           f"out")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -149,28 +137,25 @@ def run(args: argparse.Namespace) -> int:
 
 
 def checked_outputs(args: argparse.Namespace, inputs) -> dict[str, Path]:
-    """The files to write, refused (ValueError, one line) when one would replace an input of this command or
-    something that is not a regular file."""
+    """The files to write; OutputError (one line) when one would replace an input of this command (a recording's
+    WAV or sidecar), another output or something that is not a regular file."""
+    from analysis.files import check_output, check_outputs_spare_inputs
     from analysis.recording import recording_paths
-    taken = set()
-    for path in inputs:
-        try:
-            taken.update(p.resolve() for p in recording_paths(path))
-        except (OSError, ValueError):
-            taken.add(Path(path).resolve())
-    outputs = {}
-    for option, _ in OUTPUTS:
-        path = getattr(args, option.replace("-", "_"))
-        if path is None:
-            continue
-        if path.resolve() in taken:
-            raise ValueError(f"--{option} {path}: that is one of the recordings read: choose another file")
-        if path.exists() and not path.is_file():
-            raise ValueError(f"--{option} {path}: not a regular file")
-        if path.resolve() in {p.resolve() for p in outputs.values()}:
-            raise ValueError(f"--{option} {path}: already named for another output")
-        outputs[option] = path
+    taken = [p for path in inputs for p in _recording_files(path, recording_paths)]
+    outputs = {option: path for option, _ in OUTPUTS
+               if (path := getattr(args, option.replace("-", "_"))) is not None}
+    check_outputs_spare_inputs([(f"--{option}", path) for option, path in outputs.items()], taken)
+    for path in outputs.values():
+        check_output(path)          # a FIFO, a device, a folder: refused before anything runs
     return outputs
+
+
+def _recording_files(path, recording_paths) -> list[Path]:
+    """The files a recording argument reads (NAME.wav and NAME.json), or the path as given if it names none."""
+    try:
+        return list(recording_paths(path))
+    except (OSError, ValueError):
+        return [Path(path)]
 
 
 def write_outputs(result, outputs: dict[str, Path]) -> list[Path]:
@@ -185,22 +170,10 @@ def write_outputs(result, outputs: dict[str, Path]) -> list[Path]:
 
 def expand(paths) -> list[Path]:
     """Recordings, with a plan's summary replaced by its complete steps (in its folder)."""
-    import json
-    from analysis.large_signal import LargeSignalError
+    from analysis.large_signal.plan_summary import is_summary, summary_recordings
     out = []
-    for text in paths:
-        path = Path(text)
-        if not path.name.endswith(SUMMARY_SUFFIX):
-            out.append(path)
-            continue
-        try:
-            doc = json.loads(path.read_text(encoding="utf-8"))
-            steps = [s for s in doc["steps"] if s.get("recording") and s.get("usable", not s.get("partial"))]
-        except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, AttributeError) as exc:
-            raise LargeSignalError(f"{path}: not a readable large-signal plan summary ({exc})") from None
-        if not steps:
-            raise LargeSignalError(f"{path}: the plan recorded no complete step")
-        out += [path.parent / str(s["recording"]) for s in steps]
+    for given in paths:
+        out += summary_recordings(given) if is_summary(given) else [Path(given)]
     return out
 
 
@@ -219,6 +192,13 @@ def run_plan(args: argparse.Namespace) -> int:
     from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
     from instruments.measurement.plan import MeasurementPlan
 
+    plan_options_checked(args)
+    if args.out.exists() and not args.out.is_dir():
+        raise CliError(f"--out {args.out}: not a folder: the plan writes a recording a step and its summary there; "
+                       f"choose a folder")
+    if args.level is not None and args.level > args.max_voltage:
+        raise CliError(f"--level {args.level:g} V: the plan starts at most at --max-voltage {args.max_voltage:g} V: "
+                       f"lower --level or raise --max-voltage")
     base = MeasurementPlan.from_template(args.template or "large-signal", n_periods=args.periods,
                                          period_samples=args.period, on_xrun=args.on_xrun)
     limits = StepLimits(args.max_excursion * 1e-3, args.max_voltage, args.max_distortion, args.max_temperature_rise)

@@ -100,6 +100,8 @@ def run(args: argparse.Namespace) -> int:
     from instruments.measurement.recovery import find_unfinished, run_journaled
     from instruments.measurement.runner import MeasurementCancelled
 
+    from app.cli_large_signal import plan_options_checked
+    plan_options_checked(args)          # a large-signal limit given to this single measurement is refused
     effects = _effects(args.model) if args.model else None
     for unfinished in find_unfinished(args.out):
         _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "

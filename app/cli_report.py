@@ -12,7 +12,6 @@ verdict: `linpar analyze --limits` is the command whose exit code is the verdict
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from analysis.bounds import SD
@@ -76,26 +75,11 @@ def load_source(args):
 
 
 def _outputs_spare_the_inputs(args, outputs) -> None:
-    """CliError when an output file is one of the command's inputs (the recording, the limits, each other)."""
+    """OutputError when an output file is one of the command's inputs (the recording, the limits, each other)."""
+    from analysis.files import check_outputs_spare_inputs
     from analysis.recording import recording_paths
-    from app.cli import CliError
     inputs = [*recording_paths(args.source), *([Path(args.limits)] if getattr(args, "limits", None) else [])]
-    seen = []
-    for option, path in outputs:
-        path = Path(path)
-        for other in [*inputs, *seen]:
-            # realpath, not resolve(): a symlink loop is a bad input to report, not a RuntimeError
-            if os.path.realpath(path) == os.path.realpath(other) or _same_file(path, other):
-                raise CliError(f"{option} {path}: that file is an input of this command (or another output): "
-                               f"choose another name, nothing was written")
-        seen.append(path)
-
-
-def _same_file(a, b) -> bool:
-    try:
-        return os.path.samefile(a, b)
-    except OSError:         # one of them does not exist (yet), or cannot be reached
-        return False
+    check_outputs_spare_inputs(outputs, inputs)
 
 
 def run(args: argparse.Namespace) -> int:

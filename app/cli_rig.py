@@ -86,7 +86,10 @@ def _start(args) -> int:
     # A driver file or a spec that cannot be used is one line here, not a rig process that dies starting.
     from analysis.drivers import load_driver
     from instruments.rig.engine import RigFaults, RigNoise
-    load_driver(args.driver)
+    definition = load_driver(args.driver)
+    if args.model == "nonlinear":         # its curves too (a short FIR: only the shapes are checked)
+        from instruments.simulation.nonlinear_driver_file import nonlinear_driver_of
+        nonlinear_driver_of(definition, 48000, fir_length=1024)
     RigFaults.parse(args.fault)
     if args.noise:
         RigNoise.parse(args.noise)

@@ -8,7 +8,6 @@ Series page's level series ("Large-signal curves") or with its own button.
 from __future__ import annotations
 
 import html
-import logging
 import math
 import threading
 from pathlib import Path
@@ -19,11 +18,10 @@ from PySide6.QtCore import QObject, Qt, QThreadPool, Signal
 from PySide6.QtWidgets import (QComboBox, QFileDialog, QGridLayout, QHBoxLayout, QLabel, QProgressBar, QPushButton,
                                QSplitter, QVBoxLayout, QWidget)
 
-from analysis.large_signal import LargeSignalError, LargeSignalResult, large_signal
+from analysis.large_signal import LargeSignalResult, large_signal
 from app.large_signal_plots import CurvePlot, DistortionPlot
-from app.workers import USER_ERRORS
+from app.job_book import failure_text
 
-log = logging.getLogger(__name__)
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 SAVE_FILTER = "PDF report (*.pdf);;HTML report (*.html);;Curves as CSV (*.csv);;Curves as JSON (*.json)"
 EMPTY_TEXT = ("No large-signal curves yet: choose recordings of one driver at large signal (a level series, or "
@@ -55,14 +53,9 @@ class LargeSignalWorker(QObject):
     def _run(self, paths: list[Path], cancel: threading.Event) -> None:
         try:
             result = large_signal(paths)
-        except (LargeSignalError, ValueError, *USER_ERRORS) as exc:
+        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
             if not cancel.is_set():
-                self.failed.emit(str(exc).splitlines()[0])
-            return
-        except Exception as exc:  # noqa: BLE001 - the GUI must survive whatever a file does
-            log.exception("large-signal identification failed")
-            if not cancel.is_set():
-                self.failed.emit(f"internal error ({type(exc).__name__}: {exc})")
+                self.failed.emit(failure_text(exc, "the large-signal identification"))
             return
         if cancel.is_set():
             self.failed.emit("cancelled")
@@ -177,8 +170,8 @@ class LargeSignalPage(QWidget):
             return
         try:
             write_atomic(path, render(self.result))
-        except OSError as exc:
-            self.status.setText(f"Not saved: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a full disk is the user's, a bug is said as one (job_book)
+            self.status.setText(f"Not saved: {failure_text(exc, f'saving {path.name}')}")
             return
         self.status.setText(f"Saved {path}")
 

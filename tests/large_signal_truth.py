@@ -73,3 +73,29 @@ def noisy_recording(block, mt, settle: int = 2, seed: int = 0, noise: ChannelNoi
                "displacement": block.displacement + rng.normal(0, noise.displacement, n)}
     return make_recording(FS, signals, mt.period_samples, settle, tuple(int(k) for k in mt.excited_bins),
                           driver={"name": driver_name})
+
+
+def write_steps(folder, levels=(5.0, 9.0), period: int = 8192) -> list:
+    """The known driver at each level, 4 periods each, written as recordings in folder: their WAV paths."""
+    from analysis.recording import write_recording
+    driver = known_driver(period)
+    paths = []
+    for level in levels:
+        block, mt = clean_periods(driver, level, 4)
+        paths.append(write_recording(folder / f"step-{level:g}V", noisy_recording(block, mt))[0])
+    return paths
+
+
+def inner(x_range, share: float = 0.8, points: int = 81) -> np.ndarray:
+    """`points` values of x over the middle `share` of x_range (the issue's "80 % of the covered range")."""
+    lo, hi = x_range
+    margin = (1.0 - share) / 2.0 * (hi - lo)
+    return np.linspace(lo + margin, hi - margin, points)
+
+
+def relative_errors(model, driver, name: str) -> tuple[float, float]:
+    """The curve's largest relative error against the driver's truth over the middle 80 % of the measured range,
+    and its relative error at rest (x = 0)."""
+    curve, truth = model.curves[name], getattr(driver, name.lower())
+    x = inner(model.x_range)
+    return float(np.max(np.abs(curve(x) / truth(x) - 1.0))), float(curve(0.0) / truth(0.0) - 1.0)

@@ -8,18 +8,13 @@ import pytest
 
 from analysis.recording import make_recording, write_recording
 from app.cli import main
-from tests.large_signal_truth import KNOWN_OFFSET_M, clean_periods, known_driver, noisy_recording
+from tests.large_signal_truth import KNOWN_OFFSET_M, write_steps
 
 
 @pytest.fixture(scope="module")
 def recordings(tmp_path_factory):
     folder = tmp_path_factory.mktemp("large-signal")
-    driver = known_driver(8192)
-    paths = []
-    for level in (5.0, 9.0):
-        block, mt = clean_periods(driver, level, 4)
-        paths.append(write_recording(folder / f"step-{level:g}V", noisy_recording(block, mt))[0])
-    return folder, paths
+    return folder, write_steps(folder)
 
 
 def run(argv, capsys):
@@ -77,7 +72,7 @@ def test_the_report_and_the_curves_are_written_and_never_over_an_input(recording
     sidecar = paths[1].with_suffix(".json")
     before = sidecar.read_bytes()
     code, _, err = run(["large-signal", str(paths[1]), "--csv", str(sidecar)], capsys)
-    assert code == 2 and "one of the recordings read" in err and sidecar.read_bytes() == before
+    assert code == 2 and "an input of this command" in err and sidecar.read_bytes() == before
 
 
 def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
@@ -89,16 +84,22 @@ def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
     cases = [
         (["large-signal", str(tmp_path / "missing")], "missing"),
         (["large-signal", str(no_laser)], "no displacement"),
-        (["large-signal", good, "--order", "12"], "order"),
-        (["large-signal", good, "--bl-min", "nan"], "percentage"),
-        (["large-signal", good, "--le-change", "150"], "percentage"),
+        (["large-signal", good, "--order", "12"], "polynomial order"),
+        (["large-signal", good, "--bl-min", "nan"], "limit's threshold"),
+        (["large-signal", good, "--le-change", "150"], "limit's threshold"),
         (["large-signal", good, "--sine", "40"], "--predict"),
         (["large-signal", good, "--predict", "6", "--two-tones", "500,30"], "F1 < F2"),
-        (["large-signal", good, "--predict", "inf"], "level"),
+        (["large-signal", good, "--predict", "inf"], "drive level"),
+        (["large-signal", good, "--predict", "6", "--sine", "1e6"], "audio frequency"),
         (["large-signal", str(tmp_path / "empty.large-signal.json")], "no complete step"),
         (["large-signal", good, "--pdf", str(tmp_path)], "not a regular file"),
-        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--max-excursion", "-1"], "excursion"),
-        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--step", "9"], "factor"),
+        (["large-signal", good, "--html", "/dev/null"], "not a regular file"),
+        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--max-excursion", "-1"], "peak excursion"),
+        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--step", "9"], "level factor"),
+        # refused before any rig starts: a limit the single plan would ignore, a start above the top, a file as --out
+        (["measure", "--out", str(tmp_path), "--max-excursion", "3"], "add --plan large-signal"),
+        (["measure", "--out", str(tmp_path), "--plan", "large-signal", "--level", "20"], "--max-voltage 10 V"),
+        (["measure", "--out", str(tmp_path / "empty.large-signal.json"), "--plan", "large-signal"], "not a folder"),
     ]
     for argv, words in cases:
         code, out, err = run(argv, capsys)

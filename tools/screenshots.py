@@ -119,11 +119,16 @@ def model_lab_unexplained_screenshots(app: QApplication, window, folder: Path, o
     if not wait_for(lab.diagnosis_shown, ANALYSIS_TIMEOUT_S):
         print("screenshots: the diagnosis of the odd-damping recording did not finish in time", file=sys.stderr)
         return []
+    return grab_small_and_large(app, window, out, "model-lab-unexplained")
+
+
+def grab_small_and_large(app: QApplication, window, out: Path, stem: str) -> list[Path]:
+    """The window as it is, at 1280x720 and at 1920x1080 (OUT/STEM-WxH.png); then back to its usual size."""
     written = []
     for width, height in SMALL_AND_LARGE:
         window.resize(width, height)
         settle(app, 600)
-        path = out / f"model-lab-unexplained-{width}x{height}.png"
+        path = out / f"{stem}-{width}x{height}.png"
         window.grab().save(str(path))
         written.append(path)
     window.resize(*SIZE)
@@ -248,16 +253,7 @@ def large_signal_screenshots(app: QApplication, window, folder: Path, out: Path)
     if not wait_for(page.result_shown, 4 * ANALYSIS_TIMEOUT_S):
         print("screenshots: the large-signal identification did not finish", file=sys.stderr)
         return []
-    written = []
-    for width, height in SMALL_AND_LARGE:
-        window.resize(width, height)
-        settle(app, 600)
-        path = out / f"large-signal-{width}x{height}.png"
-        window.grab().save(str(path))
-        written.append(path)
-    window.resize(*SIZE)
-    settle(app)
-    return written
+    return grab_small_and_large(app, window, out, "large-signal")
 
 
 # A production batch of the paper's driver measured in the days before: (serial, operator, station, days and

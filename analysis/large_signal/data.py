@@ -24,11 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.errors import LinparError
 from analysis.recording import MIN_PERIODS, Recording
 
 
-class LargeSignalError(ValueError):
-    """Recordings that cannot give large-signal curves (no laser, too few periods, ...). One line."""
+class LargeSignalError(LinparError, ValueError):
+    """Recordings, options or limits that cannot give large-signal curves (no laser, too few periods, ...).
+    One line."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)

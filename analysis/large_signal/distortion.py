@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.large_signal.data import RecordingData
+from analysis.large_signal.data import LargeSignalError, RecordingData
 from analysis.large_signal.model import LargeSignalModel
 from analysis.large_signal.simulate import SimulationDiverged, steady_state
 
@@ -159,6 +159,9 @@ def harmonics(model: LargeSignalModel, frequency_hz: float, level_rms_v: float, 
     """H2 and H3 (dB re the fundamental) of current and displacement for a sine of level_rms_v at frequency_hz
     (moved to the nearest line of the period: the returned "frequency_hz")."""
     k = max(1, int(round(frequency_hz * period / sample_rate)))
+    if not 2 * k < period // 2:
+        raise LargeSignalError(f"a sine at {frequency_hz:g} Hz: its second harmonic is beyond the "
+                               f"{sample_rate / 2:g} Hz the model is sampled to")
     t = np.arange(period)
     u = level_rms_v * math.sqrt(2.0) * np.sin(2 * np.pi * k * t / period)
     sim = steady_state(model, u, sample_rate)
@@ -176,6 +179,9 @@ def intermodulation(model: LargeSignalModel, f1_hz: float, f2_hz: float, level_r
     """IMD2 and IMD3 (dB re the f2 line) of current and displacement, two tones with amplitudes 4:1."""
     k1 = max(1, int(round(f1_hz * period / sample_rate)))
     k2 = max(3 * k1, int(round(f2_hz * period / sample_rate)))
+    if not k2 + 2 * k1 < period // 2:
+        raise LargeSignalError(f"two tones at {f1_hz:g} + {f2_hz:g} Hz: their products are beyond the "
+                               f"{sample_rate / 2:g} Hz the model is sampled to")
     t = np.arange(period)
     tones = 4.0 * np.sin(2 * np.pi * k1 * t / period) + np.sin(2 * np.pi * k2 * t / period)
     u = tones * level_rms_v / float(np.sqrt(np.mean(tones**2)))

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from analysis.large_signal.data import LargeSignalError
 from analysis.large_signal.model import LargeSignalModel
 
 GRID_POINTS = 801
@@ -37,8 +38,8 @@ class LimitThresholds:
     def __post_init__(self) -> None:
         for name, value in (("bl_ratio", self.bl_ratio), ("compliance_ratio", self.compliance_ratio),
                             ("le_change", self.le_change)):
-            if not (np.isfinite(value) and 0.0 < value < 1.0):
-                raise ValueError(f"{name}: expected a fraction between 0 and 1 (exclusive), got {value!r}")
+            if not (isinstance(value, (int, float)) and np.isfinite(value) and 0.0 < value < 1.0):
+                raise LargeSignalError(f"{name}: expected a fraction between 0 and 1 (exclusive), got {value!r}")
 
     def criteria(self) -> dict[str, str]:
         return {"X_Bl": f"Bl >= {self.bl_ratio * 100:g} %", "X_C": f"Cms >= {self.compliance_ratio * 100:g} %",

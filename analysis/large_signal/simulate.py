@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.errors import LinparError
 from analysis.large_signal.model import LargeSignalModel
 
 MAX_ITERATIONS = 200
@@ -32,7 +33,7 @@ TOLERANCE = 1e-10
 _ANDERSON_DEPTH = 6
 
 
-class SimulationDiverged(ArithmeticError):
+class SimulationDiverged(LinparError, ArithmeticError):
     """The iteration did not settle: the level is beyond what the curves can describe."""
 
 

@@ -33,11 +33,14 @@ here: the limit is reached as predicted.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from analysis.bounds import DISTORTION_DB, EXCURSION_MM, LEVEL_V_RMS, TEMPERATURE_RISE_K
 from analysis.excursion import recording_peak_displacement
+from analysis.large_signal.data import LargeSignalError
 from analysis.recording import Recording
 
 COPPER_ALPHA_PER_K = 0.00393
@@ -56,12 +59,13 @@ class StepLimits:
     max_temperature_rise_k: float = 20.0
 
     def __post_init__(self) -> None:
-        for name, value, low, high in (("max_excursion_m", self.max_excursion_m, 1e-5, 0.05),
-                                       ("max_voltage_v", self.max_voltage_v, 1e-3, 200.0),
-                                       ("max_current_distortion_db", self.max_current_distortion_db, -80.0, 0.0),
-                                       ("max_temperature_rise_k", self.max_temperature_rise_k, 0.1, 200.0)):
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and low <= value <= high):
-                raise ValueError(f"{name}: expected a number from {low:g} to {high:g}, got {value!r}")
+        # The same bounds as the CLI's options (analysis.bounds), the excursion's in mm
+        excursion = self.max_excursion_m
+        EXCURSION_MM.check(excursion * 1e3 if isinstance(excursion, numbers.Real) else excursion,
+                           "max_excursion_m (in mm)", LargeSignalError)
+        LEVEL_V_RMS.check(self.max_voltage_v, "max_voltage_v", LargeSignalError)
+        DISTORTION_DB.check(self.max_current_distortion_db, "max_current_distortion_db", LargeSignalError)
+        TEMPERATURE_RISE_K.check(self.max_temperature_rise_k, "max_temperature_rise_k", LargeSignalError)
 
     def as_json(self) -> dict:
         return asdict(self)

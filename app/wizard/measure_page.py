@@ -155,13 +155,7 @@ class MeasurePage(WizardPage):
             self.start_large_signal()
             return
         self.state.outcome = None
-        self.result.setText("")
-        self.panels.clear(band_hz=self.request().template.band_hz)
-        self.jobs.run(self.session.measure(self.request()), "Starting…", self.on_measured,
-                      lambda message: self.result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
-                      lambda: self.result.setText("Measurement cancelled: nothing analysed."),
-                      frame=self.panels.set_frame)
-        self.changed.emit()
+        self._run(self.session.measure, self.on_measured, "Measurement cancelled: nothing analysed.")
 
     def on_measured(self, outcome) -> None:
         self.state.outcome = outcome
@@ -173,12 +167,17 @@ class MeasurePage(WizardPage):
 
     def start_large_signal(self) -> None:
         self.large_signal_done = None
+        self._run(self.session.measure_large_signal, self.on_large_signal,
+                  "Large-signal plan cancelled: its steps so far are kept.")
+
+    def _run(self, start_job, on_done, cancelled_text: str) -> None:
+        """A measurement job of the session (start_job(request)), its frames on the live panels."""
         self.result.setText("")
-        self.panels.clear(band_hz=self.request().template.band_hz)
-        self.jobs.run(self.session.measure_large_signal(self.request()), "Starting…", self.on_large_signal,
+        request = self.request()
+        self.panels.clear(band_hz=request.template.band_hz)
+        self.jobs.run(start_job(request), "Starting…", on_done,
                       lambda message: self.result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
-                      lambda: self.result.setText("Large-signal plan cancelled: its steps so far are kept."),
-                      frame=self.panels.set_frame)
+                      lambda: self.result.setText(cancelled_text), frame=self.panels.set_frame)
         self.changed.emit()
 
     def on_large_signal(self, done) -> None:

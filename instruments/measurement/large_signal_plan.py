@@ -29,13 +29,17 @@ from pathlib import Path
 from typing import Callable
 
 from analysis.archive.atomic import write_atomic
+from analysis.bounds import LEVEL_STEP
+from analysis.errors import LinparError
+from analysis.files import check_output
+from analysis.large_signal.data import LargeSignalError
+from analysis.large_signal.plan_summary import SUMMARY_SUFFIX
 from analysis.large_signal.stepping import StepLimits, StepMeasures, next_level, step_measures, stop_reason
 from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import MeasurementPlan
 
 DEFAULT_STEP = 1.41          # +3 dB
 MAX_STEPS = 24
-SUMMARY_SUFFIX = ".large-signal.json"
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,12 +52,11 @@ class LargeSignalPlan:
 
     def __post_init__(self) -> None:
         if not (0 < self.start_level_v <= self.limits.max_voltage_v):
-            raise ValueError(f"the start level must be above 0 and at most the maximum voltage "
-                             f"{self.limits.max_voltage_v:g} V, got {self.start_level_v!r}")
-        if not (1.05 <= self.step <= 4.0):
-            raise ValueError(f"the step must be a factor from 1.05 to 4, got {self.step!r}")
+            raise LargeSignalError(f"the start level must be above 0 and at most the maximum voltage "
+                                   f"{self.limits.max_voltage_v:g} V, got {self.start_level_v!r}")
+        LEVEL_STEP.check(self.step, "the step", LargeSignalError)
         if not (isinstance(self.max_steps, int) and 1 <= self.max_steps <= 100):
-            raise ValueError(f"max_steps must be a whole number from 1 to 100, got {self.max_steps!r}")
+            raise LargeSignalError(f"max_steps must be a whole number from 1 to 100, got {self.max_steps!r}")
 
     def as_json(self) -> dict:
         return {"base": self.base.as_json(), "start_level_v": self.start_level_v, "step": self.step,
@@ -100,9 +103,14 @@ def run_large_signal(plan: LargeSignalPlan, audio, laser=None, out_dir: Path | s
     from instruments.measurement.runner import MeasurementCancelled, MeasurementFailed
     measure = measure or run_journaled
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     name = name or datetime.now().strftime("large-signal-%Y%m%d-%H%M%S")
     summary = out_dir / f"{name}{SUMMARY_SUFFIX}"
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        check_output(summary)
+    except OSError as exc:          # OutputError is one too
+        why = str(exc) if isinstance(exc, LinparError) else f"{out_dir}: cannot be written ({exc.strerror or exc})"
+        raise MeasurementError(f"{why}; nothing was measured") from None
     steps: list[PlanStep] = []
     re_lines = None
     re_reference = float("nan")

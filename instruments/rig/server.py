@@ -95,9 +95,8 @@ class RigProcess:
             noise = RigNoise.parse(args.noise) if args.noise else RigNoise()
             driver, definition = default_driver(args.driver, args.sample_rate, args.effects)
             if args.model == "nonlinear":
-                from instruments.simulation.nonlinear_driver import NonlinearBlockDriver, options_from
-                driver = NonlinearBlockDriver(dict(definition.parameters), args.sample_rate,
-                                              **options_from(definition.extra))
+                from instruments.simulation.nonlinear_driver_file import nonlinear_driver_of
+                driver = nonlinear_driver_of(definition, args.sample_rate)
             engine = RigEngine(driver, RIG_CALIBRATION, noise, faults, seed=args.seed)
             feed = DisplacementFeed(args.sample_rate)
             if not args.no_laser:

@@ -303,34 +303,6 @@ class NonlinearBlockDriver:
         return current, displacement
 
 
-def options_from(definition_extra: Mapping) -> dict:
-    """NonlinearBlockDriver's shape arguments from a driver file's "nonlinear" object (analysis.drivers keeps it
-    in DriverDefinition.extra); {} without one. ValueError (one line) for what is not a shape."""
-    spec = definition_extra.get("nonlinear") if definition_extra else None
-    if spec is None:
-        return {}
-    if not isinstance(spec, Mapping):
-        raise ValueError("the driver file's 'nonlinear' must be an object of polynomials (bl_poly, kms_poly, ...)")
-    lists = ("bl_poly", "kms_poly", "le_poly", "l2_poly", "le_i_poly")
-    numbers = ("rms_v2", "x_range_m", "i_range_a")
-    unknown = sorted(set(spec) - set(lists) - set(numbers))
-    if unknown:
-        raise ValueError(f"the driver file's 'nonlinear' has unknown keys {', '.join(unknown)}; "
-                         f"known: {', '.join(lists + numbers)}")
-    out = {}
-    for key, value in spec.items():
-        if key in lists:
-            if not isinstance(value, list) or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                                      for v in value):
-                raise ValueError(f"the driver file's nonlinear.{key}: expected a list of numbers")
-            out[key] = tuple(float(v) for v in value)
-        else:
-            if not isinstance(value, (int, float)) or isinstance(value, bool) or not np.isfinite(value):
-                raise ValueError(f"the driver file's nonlinear.{key}: expected a finite number")
-            out[key] = float(value)
-    return out
-
-
 def _padded(poly: Sequence[float], name: str, degree: int = _MAX_DEGREE) -> tuple[float, ...]:
     coeffs = tuple(float(c) for c in poly)
     if len(coeffs) > degree:

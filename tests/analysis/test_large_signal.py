@@ -17,8 +17,8 @@ from analysis.large_signal import LargeSignalError, LimitThresholds, Prediction,
 from analysis.large_signal.data import recording_data
 from analysis.large_signal.distortion import harmonics, recording_fit
 from analysis.recording import make_recording
-from tests.large_signal_truth import (KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, clean_periods, known_driver,
-                                      noisy_recording)
+from tests.large_signal_truth import (KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, clean_periods, inner,
+                                      known_driver, noisy_recording, relative_errors)
 
 PERIOD = 16384
 
@@ -31,21 +31,12 @@ def known():
     return driver, block, mt, large_signal([noisy_recording(block, mt)], predictions=[prediction])
 
 
-def inner(x_range, share=0.8):
-    lo, hi = x_range
-    margin = (1.0 - share) / 2.0 * (hi - lo)
-    return np.linspace(lo + margin, hi - margin, 81)
-
-
 def test_the_issues_known_polynomials_come_back(known, record_property):
     driver, _, _, result = known
     lo, hi = result.model.x_range
     assert lo < -3.5e-3 and hi > 3.5e-3                          # "a multitone to about +-4 mm"
-    x = inner(result.model.x_range)
-    for name, truth in (("Bl", driver.bl), ("Kms", driver.kms)):
-        curve = result.model.curves[name]
-        worst = float(np.max(np.abs(curve(x) / truth(x) - 1.0)))
-        at_rest = float(curve(0.0) / truth(0.0) - 1.0)
+    for name in ("Bl", "Kms"):
+        worst, at_rest = relative_errors(result.model, driver, name)
         record_property(f"{name}_worst_error_80_percent", worst)
         record_property(f"{name}_0_error", at_rest)
         assert worst < 0.03, name

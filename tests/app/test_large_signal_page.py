@@ -6,21 +6,14 @@ import numpy as np
 import pytest
 
 from analysis.large_signal import large_signal
-from analysis.recording import write_recording
 from app.large_signal_page import LargeSignalPage, summary_html
-from tests.large_signal_truth import clean_periods, known_driver, noisy_recording
+from tests.large_signal_truth import write_steps
 
 
 @pytest.fixture(scope="module")
 def steps(tmp_path_factory):
     """Two levels of the issue's known driver, written as recordings (8,192-sample periods: ~1 s to identify)."""
-    folder = tmp_path_factory.mktemp("large-signal-page")
-    driver = known_driver(8192)
-    paths = []
-    for level in (5.0, 9.0):
-        block, mt = clean_periods(driver, level, 4)
-        paths.append(write_recording(folder / f"step-{level:g}V", noisy_recording(block, mt))[0])
-    return paths
+    return write_steps(tmp_path_factory.mktemp("large-signal-page"))
 
 
 @pytest.fixture(scope="module")

@@ -12,7 +12,6 @@ from __future__ import annotations
 import dataclasses
 import json
 
-import numpy as np
 import pytest
 
 from analysis.large_signal import large_signal
@@ -21,7 +20,7 @@ from instruments.measurement import MeasurementPlan, run_measurement
 from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
 from instruments.rig.engine import RIG_CALIBRATION
 from instruments.rig.in_process import InProcessRig
-from tests.large_signal_truth import KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, known_driver
+from tests.large_signal_truth import KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, known_driver, relative_errors
 
 pytestmark = pytest.mark.timeout(240)
 # +-4 mm needs ~10.5 V RMS of multitone, 22 V peak, and ~5 A peak: the rig's chain (10 V out, 20 V and 2 A in at
@@ -47,12 +46,8 @@ def test_the_known_polynomials_come_back_through_the_rig_with_the_serial_laser(t
     result = large_signal([outcome.recording_path])
     lo, hi = result.model.x_range
     assert lo < -3.5e-3 and hi > 3.5e-3
-    margin = 0.1 * (hi - lo)
-    x = np.linspace(lo + margin, hi - margin, 81)
-    for name, curve_truth in (("Bl", truth.bl), ("Kms", truth.kms)):
-        curve = result.model.curves[name]
-        worst = float(np.max(np.abs(curve(x) / curve_truth(x) - 1.0)))
-        at_rest = float(curve(0.0) / curve_truth(0.0) - 1.0)
+    for name in ("Bl", "Kms"):
+        worst, at_rest = relative_errors(result.model, truth, name)
         record_property(f"rig_{name}_worst_error_80_percent", worst)
         record_property(f"rig_{name}_0_error", at_rest)
         assert worst < 0.03 and abs(at_rest) < 0.01, name
