@@ -33,7 +33,8 @@ from typing import Iterable
 from analysis.archive.atomic import fsync_dir
 from analysis.archive.leftovers import STALE_AFTER_S, sweep
 from analysis.archive.names import ArchiveError, check_id
-from analysis.archive.record import Entry, checked_entry, checked_parameter, entry_of, one_line_text, read_record
+from analysis.archive.record import (Entry, checked_entry, checked_parameter, checked_qa, entry_of, one_line_text,
+                                     read_record)
 from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
@@ -272,8 +273,8 @@ class Index:
         if flt.until:
             where.append("measured_at <= ?")
             args.append(flt.until + ("T99" if len(flt.until) == 10 else ""))   # a bare date: the whole day
-        sql = "SELECT id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects " \
-              "FROM measurements" + (" WHERE " + " AND ".join(where) if where else "") + \
+        sql = "SELECT id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects, " \
+              "verdict, limits_version FROM measurements" + (" WHERE " + " AND ".join(where) if where else "") + \
               " ORDER BY measured_at DESC, id DESC"
         if flt.limit is not None:
             sql += " LIMIT ?"
@@ -342,7 +343,8 @@ def _entry_of_row(row: tuple) -> Entry:
     one_line_text(effects, f"{where}: effects")
     values["effects"] = tuple(e for e in effects.split(",") if e)
     checked_entry(values, where)
-    return Entry(*(values[k] for k in keys), values["effects"], {})
+    verdict, version = checked_qa(row[10], row[11], where)
+    return Entry(*(values[k] for k in keys), values["effects"], {}, verdict, version)
 
 
 def insert(conn: sqlite3.Connection, record: dict) -> None:
@@ -361,9 +363,9 @@ def _insert(conn: sqlite3.Connection, record: dict) -> None:
     e = entry_of(record)
     conn.execute("DELETE FROM parameters WHERE measurement_id = ?", (e.id,))
     conn.execute("INSERT INTO measurements (id, folder, measured_at, stored_at, driver, serial, operator, station, "
-                 "validity, effects) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+                 "validity, effects, verdict, limits_version) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
                  (e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station,
-                  e.validity, ",".join(e.effects)))
+                  e.validity, ",".join(e.effects), e.verdict, e.limits_version))
     for name in KEY_PARAMETERS:
         p = e.parameters.get(name)
         if p is None:

@@ -3,6 +3,7 @@
     {"format": "linpar-measurement/1", "id", "folder", "measured_at", "stored_at",
      "driver", "serial", "operator", "station", "notes", "validity", "effects", "sd_m2",
      "key_parameters": {name: {"value", "std", "unit"}},   (SI)
+     "qa": {"verdict", "limits_version", "limits_name"},   (optional: when the archive had limits)
      "files": {"recording": "recording.wav", "sidecar": "recording.json", "results": "results.json",
                "settings": "settings.json", "calibration": "calibration.json", "laser_stream": ...}}
 
@@ -32,6 +33,8 @@ RECORD_FORMAT = "linpar-measurement/1"
 RECORD_FILE = "measurement.json"
 TEXT_FIELDS = ("driver", "serial", "operator", "station")
 VALIDITY_STATES = ("green", "yellow", "red", "unknown")
+# analysis.limits.judge_result's verdicts: each stored verdict names the limits version that judged it.
+QA_VERDICTS = ("pass", "fail", "invalid", "not judged")
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
@@ -50,17 +53,33 @@ class Entry:
     validity: str
     effects: tuple[str, ...] = ()
     parameters: dict[str, dict[str, Any]] = field(default_factory=dict)   # name -> {value, std, unit} (SI)
+    verdict: str | None = None            # QA_VERDICTS, when limits judged it as it was stored
+    limits_version: int | None = None     # the version of the archive's limits that judged it
 
     def as_json(self) -> dict:
         return {"id": self.id, "folder": self.folder, "measured_at": self.measured_at, "stored_at": self.stored_at,
                 "driver": self.driver, "serial": self.serial, "operator": self.operator, "station": self.station,
-                "validity": self.validity, "effects": list(self.effects), "parameters": self.parameters}
+                "validity": self.validity, "effects": list(self.effects), "parameters": self.parameters,
+                "verdict": self.verdict, "limits_version": self.limits_version}
 
 
 def entry_of(record: dict) -> Entry:
+    qa = record.get("qa") or {}
     return Entry(record["id"], record["folder"], record["measured_at"], record["stored_at"],
                  *(record[k] for k in TEXT_FIELDS), record["validity"], tuple(record.get("effects", ())),
-                 dict(record.get("key_parameters", {})))
+                 dict(record.get("key_parameters", {})), qa.get("verdict"), qa.get("limits_version"))
+
+
+def checked_qa(verdict, version, where: str) -> tuple[str | None, int | None]:
+    """A stored verdict and the limits version that judged it: both, or neither."""
+    if verdict is None and version is None:
+        return None, None
+    if verdict not in QA_VERDICTS:
+        raise ArchiveError(f"{where}: verdict: found {str(verdict)[:20]!r}, expected one of {', '.join(QA_VERDICTS)}")
+    if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= 2**31 - 1:
+        raise ArchiveError(f"{where}: limits_version: found {str(version)[:20]!r}, expected a version number "
+                           "(a whole number from 1)")
+    return verdict, version
 
 
 def one_line_text(value, where: str) -> str:
@@ -115,6 +134,12 @@ def checked_entry(values: dict[str, Any], where: str) -> dict[str, Any]:
         raise ArchiveError(f"{where}: effects: expected a list of effect ids (strings)")
     for i, e in enumerate(effects):
         one_line_text(e, f"{where}: effects[{i}]")
+    qa = values.get("qa")
+    if qa is not None:
+        if not isinstance(qa, dict):
+            raise ArchiveError(f"{where}: qa: expected an object with verdict and limits_version")
+        checked_qa(qa.get("verdict"), qa.get("limits_version"), f"{where}: qa")
+        one_line_text(qa.get("limits_name", ""), f"{where}: qa.limits_name")
     return values
 
 

@@ -45,12 +45,20 @@ def _v2(conn: sqlite3.Connection) -> None:
     conn.execute("CREATE INDEX measurements_by_driver ON measurements(driver, serial)")
 
 
-MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2)
+def _v3(conn: sqlite3.Connection) -> None:
+    # Production QA: each measurement's verdict and the limits version that judged it; statistics select
+    # by station and by date.
+    conn.execute("ALTER TABLE measurements ADD COLUMN verdict TEXT")
+    conn.execute("ALTER TABLE measurements ADD COLUMN limits_version INTEGER")
+    conn.execute("CREATE INDEX measurements_by_station ON measurements(station, measured_at)")
+
+
+MIGRATIONS: tuple[Callable[[sqlite3.Connection], None], ...] = (_v1, _v2, _v3)
 CURRENT_VERSION = len(MIGRATIONS)
 # What a database of the current version must have (checked on open).
 EXPECTED_COLUMNS = {
     "measurements": {"id", "folder", "measured_at", "stored_at", "driver", "serial", "operator", "station",
-                     "validity", "effects"},
+                     "validity", "effects", "verdict", "limits_version"},
     "parameters": {"measurement_id", "name", "value", "std", "unit"},
 }
 
