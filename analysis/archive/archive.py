@@ -22,6 +22,7 @@ import os
 import shutil
 import sqlite3
 import tempfile
+import uuid
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
@@ -29,8 +30,10 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from analysis.archive.atomic import DIR_MODE, FILE_MODE, fsync_dir, write_atomic
+from analysis.archive.folder_qa import FolderQA
 from analysis.archive.index import Filter, Index, RebuildReport, insert
-from analysis.archive.leftovers import INCOMING_PREFIX
+from analysis.archive.leftovers import INCOMING_PREFIX, REMOVING_PREFIX
+from analysis.archive.limits_store import judged
 from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, clean_text, folder_name, inside,
                                     new_measurement_id, safe_suffix)
 from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
@@ -41,6 +44,7 @@ from analysis.files import read_text, regular_file
 MeasurementId = str
 FOLDERS = "measurements"
 RESULTS_FILE = "results.json"
+OWN_LIMITS = object()       # store(judge_with=...): judge with the archive's newest limits version
 
 
 def default_root() -> Path:
@@ -154,11 +158,15 @@ def _share(folder: Path) -> None:
         os.chmod(item, FILE_MODE)
 
 
-class Archive:
+class Archive(FolderQA):
     def __init__(self, root: str | Path | None = None):
         self.root = Path(root) if root is not None else default_root()
         self.folders = self.root / FOLDERS
         self._index = Index(self.root, self.folders)
+
+    @property
+    def location(self) -> str:
+        return str(self.root)
 
     @property
     def notes(self) -> list[str]:
@@ -184,13 +192,15 @@ class Archive:
     # --- storing --------------------------------------------------------------------
 
     def store(self, recording, result, meta=None, laser_stream: str | Path | None = None,
-              now: datetime | None = None) -> MeasurementId:
+              now: datetime | None = None, judge_with=OWN_LIMITS) -> MeasurementId:
         """Store a measurement; return its id.
 
         recording: a path (NAME, NAME.wav or NAME.json; copied byte for byte)
         or an analysis.recording.Recording (written as float32). result: an
         analysis.pipeline.AnalysisResult or its results document (a dict, as
         analysis.archive.results.results_document makes). meta: MeasurementMeta or a dict.
+        When the archive holds limits, the record keeps the verdict of its newest version and that
+        version's number (`judge_with`: another analysis.archive.limits_store.LimitsVersion, or None).
         """
         from analysis.archive.results import results_document
         from analysis.recording import Recording, read_recording, recording_paths, write_recording
@@ -236,6 +246,9 @@ class Archive:
                                    "unit": params[k].get("unit", "")} for k in KEY_PARAMETERS if k in params},
             "files": files,
         }
+        qa = judged(doc, self.limits() if judge_with is OWN_LIMITS else judge_with)
+        if qa is not None:
+            record["qa"] = qa
         with self._index_errors("opening the index"):
             conn = self._connect()
         tmp = Path(tempfile.mkdtemp(dir=self.folders, prefix=INCOMING_PREFIX))
@@ -327,20 +340,44 @@ class Archive:
 
     def export(self, id_or_prefix: str, directory: str | Path) -> Path:
         """Copy a measurement's folder into `directory` (made if missing); return the copy's path."""
-        m = self.get(id_or_prefix)
-        directory = Path(directory)
-        directory.mkdir(parents=True, exist_ok=True)
-        target = directory / m.folder.name
-        if target.exists():
-            raise ArchiveError(f"{target}: already exists; choose another directory")
-        tmp = Path(tempfile.mkdtemp(dir=directory, prefix=f".{m.folder.name}."))
-        try:
-            for item in m.folder.iterdir():
-                if item.is_file() and not item.is_symlink():
-                    shutil.copy2(item, tmp / item.name)
-            _share(tmp)
-            os.rename(tmp, target)
-        except BaseException:
-            shutil.rmtree(tmp, ignore_errors=True)
-            raise
-        return target
+        return export_folder(self.get(id_or_prefix).folder, directory)
+
+    def discard(self, mid: MeasurementId) -> None:
+        """Remove a measurement: for a station's local queue (analysis.archive.pg.outbox), once the server has it.
+
+        The folder is renamed away first (one step: it is there or it is not), then deleted; a crash in
+        between leaves a .removing-* folder that the next opening sweeps away, and an index row that the
+        next opening drops because its folder is gone.
+        """
+        mid, folder = self.resolve(mid)
+        path = inside(self.folders, folder)
+        gone = path.with_name(f"{REMOVING_PREFIX}{uuid.uuid4().hex}")
+        os.rename(path, gone)
+        shutil.rmtree(gone, ignore_errors=True)
+        with self._index_errors(f"removing {mid} from the index"):
+            conn = self._connect()
+            try:
+                with conn:
+                    conn.execute("DELETE FROM measurements WHERE id = ?", (mid,))
+            finally:
+                conn.close()
+
+
+def export_folder(folder: Path, directory: str | Path) -> Path:
+    """Copy a measurement's folder (its regular files) into `directory` as a complete folder, or not at all."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    target = directory / folder.name
+    if target.exists():
+        raise ArchiveError(f"{target}: already exists; choose another directory")
+    tmp = Path(tempfile.mkdtemp(dir=directory, prefix=f".{folder.name}."))
+    try:
+        for item in folder.iterdir():
+            if item.is_file() and not item.is_symlink() and not item.name.startswith("."):
+                shutil.copy2(item, tmp / item.name)
+        _share(tmp)
+        os.rename(tmp, target)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return target
