@@ -58,3 +58,59 @@ def _no_user_effects(tmp_path_factory, monkeypatch):
     monkeypatch.setenv(registry.FOLDER_ENV, str(tmp_path_factory.getbasetemp() / "no-user-effects"))
     yield
     registry.clear()
+
+
+# --- a PostgreSQL server for the archive's second back end ----------------------------------------------------
+
+_PG_DATABASES = __import__("itertools").count(1)
+PG_USERS = {"station_a": "operator", "station_b": "operator", "station_c": "operator", "eva": "engineer",
+            "audrey": "auditor"}
+
+
+@pytest.fixture(scope="session")
+def pg_server():
+    """A throw-away PostgreSQL server for the session (tests/pg_server.py).
+
+    Skipped, saying what to install, only when PostgreSQL is not installed; a server that is installed
+    but does not start is an error, never a skip.
+    """
+    from tests.pg_server import PostgresServer, missing_reason
+    reason = missing_reason()
+    if reason:
+        pytest.skip(reason)
+    server = PostgresServer.start()
+    try:
+        yield server
+    finally:
+        server.stop()
+
+
+class PgDatabase:
+    """One test's database on the session's server, set up as `linpar archive setup` does (PG_USERS)."""
+
+    def __init__(self, server, name: str):
+        self.server = server
+        self.name = name
+
+    def url(self, user: str = "station_a") -> str:
+        return self.server.url(user, self.name)
+
+    def admin(self):
+        return self.server.admin(self.name)
+
+
+@pytest.fixture
+def pg_database(pg_server, tmp_path, monkeypatch):
+    """A fresh archive database (users PG_USERS); each test's station queues in a folder of its own."""
+    from psycopg import sql
+
+    from analysis.archive.pg import setup
+    from tests.pg_server import ADMIN
+    name = f"linpar_t{os.getpid()}_{next(_PG_DATABASES)}"
+    pg_server.create_database(name)
+    setup(pg_server.url(ADMIN, name), PG_USERS)
+    monkeypatch.setenv("LINPAR_QUEUE", str(tmp_path / "queues"))
+    db = PgDatabase(pg_server, name)
+    yield db
+    with pg_server.admin() as conn:
+        conn.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))

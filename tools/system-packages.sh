@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs the Debian packages linpar needs (PortAudio for the sound card,
 # jackd2 for the virtual rig, the libraries Qt loads, poppler-utils' pdftoppm for
-# the report tests), when they are missing.
+# the report tests, postgresql for the PostgreSQL archive's tests: a throw-away
+# server is started from its binaries, the package's own cluster is not used), when they are missing.
 # As root it installs them with apt-get; otherwise it says what to install.
 set -u
-needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 libfontconfig1 libdbus-1-3 libxcb-cursor0 libglib2.0-0 poppler-utils)
+needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 libfontconfig1 libdbus-1-3 libxcb-cursor0 libglib2.0-0 poppler-utils postgresql)
 missing=()
 for pkg in "${needed[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")

@@ -1,0 +1,157 @@
+"""The server a postgresql:// URL names: checked where it enters, connected to with bounded waits, and every
+error of the server or the network turned into one line that says what to do.
+
+Two kinds of failure are told apart, because a station treats them apart:
+
+- ServerUnreachable: the network or the server is down (refused, timed out,
+  the connection dropped). A station keeps measuring and queues locally
+  (analysis.archive.pg.outbox); the next store or `linpar archive sync` sends.
+- ServerRefused: the server answered no (a role without the right, a failed
+  login, no such database, a schema it must migrate first). Waiting does not
+  help: the message says who must do what.
+
+Connections are opened per operation and closed after it; libpq's keepalives
+notice a server that vanishes in the middle of one within ~15 s, and
+connect_timeout (default 5 s, or the URL's) bounds the wait for one that is off.
+"""
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import re
+from dataclasses import dataclass
+from typing import Iterator
+
+from analysis.archive.names import ArchiveError
+from analysis.errors import one_line
+
+CONNECT_TIMEOUT_S = 5
+SCHEMA = "linpar"
+# What libpq says when the server answered and said no, as opposed to not answering at all.
+_REFUSALS = ("authentication failed", "does not exist", "pg_hba.conf", "permission denied", "password",
+             "invalid", "too many connections", "not permitted", "SSL")
+
+
+class ServerUnreachable(ArchiveError):
+    """The server cannot be reached now (network, server down): measurements wait in the local queue."""
+
+
+class ServerRefused(ArchiveError):
+    """The server answered, and refused: a right, a login, a database, a schema version."""
+
+    queued_id: str | None = None      # a measurement that waits in the local queue because of it
+
+
+@dataclass(frozen=True)
+class ServerURL:
+    """A postgresql:// URL, checked: the keywords libpq takes, and the place to show in messages."""
+
+    url: str
+    params: dict
+    user: str
+    host: str
+    port: int
+    dbname: str
+
+    @property
+    def display(self) -> str:
+        """The URL without a password, for messages and labels."""
+        return f"postgresql://{self.user}@{self.host}:{self.port}/{self.dbname}"
+
+    @property
+    def slug(self) -> str:
+        """A folder name for this server and user (its local queue, its cache)."""
+        raw = f"{self.user}@{self.host}:{self.port}/{self.dbname}"
+        tail = hashlib.sha256(raw.encode()).hexdigest()[:8]
+        return re.sub(r"[^A-Za-z0-9@._-]+", "-", f"{self.user}@{self.host}-{self.port}-{self.dbname}")[:80] + "-" + tail
+
+
+def parse_url(url: str) -> ServerURL:
+    """The checked URL; ArchiveError (one line, the password never shown) when it cannot be one."""
+    from psycopg import conninfo
+    text = str(url).strip()
+    shown = re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", text)[:120]
+    if not re.match(r"^postgres(ql)?://", text, re.IGNORECASE):
+        raise ArchiveError(f"{shown}: expected postgresql://USER@HOST[:PORT]/DATABASE")
+    try:
+        params = conninfo.conninfo_to_dict(text)
+    except Exception as exc:  # noqa: BLE001 - psycopg's parser raises ProgrammingError and others: all one line
+        raise ArchiveError(f"{shown}: not a PostgreSQL URL ({one_line(exc)}): expected "
+                           "postgresql://USER@HOST[:PORT]/DATABASE") from None
+    import getpass
+    user = str(params.get("user") or getpass.getuser())
+    host = str(params.get("host") or "localhost")
+    port_text = str(params.get("port") or "5432")
+    if not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
+        raise ArchiveError(f"{shown}: port {port_text!r}: expected a whole number from 1 to 65535")
+    dbname = str(params.get("dbname") or user)
+    if "connect_timeout" not in params:
+        params["connect_timeout"] = str(CONNECT_TIMEOUT_S)
+    else:
+        timeout = str(params["connect_timeout"])
+        if not timeout.isdigit() or not 1 <= int(timeout) <= 600:
+            raise ArchiveError(f"{shown}: connect_timeout {timeout!r}: expected seconds from 1 to 600")
+    params.setdefault("application_name", "linpar")
+    for key, value in (("keepalives", "1"), ("keepalives_idle", "5"), ("keepalives_interval", "3"),
+                       ("keepalives_count", "3")):
+        params.setdefault(key, value)
+    return ServerURL(text, params, user, host, int(port_text), dbname)
+
+
+def _unreachable(exc) -> bool:
+    """True when the server did not answer (the network, a server down or restarting), not a refusal."""
+    state = getattr(exc, "sqlstate", None)
+    if state is not None:
+        return state.startswith("08") or state in ("57P01", "57P02", "57P03")
+    message = str(exc)
+    return not any(word in message for word in _REFUSALS)
+
+
+@contextlib.contextmanager
+def server_errors(server: ServerURL, doing: str, needs: str = "") -> Iterator[None]:
+    """Errors of the server as one-line ArchiveErrors: ServerUnreachable, ServerRefused, or ArchiveError.
+
+    `needs`: the role the action takes ("an engineer"), said when the server refuses it for want of a right.
+    """
+    import psycopg
+    from psycopg import errors
+    try:
+        yield
+    except errors.InsufficientPrivilege as exc:
+        who = f"the database user {server.user!r}"
+        hint = f" ({needs} may; the line's administrator grants it with 'linpar archive setup')" if needs else ""
+        raise ServerRefused(f"{server.display}: the server refused {doing}: {_first_line(exc)}: {who} may not"
+                            f"{hint}") from None
+    except (psycopg.OperationalError, psycopg.InterfaceError) as exc:
+        if _unreachable(exc):
+            raise ServerUnreachable(f"{server.display}: cannot reach the server while {doing} "
+                                    f"({_first_line(exc)})") from None
+        raise ServerRefused(f"{server.display}: the server refused {doing}: {_first_line(exc)}") from None
+    except psycopg.Error as exc:
+        raise ArchiveError(f"{server.display}: {doing}: {_first_line(exc)}") from None
+
+
+def _first_line(exc) -> str:
+    text = str(exc).strip()
+    text = re.sub(r"^connection failed: ", "", text)
+    return one_line(text.splitlines()[0] if text else type(exc).__name__)[:300]
+
+
+def connect(server: ServerURL, doing: str):
+    """An autocommit connection with search_path linpar, its schema version checked (analysis.archive.pg.schema).
+
+    Transactions are explicit (`with conn.transaction():`), so that a failed statement never leaves a
+    session half in one.
+    """
+    import psycopg
+    from analysis.archive.pg.schema import check_version
+    with server_errors(server, doing):
+        conn = psycopg.connect(**server.params, autocommit=True)
+    try:
+        with server_errors(server, doing):
+            conn.execute(f"SET search_path TO {SCHEMA}, pg_catalog")
+            check_version(conn, server)
+    except BaseException:
+        conn.close()
+        raise
+    return conn
