@@ -120,6 +120,11 @@ YEAR = Bound("a year", "", 1900, 9998, "dates of measurements: a year the calend
              integer=True)
 PARAMETER = Bound("a parameter value", "SI", -1e30, 1e30,
                   "fitted and derived values as stored in an archive record: finite, not astronomical")
+COVERAGE_K = Bound("a coverage factor k", "", 0.5, 10.0,
+                   "`qa limits --k`: limits at mean +- k sigma of golden units; 3 is usual, 10 is no limit at all")
+BASELINE = Bound("a control-chart baseline", "units", 10, 10**6,
+                 "`qa stats --baseline`: the first units set the chart's limits; fewer than 10 set nothing",
+                 integer=True)
 LASER_RANGE_M = Bound("a laser measuring range", "m", 1e-4, 10.0,
                       "the sensor's reply: 10 mm (ILD1420-10) to 500 mm; garbage otherwise")
 # The large-signal identification and plan (analysis/large_signal/, docs/large-signal.md).
@@ -139,7 +144,8 @@ AUDIO_FREQUENCY = Bound("an audio frequency", "Hz", 1.0, 20000.0,
 
 BOUNDS = (SAMPLE_RATE, PERIOD_SAMPLES, SD, FREQUENCY, IMPEDANCE, HX, PHASE_DEG, CHANNEL_SCALE, LEVEL_V_RMS,
           PERIODS, ADDED_MASS_G, XRUN_S, LIST_LIMIT, YEAR, PARAMETER, LASER_RANGE_M, EXCURSION_MM,
-          TEMPERATURE_RISE_K, DISTORTION_DB, LEVEL_STEP, LIMIT_PERCENT, POLYNOMIAL_ORDER, AUDIO_FREQUENCY)
+          TEMPERATURE_RISE_K, DISTORTION_DB, LEVEL_STEP, LIMIT_PERCENT, POLYNOMIAL_ORDER, AUDIO_FREQUENCY, COVERAGE_K,
+          BASELINE)
 
 
 # --- file sizes ------------------------------------------------------------------------------------------------

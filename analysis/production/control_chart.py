@@ -1,0 +1,144 @@
+"""Individuals and moving-range (I-MR) control chart, with the Western Electric rules flagged.
+
+The chart's centre line and sigma come from a baseline: the first `baseline`
+units of the selection (phase I), sigma from their mean moving range
+(MR_bar / d2, d2 = 2/sqrt(pi)), so that a later drift moves the points, not
+the limits. Every unit, baseline included, is then judged by the rules
+(Western Electric Statistical Quality Control Handbook, 1956; NIST/SEMATECH
+e-Handbook 6.3.2):
+
+    WE1  one point beyond 3 sigma
+    WE2  2 of 3 points in a row beyond 2 sigma, on one side
+    WE3  4 of 5 points in a row beyond 1 sigma, on one side
+    WE4  8 points in a row on one side of the centre line
+    MR   a moving range above its upper limit D4 * MR_bar (D4 = 3.267): a jump between two units
+
+A rule fires at the point that completes its pattern (that point is itself
+beyond the line). Overlapping firings of one rule on one side are one alarm,
+which names every point involved. The four rules together raise a false
+alarm about once in 92 points of a stable process (in-control average run
+length): an alarm is a reason to look, not a verdict.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from analysis.production.capability import D2_PAIRS
+
+D4_PAIRS = 3.267
+DEFAULT_BASELINE = 50
+MIN_BASELINE = 10
+RULES = {
+    "WE1": "one point beyond 3 sigma",
+    "WE2": "2 of 3 points in a row beyond 2 sigma on one side",
+    "WE3": "4 of 5 points in a row beyond 1 sigma on one side",
+    "WE4": "8 points in a row on one side of the centre line",
+    "MR": "a jump between two units: the moving range above its upper limit",
+}
+# rule -> (window length, how many beyond, how far in sigma)
+_ZONE_RULES = {"WE1": (1, 1, 3.0), "WE2": (3, 2, 2.0), "WE3": (5, 4, 1.0), "WE4": (8, 8, 0.0)}
+
+
+@dataclass(frozen=True)
+class Alarm:
+    rule: str                       # RULES' key
+    side: str                       # "above", "below" (of the centre line), or "" (MR)
+    points: tuple[int, ...]         # the chart's points involved, in order
+    triggers: tuple[int, ...]       # the points at which the rule fired
+
+    @property
+    def title(self) -> str:
+        return RULES[self.rule]
+
+    def as_json(self, ids=None) -> dict:
+        doc = {"rule": self.rule, "title": self.title, "side": self.side, "points": list(self.points),
+               "first": self.triggers[0]}
+        if ids is not None:
+            doc["measurements"] = [ids[i] for i in self.points]
+        return doc
+
+
+@dataclass(frozen=True)
+class ControlChart:
+    values: np.ndarray              # the individuals, in time order
+    baseline: int                   # the first `baseline` points set the limits
+    centre: float
+    sigma: float                    # within, from the baseline's moving ranges
+    moving_ranges: np.ndarray       # |x[i] - x[i-1]|, i = 1 ... n-1
+    mr_centre: float
+    alarms: tuple[Alarm, ...]
+
+    @property
+    def ucl(self) -> float:
+        return self.centre + 3 * self.sigma
+
+    @property
+    def lcl(self) -> float:
+        return self.centre - 3 * self.sigma
+
+    @property
+    def mr_ucl(self) -> float:
+        return D4_PAIRS * self.mr_centre
+
+    def flagged(self) -> np.ndarray:
+        """Indices of the points some alarm involves."""
+        return np.array(sorted({i for a in self.alarms for i in a.points}), dtype=int)
+
+    def as_json(self, ids=None) -> dict:
+        return {"baseline": self.baseline, "centre": self.centre, "sigma": self.sigma, "ucl": self.ucl,
+                "lcl": self.lcl, "mr_centre": self.mr_centre, "mr_ucl": self.mr_ucl,
+                "alarms": [a.as_json(ids) for a in self.alarms]}
+
+
+def control_chart(values, baseline: int = DEFAULT_BASELINE) -> ControlChart | None:
+    """The I-MR chart of finite `values` in time order; None with fewer than two points or no spread."""
+    x = np.asarray(values, dtype=float)
+    if x.size < 2:
+        return None
+    b = int(min(max(baseline, 2), x.size))
+    mr = np.abs(np.diff(x))
+    mr_centre = float(np.mean(mr[: b - 1]))
+    sigma = mr_centre / D2_PAIRS
+    if not sigma > 0:
+        return None
+    centre = float(np.mean(x[:b]))
+    z = (x - centre) / sigma
+    alarms = [a for rule in _ZONE_RULES for a in _zone_alarms(z, rule)] + _jump_alarms(mr, D4_PAIRS * mr_centre)
+    alarms.sort(key=lambda a: (a.triggers[0], a.rule))
+    return ControlChart(x, b, centre, sigma, mr, mr_centre, tuple(alarms))
+
+
+def _zone_alarms(z: np.ndarray, rule: str) -> list[Alarm]:
+    window, needed, zone = _ZONE_RULES[rule]
+    alarms: list[Alarm] = []
+    for side, sign in (("above", 1.0), ("below", -1.0)):
+        beyond = sign * z > zone
+        if z.size < window:
+            continue
+        counts = np.convolve(beyond.astype(int), np.ones(window, dtype=int), mode="valid")   # window ending at i
+        fired = np.flatnonzero((counts >= needed) & beyond[window - 1:]) + window - 1
+        for i in fired:
+            points = [j for j in range(i - window + 1, i + 1) if beyond[j]]
+            _add(alarms, rule, side, points, int(i))
+    return alarms
+
+
+def _jump_alarms(mr: np.ndarray, limit: float) -> list[Alarm]:
+    alarms: list[Alarm] = []
+    for k in np.flatnonzero(mr > limit):
+        _add(alarms, "MR", "", [int(k), int(k) + 1], int(k) + 1)
+    return alarms
+
+
+def _add(alarms: list[Alarm], rule: str, side: str, points: list[int], trigger: int) -> None:
+    """A firing joins the previous alarm of the rule and side when their points overlap or touch."""
+    for n in range(len(alarms) - 1, -1, -1):
+        a = alarms[n]
+        if a.rule == rule and a.side == side:
+            if points[0] <= a.points[-1] + 1:
+                alarms[n] = Alarm(rule, side, tuple(sorted(set(a.points) | set(points))), a.triggers + (trigger,))
+                return
+            break
+    alarms.append(Alarm(rule, side, tuple(points), (trigger,)))
