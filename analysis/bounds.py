@@ -125,6 +125,8 @@ COVERAGE_K = Bound("a coverage factor k", "", 0.5, 10.0,
 BASELINE = Bound("a control-chart baseline", "units", 10, 10**6,
                  "`qa stats --baseline`: the first units set the chart's limits; fewer than 10 set nothing",
                  integer=True)
+LIMITS_VERSION = Bound("a limits version", "", 1, 2**31 - 1,
+                       "`qa stats --limits-version`, `qa limits --show`: versions are numbered from 1", integer=True)
 LASER_RANGE_M = Bound("a laser measuring range", "m", 1e-4, 10.0,
                       "the sensor's reply: 10 mm (ILD1420-10) to 500 mm; garbage otherwise")
 # The large-signal identification and plan (analysis/large_signal/, docs/large-signal.md).
@@ -145,7 +147,7 @@ AUDIO_FREQUENCY = Bound("an audio frequency", "Hz", 1.0, 20000.0,
 BOUNDS = (SAMPLE_RATE, PERIOD_SAMPLES, SD, FREQUENCY, IMPEDANCE, HX, PHASE_DEG, CHANNEL_SCALE, LEVEL_V_RMS,
           PERIODS, ADDED_MASS_G, XRUN_S, LIST_LIMIT, YEAR, PARAMETER, LASER_RANGE_M, EXCURSION_MM,
           TEMPERATURE_RISE_K, DISTORTION_DB, LEVEL_STEP, LIMIT_PERCENT, POLYNOMIAL_ORDER, AUDIO_FREQUENCY, COVERAGE_K,
-          BASELINE)
+          BASELINE, LIMITS_VERSION)
 
 
 # --- file sizes ------------------------------------------------------------------------------------------------

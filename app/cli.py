@@ -70,6 +70,9 @@ def build_parser() -> argparse.ArgumentParser:
     from app import cli_large_signal
     cli_large_signal.add_commands(sub)
 
+    from app import cli_qa
+    cli_qa.register(sub)
+
     effects = sub.add_parser("effects", help="list the effects catalogue and your own effects")
     effects.add_argument("--json", action="store_true")
     cli_effects.add_option(effects)
@@ -113,6 +116,9 @@ def _run(args: argparse.Namespace) -> int:
     if args.command == "large-signal" or getattr(args, "plan", None) == "large-signal":
         from app import cli_large_signal
         return cli_large_signal.run(args) if args.command == "large-signal" else cli_large_signal.run_plan(args)
+    if args.command == "qa":
+        from app import cli_qa
+        return cli_qa.run(args)
     if args.command == "measure":
         from app import cli_measure
         return cli_measure.run(args)

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from analysis.bounds import LIST_LIMIT, SD
+from app import cli_archive_server
 from app.cli_json import dumps
 from app.cli_options import number
 
@@ -17,12 +17,13 @@ LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("
 
 
 def add_root_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--root", metavar="DIR",
-                        help="archive folder (default: $LINPAR_ARCHIVE or ~/.local/share/linpar/archive)")
+    """--archive URL|DIR or --root DIR (app.cli_archive_server)."""
+    cli_archive_server.add_archive_options(parser)
 
 
 def add_commands(sub) -> None:
-    archive = sub.add_parser("archive", help="the measurement archive: list, show, export, rebuild, store, compare")
+    archive = sub.add_parser("archive", help="the measurement archive: list, show, export, rebuild, store, compare; "
+                                             "setup and sync for a PostgreSQL server")
     verbs = archive.add_subparsers(dest="archive_command", required=True, parser_class=type(archive))
 
     ls = verbs.add_parser("list", help="list stored measurements, newest first")
@@ -59,16 +60,14 @@ def add_commands(sub) -> None:
     for parser in (ls, show, export, store, compare, verbs.choices["rebuild"]):
         add_root_option(parser)
         parser.add_argument("--json", action="store_true", help="print JSON")
+    cli_archive_server.register_verbs(verbs)
 
 
 def _archive(args):
-    from analysis.archive import Archive
-    return Archive(Path(args.root).expanduser() if args.root else None)
+    return cli_archive_server.open_from_args(args)
 
 
-def _notes(archive) -> None:
-    for note in archive.notes:
-        print(f"linpar: note: {note}", file=sys.stderr)
+_notes = cli_archive_server.say_notes
 
 
 def _param(entry, name: str, scale: float) -> str:
@@ -78,8 +77,10 @@ def _param(entry, name: str, scale: float) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    archive = _archive(args)
     verb = args.archive_command
+    if verb in cli_archive_server.SERVER_VERBS:
+        return cli_archive_server.run_verb(args)
+    archive = _archive(args)
     if verb == "list":
         from analysis.archive import Filter
         entries = archive.list(Filter(args.driver, args.serial, args.operator, args.station, args.validity,
@@ -94,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
             params = "  ".join(f"{_param(e, n, s):>10}" for n, _, s in LIST_PARAMETERS)
             lines.append(f"{e.id:<22}  {e.measured_at:<20}  {e.driver[:20]:<20}  {e.serial[:12]:<12}  "
                          f"{e.validity:<8}  {params}")
-        lines.append(f"{len(entries)} measurement(s) in {archive.root}")
+        lines.append(f"{len(entries)} measurement(s) in {archive.location}")
         sys.stdout.write("\n".join(lines) + "\n")
         return 0
     if verb == "show":
@@ -146,8 +147,12 @@ def _store(archive, args) -> int:
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)
     _notes(archive)
-    print(dumps({"id": mid, "validity": result.validity.get("overall")}) if args.json else
-          f"stored {mid} (validity {result.validity.get('overall')})")
+    queued = archive.pending > 0
+    if args.json:
+        print(dumps({"id": mid, "validity": result.validity.get("overall"), **({"queued": True} if queued else {})}))
+    else:
+        print(f"{'queued' if queued else 'stored'} {mid} (validity {result.validity.get('overall')})"
+              + (": it waits in this station's queue until the server can be reached" if queued else ""))
     return 0
 
 

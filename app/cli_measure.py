@@ -4,7 +4,7 @@
                    [--laser URL|analog|none] [--template woofer|midrange|tweeter|microspeaker]
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
                    [--on-xrun end|restart] [--serial TEXT] [--operator TEXT] [--station TEXT]
-                   [--archive-root DIR | --no-archive] [--json]
+                   [--archive URL|DIR | --archive-root DIR | --no-archive] [--json]
                    [--plan single|large-signal [the plan's limits: app/cli_large_signal.py]]
 
 With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
@@ -23,9 +23,13 @@ keeps what was recorded and exits with 2 and a message that says what
 happened and where the data are.
 
 A complete measurement is then stored in the measurement archive
-(analysis.archive: ``--archive-root``, default $LINPAR_ARCHIVE or
-~/.local/share/linpar/archive; ``--no-archive``: not stored) and stderr says
-its id; with --json the printed object gets "archive": {"id", "root"}. When
+(analysis.archive: ``--archive`` a postgresql:// URL or a folder, or
+``--archive-root`` a folder; default $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE,
+else ~/.local/share/linpar/archive; ``--no-archive``: not stored) and stderr says
+its id; with --json the printed object gets "archive": {"id", "root"} ("root":
+the folder or the server's URL without its password; "queued": true when the
+server could not be reached and the measurement waits in the station's local
+queue, which is sent with the next store or `linpar archive sync`). When
 storing fails (a read-only or full disk ...), nothing is lost, since the
 recording is already written: a warning on stderr says why and how to store it
 later (a ``linpar archive store`` command, shell-quoted, that keeps the time of
@@ -85,6 +89,9 @@ def add_commands(sub) -> None:
     for field in ("serial", "operator", "station"):
         m.add_argument(f"--{field}", default="", metavar="TEXT", help=f"the {field} kept with it in the archive")
     where = m.add_mutually_exclusive_group()
+    where.add_argument("--archive", metavar="URL|DIR",
+                       help="archive to store in: postgresql://USER@HOST[:PORT]/DB (the line's server) or a folder "
+                            "(default: $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE, else ~/.local/share/linpar/archive)")
     where.add_argument("--archive-root", type=Path, metavar="DIR",
                        help="archive to store the measurement in (default: $LINPAR_ARCHIVE or "
                             "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
@@ -179,8 +186,9 @@ def _ctrl_c_cancels(cancel: _Cancel) -> Iterator[None]:
 
 def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at: str) -> dict:
     """Store the measurement in the archive: {"id", "root"}, or {"error", "root"} and a warning (module doc)."""
-    from analysis.archive import Archive, default_root
-    root = Path(args.archive_root).expanduser() if args.archive_root else default_root()
+    from analysis.archive.backends import archive_spec, open_archive, shown
+    spec = archive_spec(args.archive or (str(Path(args.archive_root).expanduser()) if args.archive_root else None))
+    root = shown(spec)
     if outcome.result.fit is None:        # a broken measurement: judged (printed), but nothing to keep in the archive
         why = f"nothing could be fitted ({outcome.result.not_fitted})"
         _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in {outcome.recording_path}")
@@ -190,7 +198,8 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
                          "laser": "serial" if outcome.raw_path is not None else (args.laser or LASER_ANALOG)}}
     archive = None
     try:
-        archive = Archive(root)
+        archive = open_archive(spec)
+        root = archive.location
         mid = archive.store(outcome.recording_path, outcome.result, meta, laser_stream=outcome.raw_path)
     except Exception as exc:  # noqa: BLE001 - whatever went wrong, the recording is on disk: say so, lose nothing
         if is_user_error(exc):
@@ -198,17 +207,23 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
         else:
             from app.crash_report import internal_error_line
             why = internal_error_line(exc, "storing the measurement in the archive")
+        if getattr(exc, "queued_id", None):     # refused by the server, kept in the station's queue: not twice
+            _say(f"warning: not stored in the archive {root}: {why}")
+            return {"error": why, "root": str(root), "queued": exc.queued_id}
         _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
              f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
         return {"error": why, "root": str(root)}
     finally:
         for note in archive.notes if archive is not None else ():
             _say(f"note: {note}")
+    if archive.pending:
+        _say(f"measured as {mid}; it waits in this station's queue until the server {root} can be reached")
+        return {"id": mid, "root": str(root), "queued": True}
     _say(f"stored in the archive {root} as {mid}")
     return {"id": mid, "root": str(root)}
 
 
-def _store_later(args: argparse.Namespace, outcome, root: Path, measured_at: str) -> str:
+def _store_later(args: argparse.Namespace, outcome, root: str, measured_at: str) -> str:
     """The `linpar archive store` command that stores this measurement as this command would have (shell-quoted)."""
     effects = ",".join(outcome.result.fit.model.effect_ids) or "none"
     command = ["linpar", "archive", "store", str(outcome.recording_path.with_suffix("")), "--model", effects]
@@ -216,7 +231,8 @@ def _store_later(args: argparse.Namespace, outcome, root: Path, measured_at: str
         command += ["--laser-stream", str(outcome.raw_path)]
     for key in ("serial", "operator", "station"):
         command += [f"--{key}", getattr(args, key)] if getattr(args, key) else []
-    return shlex.join(command + ["--measured-at", measured_at, "--root", str(root)])
+    where = "--archive" if "://" in root else "--root"
+    return shlex.join(command + ["--measured-at", measured_at, where, str(root)])
 
 
 def _devices(args: argparse.Namespace, stack: ExitStack):

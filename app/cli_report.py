@@ -66,9 +66,8 @@ def load_source(args):
     if args.sd is not None or args.model is not None:
         raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "
                        "its own")
-    from analysis.archive import Archive
-    archive = Archive(Path(args.root).expanduser() if args.root else None)
-    m = archive.get(args.source)
+    from app.cli_archive_server import open_from_args
+    m = open_from_args(args).get(args.source)
     record = m.record
     header = {k: record.get(k) for k in ("driver", "serial", "measured_at", "operator", "station", "id")}
     return m.result(), header, m.load_json("settings"), m.load_json("calibration")

@@ -17,6 +17,7 @@ runs one suite against each.
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Protocol
@@ -101,6 +102,11 @@ def archive_spec(explicit: str | Path | None = None) -> str:
 
 def is_url(spec: str) -> bool:
     return "://" in str(spec)
+
+
+def shown(spec: str) -> str:
+    """A specification as messages may show it: a URL's password masked."""
+    return re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", str(spec))
 
 
 def open_archive(spec: str | Path | None = None) -> ArchiveBackend:

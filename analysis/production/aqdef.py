@@ -28,6 +28,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from analysis.errors import LinparError
+
 ENCODING = "cp1252"
 VALID, INVALID, PLACEHOLDER = 0, 129, 255
 LENGTHS = {"K1001": 30, "K1002": 80, "K2001": 40, "K2002": 80, "K2142": 20, "K0014": 40, "K0009": 255}
@@ -116,8 +118,8 @@ class Dfq:
     values: list[dict[int, dict[str, str]]] = field(default_factory=list)   # per unit: characteristic -> fields
 
 
-class DfqFormatError(ValueError):
-    pass
+class DfqFormatError(LinparError, ValueError):
+    """A .dfq line that read_dfq cannot read."""
 
 
 def read_dfq(data: bytes) -> Dfq:

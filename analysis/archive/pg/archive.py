@@ -64,7 +64,14 @@ class PostgresArchive:
 
     @contextlib.contextmanager
     def _session(self, doing: str, needs: str = "") -> Iterator:
-        conn = connect(self.server, doing)
+        try:
+            conn = connect(self.server, doing)
+        except ServerUnreachable as exc:
+            waiting = self.pending
+            if not waiting:
+                raise
+            raise ServerUnreachable(f"{exc}; {waiting} measurement(s) of this station wait in the local queue "
+                                    f"{self.outbox.root}") from None
         try:
             with server_errors(self.server, doing, needs):
                 yield conn
@@ -98,8 +105,9 @@ class PostgresArchive:
                                   "server accepts it ('linpar archive sync')")
             error.queued_id = mid
             raise error
-        self.notes.append(f"{report.problem or 'not sent'}: the measurement {mid} waits in {where}, with "
-                          f"{report.waiting - 1} other(s); it is sent with the next store or 'linpar archive sync'")
+        others = f" with {report.waiting - 1} other(s)" if report.waiting > 1 else ""
+        self.notes.append(f"{report.problem or 'not sent'}: the measurement {mid} waits in {where}{others}; it is "
+                          "sent with the next store or 'linpar archive sync'")
         return mid
 
     def sync(self) -> SyncReport:

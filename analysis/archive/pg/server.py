@@ -70,7 +70,8 @@ def parse_url(url: str) -> ServerURL:
     """The checked URL; ArchiveError (one line, the password never shown) when it cannot be one."""
     from psycopg import conninfo
     text = str(url).strip()
-    shown = re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", text)[:120]
+    from analysis.archive.backends import shown as masked
+    shown = masked(text)[:120]
     if not re.match(r"^postgres(ql)?://", text, re.IGNORECASE):
         raise ArchiveError(f"{shown}: expected postgresql://USER@HOST[:PORT]/DATABASE")
     try:

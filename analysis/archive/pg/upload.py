@@ -12,7 +12,7 @@ import hashlib
 import json
 from pathlib import Path
 
-from analysis.archive.names import inside
+from analysis.archive.names import ArchiveError, inside
 from analysis.archive.pg.files import send_file
 from analysis.archive.record import entry_of
 from analysis.archive.schema import KEY_PARAMETERS
@@ -20,8 +20,8 @@ from analysis.archive.schema import KEY_PARAMETERS
 SENT, ALREADY = "sent", "already"
 
 
-class IdTaken(Exception):
-    """The server holds another measurement under this id."""
+class IdTaken(ArchiveError):
+    """The server holds another measurement under this id (the outbox then draws another one)."""
 
 
 def canonical(record: dict) -> bytes:
