@@ -1,9 +1,13 @@
 """The Archive page: the stored measurements, filtered as one types; open one, compare up to eight.
 
-The list is read on the GUI thread: the index answers 1000 entries in ~0.1 s
+The archive is a folder, or the line's PostgreSQL server when $LINPAR_ARCHIVE_URL
+names one (it then wins over the folder chosen here, as on the command line).
+A folder's list is read on the GUI thread: the index answers 1000 entries in ~0.1 s
 (a stale index on a read-only archive is rebuilt in memory from the folders
-each time, 0.4 s for 1000: rare, and then the page is slow to filter); storing, comparing (it reads every results file) and rebuilding the index run
-in app.archive_worker. Open hands the stored recording to the main window,
+each time, 0.4 s for 1000: rare, and then the page is slow to filter); a
+server's is read in app.archive_worker, since the network may be slow or
+gone. Storing, comparing (it reads every results file) and rebuilding the
+index (for a server: sending the station's queue) run there too. Open hands the stored recording to the main window,
 which analyses it again like any opened file: the Results page, the Model lab
 and QA then have a full analysis (a stored results file has no covariance to
 refit or diagnose from). Every archive error is one line on the page.
@@ -11,13 +15,15 @@ refit or diagnose from). Every archive error is one line on the page.
 from __future__ import annotations
 
 import html
+import os
 from pathlib import Path
 
 from PySide6.QtCore import QItemSelection, QItemSelectionModel, Qt, QTimer, Signal
 from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QTabWidget, QVBoxLayout,
                                QWidget)
 
-from analysis.archive import MAX_COMPARED, Archive, ArchiveError, default_root
+from analysis.archive import MAX_COMPARED, ArchiveError, archive_spec, is_url, open_archive
+from analysis.archive.backends import URL_ENV, shown
 from app import style
 from app.archive_filter import FilterBar
 from app.archive_overlay import CompareView
@@ -33,10 +39,14 @@ COLOURS = {"error": style.VALIDITY_COLOURS["red"][1], "note": style.VALIDITY_COL
            "info": style.VALIDITY_COLOURS["unknown"][1]}
 
 
-def archive_root(qsettings) -> Path:
-    """The folder chosen on the page, else analysis.archive's default ($LINPAR_ARCHIVE or ~/.local/share/...)."""
+def archive_source(qsettings) -> str:
+    """$LINPAR_ARCHIVE_URL, else the folder chosen on the page, else analysis.archive's default
+    ($LINPAR_ARCHIVE or ~/.local/share/...)."""
+    url = os.environ.get(URL_ENV, "").strip()
+    if url:
+        return url
     saved = qsettings.value(ROOT_KEY, "")
-    return Path(saved).expanduser() if isinstance(saved, str) and saved else default_root()
+    return str(Path(saved).expanduser()) if isinstance(saved, str) and saved else archive_spec()
 
 
 class ArchivePage(QWidget):
@@ -54,6 +64,7 @@ class ArchivePage(QWidget):
         self._jobs: dict[int, str] = {}      # job id -> what it does, for its failure's message
         self._storing: dict[int, Path] = {}  # job id -> the recording being stored
         self._compare_job = None            # the ArchiveJob whose comparison will be shown
+        self._list_job = None               # the ArchiveJob listing a server (the newest asked for)
         self._list_error = False
 
         self.root_label = QLabel()
@@ -102,6 +113,7 @@ class ArchivePage(QWidget):
         self.worker.stored.connect(self.on_stored)
         self.worker.compared.connect(self.on_compared)
         self.worker.rebuilt.connect(self.on_rebuilt)
+        self.worker.listed.connect(self.on_listed)
         self.worker.failed.connect(self.on_failed)
         self.worker.cancelled.connect(self.on_cancelled)
         self._show_root()
@@ -131,10 +143,15 @@ class ArchivePage(QWidget):
         layout.addWidget(self.message)
         layout.addWidget(self.tabs, 1)
 
-    # -- the archive's folder --------------------------------------------------
+    # -- the archive's folder (or server) ----------------------------------------
     @property
-    def root(self) -> Path:
-        return archive_root(self.settings.qsettings)
+    def source(self) -> str:
+        """The archive this page shows and stores into: a folder, or a postgresql:// URL."""
+        return archive_source(self.settings.qsettings)
+
+    @property
+    def on_server(self) -> bool:
+        return is_url(self.source)
 
     def set_root(self, path: str | Path) -> None:
         self.settings.qsettings.setValue(ROOT_KEY, str(path))
@@ -148,11 +165,20 @@ class ArchivePage(QWidget):
         self.refresh_now()
 
     def _show_root(self) -> None:
-        self.root_label.setText(str(self.root))
-        self.root_label.setToolTip(f"{self.root}\nEvery measurement finished on the Measure page is stored here")
+        where = shown(self.source)
+        self.root_label.setText(where)
+        self.root_label.setToolTip(f"{where}\nEvery measurement finished on the Measure page is stored here")
+        by_env = bool(os.environ.get(URL_ENV, "").strip())
+        self.root_button.setEnabled(not by_env)
+        self.root_button.setToolTip("The line's server, set by $LINPAR_ARCHIVE_URL for this station" if by_env else
+                                    "Choose the archive's folder (shared by the people at this station)")
+        self.rebuild_button.setText("Send queue" if self.on_server else "Rebuild index")
+        self.rebuild_button.setToolTip("Send the measurements this station stored while the server could not be "
+                                       "reached" if self.on_server else
+                                       "Read every measurement folder again and rebuild the index from them")
 
     def on_choose_root(self) -> None:
-        folder = QFileDialog.getExistingDirectory(self, "Archive folder", str(self.root))
+        folder = QFileDialog.getExistingDirectory(self, "Archive folder", self.source)
         if folder:
             self.set_root(folder)
 
@@ -167,7 +193,7 @@ class ArchivePage(QWidget):
         self.message.hide()
 
     def _error_text(self, exc: Exception) -> str:
-        return failure_text(exc, f"reading the archive {self.root}")
+        return failure_text(exc, f"reading the archive {shown(self.source)}")
 
     # -- listing -----------------------------------------------------------------
     def refresh(self, *_args) -> None:
@@ -177,35 +203,56 @@ class ArchivePage(QWidget):
     def refresh_now(self) -> int:
         """List the archive with the filter now; the number of measurements shown."""
         self.filter_timer.stop()
-        root = self.root
-        keep = {e.id for e in self.table.selected_entries()}
+        source = self.source
+        self._show_root()
+        if is_url(source):
+            if self._list_job is not None:
+                self._list_job.cancel()
+            self._list_job = self.worker.list(source, self.filters.filter(LIST_LIMIT + 1))
+            self._jobs[self._list_job.id] = "list"
+            self.count_label.setText("Reading the archive's server…")
+            return 0
         try:
-            archive = Archive(root)
+            archive = open_archive(source)
             entries = archive.list(self.filters.filter(LIST_LIMIT + 1))
         except Exception as exc:  # noqa: BLE001 - every error is a message on the page
-            self.table.set_entries([])
-            self.count_label.setText("")
-            self.show_message(f"Cannot read the archive in {root}: {self._error_text(exc)}", "error")
-            self._list_error = True
-            self.listed.emit(0)
+            self._list_failed(self._error_text(exc))
             return 0
+        return self._show_entries(entries, archive.notes)
+
+    def on_listed(self, job: int, listed) -> None:
+        self._jobs.pop(job, None)
+        if self._list_job is not None and job == self._list_job.id:
+            self._list_job = None
+            self._show_entries(list(listed.entries), listed.notes)
+
+    def _list_failed(self, message: str) -> None:
+        self.table.set_entries([])
+        self.count_label.setText("")
+        self.show_message(f"Cannot read the archive in {shown(self.source)}: {message}", "error")
+        self._list_error = True
+        self.listed.emit(0)
+
+    def _show_entries(self, entries: list, notes) -> int:
+        keep = {e.id for e in self.table.selected_entries()}
         if self._list_error:
             self.clear_message()
             self._list_error = False
-        if archive.notes:
-            self.show_message("The index was repaired: " + "; ".join(archive.notes), "note")
+        if notes:
+            self.show_message(("" if self.on_server else "The index was repaired: ") + "; ".join(notes), "note")
         more = len(entries) > LIST_LIMIT
         entries = entries[:LIST_LIMIT]
         self.table.set_entries(entries)
         self._reselect(keep)
-        self.count_label.setText(self._count_text(len(entries), more, root))
+        self.count_label.setText(self._count_text(len(entries), more))
         self.listed.emit(len(entries))
         return len(entries)
 
-    def _count_text(self, n: int, more: bool, root: Path) -> str:
+    def _count_text(self, n: int, more: bool) -> str:
         filtered = self.filters.active
         if n == 0 and not filtered:
-            return ("The archive is empty" if root.is_dir() else "No archive in this folder yet") + \
+            return ("The archive is empty" if self.on_server or Path(self.source).is_dir()
+                    else "No archive in this folder yet") + \
                 ": every measurement finished on the Measure page is stored here."
         if n == 0:
             return "No measurement matches the filter."
@@ -244,7 +291,7 @@ class ArchivePage(QWidget):
             self.show_message("Select the measurement to open.", "error")
             return None
         try:
-            measurement = Archive(self.root).get(entry.id)
+            measurement = open_archive(self.source).get(entry.id)
             path = measurement.recording_path()
             if path is None or not path.is_file():
                 raise ArchiveError(f"{measurement.folder}: the recording is missing")
@@ -268,7 +315,7 @@ class ArchivePage(QWidget):
             return
         if self._compare_job is not None:
             self._compare_job.cancel()      # replaced: its outcome would be dropped anyway
-        job = self.worker.compare(self.root, [e.id for e in entries])
+        job = self.worker.compare(self.source, [e.id for e in entries])
         self._jobs[job.id] = "compare"
         self._compare_job = job
         self.show_message(f"Loading {len(entries)} measurement{'s' if len(entries) != 1 else ''}…", "info")
@@ -289,7 +336,7 @@ class ArchivePage(QWidget):
     # -- storing and rebuilding ------------------------------------------------------
     def store_measurement(self, recording: Path, result, meta: dict) -> int:
         """Store in the worker; `stored` or `store_failed` tells how it went. The job's id."""
-        job = self.worker.store(self.root, Path(recording), result, meta)
+        job = self.worker.store(self.source, Path(recording), result, meta)
         self._jobs[job.id] = "store"
         self._storing[job.id] = Path(recording)
         return job.id
@@ -298,17 +345,22 @@ class ArchivePage(QWidget):
         self._jobs.pop(job, None)
         self._storing.pop(job, None)
         self.refresh_now()
-        text = f"Stored {stored.recording.name} as {stored.id}."
+        if stored.queued:
+            text = (f"Measured {stored.recording.name} as {stored.id}: the server cannot be reached, it waits in this "
+                    "station's queue and is sent with the next store or 'Send queue'.")
+        else:
+            text = f"Stored {stored.recording.name} as {stored.id}."
         if stored.notes:
-            text += " The index was repaired: " + "; ".join(stored.notes)
+            text += (" " if self.on_server else " The index was repaired: ") + "; ".join(stored.notes)
         self.show_message(text, "note" if stored.notes else "info")
         self.stored.emit(stored.id, str(stored.recording))
 
     def on_rebuild(self) -> None:
         self.rebuild_button.setEnabled(False)
-        job = self.worker.rebuild(self.root)
+        job = self.worker.rebuild(self.source)
         self._jobs[job.id] = "rebuild"
-        self.show_message("Rebuilding the index from the measurement folders…", "info")
+        self.show_message("Sending this station's queue to the server…" if self.on_server else
+                          "Rebuilding the index from the measurement folders…", "info")
 
     def on_rebuilt(self, job: int, done) -> None:
         self._jobs.pop(job, None)
@@ -325,7 +377,12 @@ class ArchivePage(QWidget):
             self.store_failed.emit(message, str(recording))
         elif kind == "rebuild":
             self.rebuild_button.setEnabled(True)
-            self.show_message(f"Cannot rebuild the index: {message}", "error")
+            self.show_message(f"Cannot {'send the queue' if self.on_server else 'rebuild the index'}: {message}",
+                              "error")
+        elif kind == "list":
+            if self._list_job is not None and job == self._list_job.id:
+                self._list_job = None
+                self._list_failed(message)
         elif self._compare_job is not None and job == self._compare_job.id:
             self._compare_job = None
             self.show_message(f"Cannot compare: {message}", "error")

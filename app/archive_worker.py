@@ -1,9 +1,11 @@
-"""The archive's slow work off the GUI thread: storing a measurement, loading a comparison, rebuilding the index.
+"""The archive's slow work off the GUI thread: storing a measurement, loading a comparison, rebuilding the index;
+and for an archive on a PostgreSQL server, listing and sending the station's queue (a server may be slow or gone).
 
 Built like app.workers: one long-lived ArchiveWorker (a QObject of the GUI
 thread) owns a one-thread QThreadPool, so a store and the rebuild that
-follows it run in the order asked. Each job opens its own Archive (its own
-SQLite connection, its own repair notes). What crosses to the GUI thread is
+follows it run in the order asked. Each job opens its own archive
+(analysis.archive.open_archive of the page's source: its own connection,
+its own repair notes). What crosses to the GUI thread is
 frozen, or one line of text: every archive error (ArchiveError, SQLite,
 the file system, a results file that does not read) becomes that line.
 """
@@ -30,6 +32,7 @@ class StoredMeasurement:
     id: str
     recording: Path             # the recording that was stored (it stays where it was)
     notes: tuple[str, ...]      # what opening the index had to repair
+    queued: bool = False        # the server could not be reached: it waits in the station's queue
 
 
 @dataclass(frozen=True, slots=True)
@@ -42,8 +45,14 @@ class ComparisonData:
 
 @dataclass(frozen=True, slots=True)
 class RebuildDone:
-    text: str                   # RebuildReport.describe()
+    text: str                   # RebuildReport.describe() (or SyncReport.describe() for a server's queue)
     skipped: int
+
+
+@dataclass(frozen=True, slots=True)
+class Listed:
+    entries: tuple              # analysis.archive.Entry, newest first
+    notes: tuple[str, ...]
 
 
 def laser_stream_of(recording: Path) -> Path | None:
@@ -79,7 +88,8 @@ class ArchiveJob:
         except ArchiveCancelled:
             worker.cancelled.emit(self.id)
         except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            worker.failed.emit(self.id, failure_text(exc, f"the archive's {self.kind} ({self.root})"))
+            from analysis.archive.backends import shown
+            worker.failed.emit(self.id, failure_text(exc, f"the archive's {self.kind} ({shown(str(self.root))})"))
         else:
             getattr(worker, self.kind).emit(self.id, result)
 
@@ -88,29 +98,31 @@ class ArchiveWorker(QObject, JobBook):
     stored = Signal(int, object)        # job id, StoredMeasurement
     compared = Signal(int, object)      # job id, ComparisonData
     rebuilt = Signal(int, object)       # job id, RebuildDone
+    listed = Signal(int, object)        # job id, Listed
     failed = Signal(int, str)           # job id, a one-line message for the user
     cancelled = Signal(int)             # job id
 
     def __init__(self, parent: QObject | None = None):
         super().__init__(parent)
-        self._init_jobs(self, (self.stored, self.compared, self.rebuilt, self.failed, self.cancelled), max_threads=1)
+        self._init_jobs(self, (self.stored, self.compared, self.rebuilt, self.listed, self.failed, self.cancelled),
+                        max_threads=1)
 
-    def store(self, root: Path, recording: Path, result, meta: Mapping[str, Any]) -> ArchiveJob:
+    def store(self, root: str | Path, recording: Path, result, meta: Mapping[str, Any]) -> ArchiveJob:
         """Store a recording file and its analysis.pipeline.AnalysisResult with `meta` (MeasurementMeta's keys)."""
         def work(job):
-            from analysis.archive import Archive
-            archive = Archive(root)
+            from analysis.archive import open_archive
+            archive = open_archive(str(root))
             mid = archive.store(recording, result, dict(meta), laser_stream=laser_stream_of(recording))
-            return StoredMeasurement(mid, recording, tuple(archive.notes))
+            return StoredMeasurement(mid, recording, tuple(archive.notes), archive.pending > 0)
         return self._start(ArchiveJob(self._next_id(), "stored", root, work, self))
 
-    def compare(self, root: Path, ids: list[str]) -> ArchiveJob:
+    def compare(self, root: str | Path, ids: list[str]) -> ArchiveJob:
         """analysis.archive.compare of `ids`, with each one's stored curves for the overlay."""
         ids = list(ids)
 
         def work(job):
-            from analysis.archive import Archive, compare
-            archive = Archive(root)
+            from analysis.archive import compare, open_archive
+            archive = open_archive(str(root))
             comparison = compare(archive, ids)
             dates, curves = [], []
             for mid in comparison.ids:
@@ -121,9 +133,22 @@ class ArchiveWorker(QObject, JobBook):
             return ComparisonData(comparison, tuple(dates), tuple(curves), tuple(archive.notes))
         return self._start(ArchiveJob(self._next_id(), "compared", root, work, self))
 
-    def rebuild(self, root: Path) -> ArchiveJob:
+    def rebuild(self, root: str | Path) -> ArchiveJob:
+        """Rebuild a folder archive's index; for a server, send this station's queue (it has no index)."""
         def work(job):
-            from analysis.archive import Archive
-            report = Archive(root).rebuild()
+            from analysis.archive import is_url, open_archive
+            archive = open_archive(str(root))
+            if is_url(str(root)):
+                report = archive.sync()
+                return RebuildDone(f"queue sent: {report.describe()}", report.waiting)
+            report = archive.rebuild()
             return RebuildDone(report.describe(), len(report.skipped))
         return self._start(ArchiveJob(self._next_id(), "rebuilt", root, work, self))
+
+    def list(self, root: str | Path, flt) -> ArchiveJob:
+        """List an archive (on a server: the GUI thread must not wait for the network)."""
+        def work(job):
+            from analysis.archive import open_archive
+            archive = open_archive(str(root))
+            return Listed(tuple(archive.list(flt)), tuple(archive.notes))
+        return self._start(ArchiveJob(self._next_id(), "listed", root, work, self))

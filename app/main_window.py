@@ -15,6 +15,7 @@ from app.job_book import failure_text
 from app.large_signal_page import LargeSignalPage
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
+from app.production_page import ProductionPage
 from app.qa_view import QAView
 from app.series_page import SeriesPage
 from app.results_view import ResultsView
@@ -25,7 +26,7 @@ from app.workers import AnalysisJob, AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
-PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "Large signal", "QA", "Archive")
+PAGE_ORDER = ("Measure", "Results", "Model lab", "Series", "Large signal", "QA", "Production", "Archive")
 CLOSE_WAIT_MS = 5000        # a cancelled fit stops at its next iteration; this is ample
 
 
@@ -79,8 +80,11 @@ class MainWindow(QMainWindow):
         self.archive.stored.connect(self.on_archived)
         self.archive.store_failed.connect(self.on_archive_failed)
         self._titles: dict[Path, str] = {}      # recording path -> what the title bar calls it (archived ones)
+        # Statistics over the archive's units: the line's drift, Cpk, the stations (app/production_page.py).
+        self.production = ProductionPage(self.settings)
         built = {"Measure": self.wizard, "Results": self.results, "Model lab": self.model_lab,
-                 "Series": self.series, "Large signal": self.large_signal, "QA": self.qa, "Archive": self.archive}
+                 "Series": self.series, "Large signal": self.large_signal, "QA": self.qa,
+                 "Production": self.production, "Archive": self.archive}
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
@@ -382,6 +386,7 @@ class MainWindow(QMainWindow):
         self.wizard.shutdown(CLOSE_WAIT_MS)
         self.qa.shutdown(CLOSE_WAIT_MS)
         self.archive.shutdown(CLOSE_WAIT_MS)
+        self.production.shutdown(CLOSE_WAIT_MS)
         self.series.worker.cancel()
         self.series.worker.pool.waitForDone(CLOSE_WAIT_MS)
         self.settings.save_window(self.saveGeometry(), self.saveState())

@@ -23,6 +23,10 @@ and model-lab-own-effect-*.png: the lab once it is saved and checked, reduced
 chi^2 down to 1 (--only new-effect: just these).
 large-signal-1280x720.png and -1920x1080.png: the Large-signal page on the
 known-polynomial driver at three levels (--only large-signal: just these).
+production-1280x720.png and production-1920x1080.png: the Production page
+over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
+station QA3 reading high, its control chart with the alarms flagged
+(--only production: just these two).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
 """
@@ -381,6 +385,61 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
         written.append(path)
     window.resize(*SIZE)
     settle(app)
+
+
+def production_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Production page: 240 units of one driver from three stations, fs 2 sigma up from unit 150, QA3 reading
+    0.6 Hz high; limits version 1 stored first. At 1280x720 and 1920x1080."""
+    import copy
+
+    import numpy as np
+
+    from analysis.archive import open_archive
+    from analysis.archive.results import results_document
+    from analysis.pipeline import analyze_recording
+
+    driver = load_driver("paper")
+    mt = design_multitone(8000, 1024, 8.0, 3000.0, rms=1.0)      # a small recording: the units differ below
+    recording = synthesize_recording(driver.model(), driver.parameters, mt.waveform, mt.excited_bins, 8000, 3, 0,
+                                     ChannelNoise(1e-4, 1e-4, 1e-8), seed=1,
+                                     driver={"name": "W18-PAPER", "sd_m2": driver.sd_m2})
+    wav, _ = write_recording(folder / "unit", recording)
+    doc = results_document(analyze_recording(recording), recording)
+    archive = open_archive(window.production.request().source)
+    archive.store_limits({"format": "linpar-limits/1", "name": "W18-PAPER production",
+                          "parameters": {"fs": {"nominal": 70.5, "tolerance": 5.0, "unit": "Hz"},
+                                         "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+                                         "Qts": {"min": 0.40, "max": 0.52, "unit": "-"}}}, note="first article")
+    rng = np.random.default_rng(4)
+    for i in range(240):
+        station = ("QA1", "QA2", "QA3")[i % 3]
+        unit_doc = copy.deepcopy(doc)
+        params = unit_doc["parameters"]
+        fs = 70.5 + 0.8 * rng.standard_normal() + (1.6 if i >= 150 else 0.0) + (0.6 if station == "QA3" else 0.0)
+        for name, p in params.items():          # unit-to-unit spread of a few percent, as a batch has
+            if p.get("value") is not None:
+                p["value"] = p["value"] * (1 + 0.015 * rng.standard_normal())
+        params["fs"]["value"] = fs
+        archive.store(wav, unit_doc, {"driver": "W18-PAPER", "serial": f"{7000 + i}", "station": station,
+                                      "operator": ("ana", "ben")[i % 2],
+                                      "measured_at": f"2024-05-{1 + i // 80:02d}T{6 + i % 80 // 8:02d}:"
+                                                     f"{i % 8 * 7:02d}:00Z"})
+    page = window.production
+    window.pages.setCurrentWidget(page)
+    written = []
+    for width, height in SMALL_AND_LARGE:
+        window.resize(width, height)
+        page.parameter = "fs"
+        if not wait_for(page.computed, ANALYSIS_TIMEOUT_S) and page.data is None:
+            print("screenshots: the production statistics did not come", file=sys.stderr)
+            return written
+        page.details.setCurrentIndex(0)
+        settle(app)
+        path = out / f"production-{width}x{height}.png"
+        window.grab().save(str(path))
+        written.append(path)
+        page.refresh()
+    window.resize(*SIZE)
     return written
 
 
@@ -441,7 +500,7 @@ def settle(app: QApplication, ms: int = 300) -> None:
 
 
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
-        "large-signal": large_signal_screenshots}
+        "large-signal": large_signal_screenshots, "production": production_screenshots}
 
 
 def main(argv: list[str]) -> int:
@@ -488,7 +547,7 @@ def main(argv: list[str]) -> int:
         tabs.setCurrentIndex(0)
         for index in range(window.pages.count()):
             page = window.pages.tabText(index)
-            if page in ("Results", "Archive"):      # the Archive page once it has measurements, below
+            if page in ("Results", "Archive", "Production"):    # these once they have measurements, below
                 continue
             window.pages.setCurrentIndex(index)
             settle(app)
@@ -511,6 +570,8 @@ def main(argv: list[str]) -> int:
         written += series_screenshots(app, window, folder, out)
         written += large_signal_screenshots(app, window, folder, out)
         written += archive_screenshots(app, window, folder, out)
+        window.archive.set_root(folder / "production-archive")      # a line's worth of units of its own
+        written += production_screenshots(app, window, folder, out)
         window.close()
     for path in written:
         print(path)

@@ -1,0 +1,144 @@
+"""The Production page's plots: the individuals and moving-range chart with its alarms, and the histogram with
+the limits. Values in the parameter's customary unit; the chart's x axis is the unit's number in the selection.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import Qt
+
+from app import style
+from app.grid_axis import OpaqueGridAxis, show_grid
+
+ALARM = "#c62828"
+CONTROL = "#8e5bb5"          # control limits (the process)
+SPEC = "#2e7d32"             # specification limits (the product)
+LEFT_AXIS_WIDTH = 64
+
+
+def _axes():
+    return {"left": OpaqueGridAxis("left"), "bottom": OpaqueGridAxis("bottom")}
+
+
+RIGHT_MARGIN = 0.14          # room right of the last unit for the lines' labels, clear of the points
+
+
+def _hline(plot, y, colour, dashed=True, label=""):
+    pen = pg.mkPen(colour, width=1.5, style=Qt.DashLine if dashed else Qt.SolidLine)
+    line = pg.InfiniteLine(pos=y, angle=0, pen=pen, label=label,
+                           labelOpts={"position": 0.995, "color": colour, "anchors": [(1, 1), (1, 1)]})
+    plot.addItem(line)
+    return line
+
+
+def display_unit(unit: str) -> str:
+    from analysis.report.numbers import pretty_unit
+    return "" if unit in ("", "-", "1") else pretty_unit(unit)
+
+
+class ControlChartView(pg.GraphicsLayoutWidget):
+    """Individuals (top) and moving ranges (below) of one parameter, alarm points in red."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setBackground("w")
+        self.individuals = self.addPlot(row=0, col=0, axisItems=_axes())
+        self.ranges = self.addPlot(row=1, col=0, axisItems=_axes())
+        self.ci.layout.setRowStretchFactor(0, 3)
+        self.ci.layout.setRowStretchFactor(1, 1)
+        for plot in (self.individuals, self.ranges):
+            show_grid(plot)
+            plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
+        self.ranges.setXLink(self.individuals)
+        self.ranges.setLabel("bottom", "unit (in the order measured)")
+        self.ranges.setLabel("left", "moving range")
+        self.alarm_points = np.array([], dtype=int)
+
+    def clear_chart(self, why: str = "") -> None:
+        for plot in (self.individuals, self.ranges):
+            plot.clear()
+        self.individuals.setTitle(why)
+        self.alarm_points = np.array([], dtype=int)
+
+    def show_parameter(self, p) -> None:
+        """p: analysis.production.summary.ParameterStats."""
+        self.clear_chart()
+        chart, scale, unit = p.chart, p.display_scale, p.display_unit
+        if chart is None:
+            self.individuals.setTitle("No control chart: fewer than two units, or no spread between them")
+            return
+        x = np.arange(1, chart.values.size + 1)
+        y = chart.values * scale
+        unit = display_unit(unit)
+        self.individuals.setLabel("left", f"{p.name} ({unit})" if unit else p.name)
+        self.individuals.plot(x, y, pen=pg.mkPen("#9bb7e0", width=1), symbol="o", symbolSize=4,
+                              symbolBrush=style.MEASURED, symbolPen=None)
+        _hline(self.individuals, chart.centre * scale, style.GUIDE, dashed=False, label="centre")
+        _hline(self.individuals, chart.ucl * scale, CONTROL, label="UCL +3σ")
+        _hline(self.individuals, chart.lcl * scale, CONTROL, label="LCL −3σ")
+        for value, name in ((p.capability.low, "LSL"), (p.capability.high, "USL")):
+            if value is not None:
+                _hline(self.individuals, value * scale, SPEC, label=name)
+        self.individuals.setXRange(0, x[-1] * (1 + RIGHT_MARGIN), padding=0)
+        self.individuals.addItem(pg.InfiniteLine(pos=chart.baseline + 0.5, angle=90,
+                                                 pen=pg.mkPen(style.GUIDE, width=1, style=Qt.DotLine),
+                                                 label="baseline", labelOpts={"position": 0.97, "color": style.GUIDE,
+                                                                               "anchors": [(1, 0), (1, 0)]}))
+        flagged = chart.flagged()
+        self.alarm_points = flagged
+        if flagged.size:
+            self.individuals.plot(x[flagged], y[flagged], pen=None, symbol="o", symbolSize=8,
+                                  symbolBrush=ALARM, symbolPen=pg.mkPen("#7f0000"))
+            # Where the run of alarms the eye looks for begins: the first alarm after the baseline
+            # (or the first one), marked on the axis of units with its rule.
+            later = [a for a in chart.alarms if a.triggers[0] >= chart.baseline] or list(chart.alarms)
+            first = later[0]
+            self.individuals.addItem(pg.InfiniteLine(
+                pos=first.triggers[0] + 1, angle=90, pen=pg.mkPen(ALARM, width=1, style=Qt.DashLine),
+                label=f"first alarm: {first.rule}, unit {first.triggers[0] + 1}",
+                labelOpts={"position": 0.97, "color": ALARM, "anchors": [(0, 0), (0, 0)]}))
+        mr_x = x[1:]
+        self.ranges.plot(mr_x, chart.moving_ranges * abs(scale), pen=pg.mkPen("#9bb7e0", width=1), symbol="o",
+                         symbolSize=3, symbolBrush=style.MEASURED, symbolPen=None)
+        _hline(self.ranges, chart.mr_centre * abs(scale), style.GUIDE, dashed=False)
+        _hline(self.ranges, chart.mr_ucl * abs(scale), CONTROL, label="UCL")
+        self.ranges.setYRange(0, max(float(chart.moving_ranges.max()), chart.mr_ucl) * abs(scale) * 1.25, padding=0)
+        jumps = sorted({k for a in chart.alarms if a.rule == "MR" for k in a.points if k >= 1})
+        if jumps:
+            k = np.array(jumps)
+            self.ranges.plot(x[k], chart.moving_ranges[k - 1] * abs(scale), pen=None, symbol="o", symbolSize=7,
+                             symbolBrush=ALARM, symbolPen=None)
+        self.individuals.setTitle(f"{p.name}: individuals, centre and σ from the first {chart.baseline} units; "
+                                  f"{len(chart.alarms)} alarm(s)")
+
+
+class HistogramView(pg.PlotWidget):
+    """The distribution of one parameter with its specification limits."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent, axisItems=_axes(), background="w")
+        show_grid(self.getPlotItem())
+        self.getPlotItem().getAxis("left").setWidth(LEFT_AXIS_WIDTH)
+        self.setLabel("left", "units")
+
+    def show_parameter(self, p) -> None:
+        plot = self.getPlotItem()
+        plot.clear()
+        edges, counts = p.histogram
+        if len(counts) == 0:
+            plot.setTitle("No unit in this selection")
+            return
+        scale = p.display_scale
+        e = np.sort(edges * scale)
+        plot.addItem(pg.BarGraphItem(x0=e[:-1], x1=e[1:], height=counts[::-1] if scale < 0 else counts,
+                                     brush="#9bb7e0", pen=pg.mkPen("#1f5fbf")))
+        for value, name in ((p.capability.low, "LSL"), (p.capability.high, "USL")):
+            if value is not None:
+                plot.addItem(pg.InfiniteLine(pos=value * scale, angle=90, pen=pg.mkPen(SPEC, width=2,
+                                                                                        style=Qt.DashLine),
+                                             label=name, labelOpts={"position": 0.9, "color": SPEC}))
+        unit = display_unit(p.display_unit)
+        plot.setLabel("bottom", f"{p.name} ({unit})" if unit else p.name)
+        c = p.capability
+        plot.setTitle(f"{p.name}: n = {c.n}" + (f", yield {100 * c.yield_fraction:.1f} %"
+                                                if c.yield_fraction is not None else ", no limits"))

@@ -1,0 +1,348 @@
+"""The Production page: is the line drifting, what is the Cpk this week, which station reads high?
+
+Per parameter of the selected units (dates, station, driver): n, mean, sigma,
+Cp/Cpk, Pp/Ppk and yield against the archive's newest limits version; for the
+parameter chosen in the table, the individuals/moving-range chart with the
+Western Electric alarms in red, and the histogram with the limits. The alarms
+tab names each alarm's rule and its measurements; the stations tab says which
+station reads high. The numbers are analysis.production's; they are computed
+in app.production_worker (a server may be slow), and exported from here to
+CSV, JSON or Q-DAS AQDEF.
+"""
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+from PySide6.QtCore import QDate, Qt, QTimer, Signal
+from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QDateEdit, QFileDialog, QHBoxLayout, QHeaderView,
+                               QLabel, QPushButton, QSizePolicy, QSpinBox, QSplitter, QTableWidget, QTableWidgetItem,
+                               QTabWidget, QVBoxLayout, QWidget)
+
+from analysis.archive.backends import shown
+from app import style
+from app.archive_page import archive_source
+from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit
+from app.production_worker import ProductionRequest, ProductionWorker
+
+NO_DATE = QDate(2000, 1, 1)
+FILTER_DELAY_MS = 300
+STATS_COLUMNS = ("Parameter", "n", "Mean", "σ", "Limit", "Cp", "Cpk", "Pp", "Ppk", "Yield", "Alarms")
+ALARM_COLUMNS = ("Rule", "Units", "What", "Measurements")
+STATION_COLUMNS = ("Station", "n", "Mean", "Offset from the stations' mean", "Reads")
+EXPORTS = {"CSV, one row per measurement and parameter (*.csv)": ".csv", "JSON (*.json)": ".json",
+           "Q-DAS AQDEF for qs-STAT (*.dfq)": ".dfq"}
+LOW_CPK = 1.33          # below it a capability index is shown in red: the customary minimum for a process
+
+
+def _number(value, scale: float = 1.0, digits: int = 4) -> str:
+    return "–" if value is None else f"{value * scale:.{digits}g}"
+
+
+def _item(text: str, tooltip: str = "", colour: str | None = None) -> QTableWidgetItem:
+    item = QTableWidgetItem(text)
+    if tooltip:
+        item.setToolTip(tooltip)
+    if colour:
+        item.setForeground(Qt.GlobalColor.darkRed if colour == "red" else Qt.GlobalColor.darkGreen)
+    return item
+
+
+def _date_edit(tooltip: str) -> QDateEdit:
+    edit = QDateEdit()
+    edit.setCalendarPopup(True)
+    edit.setDisplayFormat("yyyy-MM-dd")
+    edit.setMinimumDate(NO_DATE)
+    edit.setSpecialValueText("any")
+    edit.setDate(NO_DATE)
+    edit.setToolTip(tooltip + " (UTC)")
+    return edit
+
+
+def _table(columns) -> QTableWidget:
+    table = QTableWidget(0, len(columns))
+    table.setHorizontalHeaderLabels(columns)
+    table.verticalHeader().setVisible(False)
+    table.setEditTriggers(QAbstractItemView.NoEditTriggers)
+    table.setSelectionBehavior(QAbstractItemView.SelectRows)
+    table.setSelectionMode(QAbstractItemView.SingleSelection)
+    table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
+    table.horizontalHeader().setStretchLastSection(True)
+    table.setWordWrap(False)
+    return table
+
+
+class ProductionPage(QWidget):
+    computed = Signal(object)           # app.production_worker.ProductionData, once shown
+    failed = Signal(str)
+
+    def __init__(self, settings, parent=None):
+        super().__init__(parent)
+        self.settings = settings
+        self.worker = ProductionWorker(self)
+        self.data = None
+        self._job: int | None = None
+        self.parameter: str | None = None
+
+        self.source_label = QLabel()
+        self.source_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.since_edit = _date_edit("Measured on or after this day")
+        self.until_edit = _date_edit("Measured on or before this day")
+        self.station_combo, self.driver_combo = QComboBox(), QComboBox()
+        self.station_combo.addItem("every station", None)
+        self.driver_combo.addItem("every driver", None)
+        self.baseline_spin = QSpinBox()
+        self.baseline_spin.setRange(10, 100000)
+        self.baseline_spin.setValue(50)
+        self.baseline_spin.setSuffix(" units")
+        self.baseline_spin.setToolTip("The control chart's centre and σ come from the first N units of the selection")
+        self.refresh_button = QPushButton("Refresh")
+        self.export_button = QPushButton("Export…")
+        self.export_button.setToolTip("The selected units as CSV, JSON or Q-DAS AQDEF (.dfq)")
+        self.message = QLabel()
+        self.message.setWordWrap(True)
+        self.message.setTextFormat(Qt.RichText)
+        self.summary = QLabel()
+        self.summary.setWordWrap(True)
+        self.stats_table = _table(STATS_COLUMNS)
+        self.alarms_table = _table(ALARM_COLUMNS)
+        self.stations_table = _table(STATION_COLUMNS)
+        self.chart = ControlChartView()
+        self.histogram = HistogramView()
+        self.details = QTabWidget()
+        self._build_layout()
+
+        self.filter_timer = QTimer(self)
+        self.filter_timer.setSingleShot(True)
+        self.filter_timer.setInterval(FILTER_DELAY_MS)
+        self.filter_timer.timeout.connect(self.refresh)
+        for signal in (self.since_edit.dateChanged, self.until_edit.dateChanged, self.baseline_spin.valueChanged,
+                       self.station_combo.currentIndexChanged, self.driver_combo.currentIndexChanged):
+            signal.connect(lambda *_: self.filter_timer.start())
+        self.refresh_button.clicked.connect(self.refresh)
+        self.export_button.clicked.connect(self.on_export)
+        self.stats_table.itemSelectionChanged.connect(self.on_parameter_chosen)
+        self.worker.computed.connect(self.on_computed)
+        self.worker.failed.connect(self.on_failed)
+        self.export_button.setEnabled(False)
+
+    def _build_layout(self) -> None:
+        # Two rows, and nothing that cannot shrink: the page must not set the window's minimum width.
+        self.source_label.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Preferred)
+        for combo in (self.station_combo, self.driver_combo):
+            combo.setSizeAdjustPolicy(QComboBox.AdjustToMinimumContentsLengthWithIcon)
+            combo.setMinimumContentsLength(11)
+        top = QHBoxLayout()
+        top.addWidget(QLabel("<b>Production</b>"))
+        top.addWidget(self.source_label, 1)
+        top.addWidget(QLabel("Baseline"))
+        top.addWidget(self.baseline_spin)
+        top.addWidget(self.refresh_button)
+        top.addWidget(self.export_button)
+        filters = QHBoxLayout()
+        for label, widget in (("Measured from", self.since_edit), ("to", self.until_edit), ("", self.station_combo),
+                              ("", self.driver_combo)):
+            if label:
+                filters.addWidget(QLabel(label))
+            filters.addWidget(widget)
+        filters.addStretch(1)
+        self.details.addTab(self.alarms_table, "Alarms")
+        self.details.addTab(self.stations_table, "Stations")
+        left = QSplitter(Qt.Vertical)
+        left.addWidget(self.stats_table)
+        left.addWidget(self.details)
+        left.setSizes([300, 200])
+        right = QSplitter(Qt.Vertical)
+        right.addWidget(self.chart)
+        right.addWidget(self.histogram)
+        right.setSizes([380, 180])
+        body = QSplitter(Qt.Horizontal)
+        body.addWidget(left)
+        body.addWidget(right)
+        body.setSizes([680, 600])
+        layout = QVBoxLayout(self)
+        layout.addLayout(top)
+        layout.addLayout(filters)
+        layout.addWidget(self.message)
+        layout.addWidget(self.summary)
+        layout.addWidget(body, 1)
+        self.message.hide()
+
+    # -- asking ------------------------------------------------------------------------------
+    def request(self) -> ProductionRequest:
+        def day(edit):
+            return None if edit.date() == NO_DATE else edit.date().toString("yyyy-MM-dd")
+        return ProductionRequest(archive_source(self.settings.qsettings), day(self.since_edit), day(self.until_edit),
+                                 self.station_combo.currentData(), self.driver_combo.currentData(),
+                                 self.baseline_spin.value())
+
+    def refresh(self) -> int:
+        self.filter_timer.stop()
+        request = self.request()
+        self.source_label.setText(shown(request.source))
+        self._job = self.worker.start(request)
+        self.summary.setText("Reading the archive and computing…")
+        return self._job
+
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        self.refresh()              # stations store while the page is away
+
+    def _say(self, text: str, kind: str = "error") -> None:
+        colour = style.VALIDITY_COLOURS["red" if kind == "error" else "yellow"][1]
+        self.message.setText(f"<span style='color:{colour}'>{html.escape(text)}</span>")
+        self.message.setVisible(bool(text))
+
+    # -- showing -----------------------------------------------------------------------------
+    def on_failed(self, job: int, message: str) -> None:
+        if job != self._job:
+            return
+        self._job = None
+        self.summary.setText("")
+        self._say(f"Cannot compute the production statistics of {shown(self.request().source)}: {message}")
+        self.failed.emit(message)
+
+    def on_computed(self, job: int, data) -> None:
+        if job != self._job:
+            return
+        self._job = None
+        self.data = data
+        self._say("; ".join(data.notes), "note") if data.notes else self.message.hide()
+        self._offer(self.station_combo, data.population.stations)
+        self._offer(self.driver_combo, data.population.drivers)
+        self.summary.setText(self._summary_text(data.stats))
+        self._fill_stats(data.stats)
+        self.export_button.setEnabled(len(data.population) > 0)
+        self.computed.emit(data)
+
+    @staticmethod
+    def _offer(combo: QComboBox, names) -> None:
+        known = {combo.itemData(i) for i in range(combo.count())}
+        for name in sorted(set(names) - known):
+            combo.addItem(name, name)
+
+    @staticmethod
+    def _summary_text(stats) -> str:
+        parts = [f"{stats.n_measurements} measurement(s): {stats.selection}"]
+        if stats.excluded:
+            parts.append("left out: " + ", ".join(f"{n} {why}" for why, n in stats.excluded.items()))
+        parts.append(f"limits version {stats.limits.version} ({stats.limits.name})" if stats.limits is not None
+                     else "no limits stored: Cp, Cpk, Pp, Ppk and yield need limits")
+        if stats.first_pass_yield is not None:
+            parts.append(f"first-pass yield {100 * stats.first_pass_yield:.1f} % as the stations judged")
+        return "; ".join(parts) + "."
+
+    def _fill_stats(self, stats) -> None:
+        table = self.stats_table
+        table.blockSignals(True)
+        table.setRowCount(len(stats.parameters))
+        chosen_row = 0
+        for row, p in enumerate(stats.parameters.values()):
+            c, s = p.capability, p.display_scale
+            unit = f" {display_unit(p.display_unit)}".rstrip()
+            alarms = 0 if p.chart is None else len(p.chart.alarms)
+            cells = [_item(p.name), _item(str(c.n)), _item(_number(c.mean, s) + unit,
+                                                           f"min {_number(c.minimum, s)}, max {_number(c.maximum, s)}"),
+                     _item(_number(c.sigma_overall, s), f"within (moving range): {_number(c.sigma_within, s)}"),
+                     _item(p.limit_text or "–")]
+            for value in (c.cp, c.cpk, c.pp, c.ppk):
+                cells.append(_item("–" if value is None else f"{value:.2f}",
+                                   colour=None if value is None else ("red" if value < LOW_CPK else "green")))
+            cells.append(_item("–" if c.yield_fraction is None else f"{100 * c.yield_fraction:.1f} %"))
+            cells.append(_item(str(alarms), colour="red" if alarms else None))
+            for col, item in enumerate(cells):
+                table.setItem(row, col, item)
+            if p.name == self.parameter:
+                chosen_row = row
+        table.blockSignals(False)
+        if stats.parameters:
+            table.selectRow(chosen_row)
+            self.on_parameter_chosen()
+        else:
+            self.chart.clear_chart("No unit in this selection")
+            self.histogram.getPlotItem().clear()
+            self.alarms_table.setRowCount(0)
+            self.stations_table.setRowCount(0)
+
+    def on_parameter_chosen(self) -> None:
+        rows = self.stats_table.selectionModel().selectedRows() if self.stats_table.selectionModel() else []
+        if self.data is None or not rows:
+            return
+        name = self.stats_table.item(rows[0].row(), 0).text()
+        self.parameter = name
+        p = self.data.stats.parameters[name]
+        self.chart.show_parameter(p)
+        self.histogram.show_parameter(p)
+        self._fill_alarms(p)
+        self._fill_stations(p)
+
+    def _fill_alarms(self, p) -> None:
+        alarms = () if p.chart is None else p.chart.alarms
+        self.alarms_table.setRowCount(len(alarms))
+        for row, a in enumerate(alarms):
+            units = [i + 1 for i in a.points]
+            ids = [p.ids[i] for i in a.points]
+            span = str(units[0]) if len(units) == 1 else f"{units[0]}–{units[-1]}"
+            what = a.title + (f" ({a.side})" if a.side else "")
+            for col, item in enumerate((_item(a.rule, colour="red"), _item(span), _item(what, what),
+                                        _item(ids[0] + (f" and {len(ids) - 1} more" if len(ids) > 1 else ""),
+                                              "\n".join(ids)))):
+                self.alarms_table.setItem(row, col, item)
+        self.details.setTabText(0, f"{p.name}: alarms ({len(alarms)})")
+
+    def _fill_stations(self, p) -> None:
+        rows = p.stations.stations
+        self.stations_table.setRowCount(len(rows))
+        unit = f" {display_unit(p.display_unit)}".rstrip()
+        for row, st in enumerate(rows):
+            pairs = [q for q in p.stations.pairs if st.station in (q.a, q.b)]
+            tip = "\n".join(f"against {q.b if q.a == st.station else q.a}: p = {q.p:.2g}"
+                            + (" (differs)" if q.significant else "") for q in pairs if q.p is not None)
+            offset = f"{st.offset * p.display_scale:+.3g}{unit}" + \
+                     ("" if st.offset_sigmas is None else f" ({st.offset_sigmas:+.2f} σ)")
+            cells = (_item(st.station), _item(str(st.n)), _item(_number(st.mean, p.display_scale) + unit),
+                     _item(offset, tip), _item(st.reads or "as the others", tip, "red" if st.reads else None))
+            for col, item in enumerate(cells):
+                self.stations_table.setItem(row, col, item)
+        self.details.setTabText(1, f"{p.name}: stations" + (f" ({sum(1 for s in rows if s.reads)} differ)"
+                                                            if any(s.reads for s in rows) else ""))
+
+    # -- export ------------------------------------------------------------------------------
+    def on_export(self) -> None:
+        path, chosen = QFileDialog.getSaveFileName(self, "Export the selected units", "production.csv",
+                                                   ";;".join(EXPORTS))
+        if path:
+            self.export_to(Path(path), EXPORTS.get(chosen))
+
+    def export_to(self, path: Path, suffix: str | None = None) -> Path | None:
+        """Write the shown population to `path` (CSV, JSON or .dfq by suffix); the path, or None (the page says)."""
+        if self.data is None:
+            return None
+        import json
+
+        from analysis.archive.atomic import write_atomic
+        from analysis.production.aqdef import encode, write_dfq
+        from analysis.production.exchange import population_csv, population_json
+        kind = (suffix or path.suffix).lower()
+        data = self.data
+        try:
+            if kind == ".dfq":
+                payload = encode(write_dfq(data.population, data.stats.parameters, data.excluded_ids))
+            elif kind == ".json":
+                payload = json.dumps(population_json(data.population, data.stats.selection, data.location,
+                                                     data.stats.limits), indent=1, ensure_ascii=False) + "\n"
+            else:
+                payload = population_csv(data.population)
+            written = write_atomic(path, payload)
+        except Exception as exc:  # noqa: BLE001 - the GUI's error boundary (job_book.failure_text)
+            from app.job_book import failure_text
+            self._say(f"Could not export to {path}: {failure_text(exc, f'exporting to {path}')}")
+            return None
+        self._say(f"Written: {written} ({len(data.population)} measurement(s)).", "note")
+        return written
+
+    def shutdown(self, wait_ms: int) -> bool:
+        return self.worker.shutdown(wait_ms)
+
+
+__all__ = ["ALARM", "ProductionPage"]

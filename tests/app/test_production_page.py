@@ -1,0 +1,98 @@
+"""The Production page: the statistics of the archive's units in a table, the chosen parameter's control chart
+with its alarms flagged and named, the stations, the exports; the Archive page on a PostgreSQL server."""
+import json
+
+import numpy as np
+import pytest
+
+from analysis.archive import open_archive
+from app.main_window import MainWindow
+from tests.production_helpers import LIMITS, small_measurement, unit
+
+TIMEOUT_MS = 120_000
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory):
+    return small_measurement(tmp_path_factory.mktemp("unit"))
+
+
+def fill(spec, measured, n=120, drift_at=80):
+    """n units of stations QA1/QA2; fs 2 sigma up from unit `drift_at`; QA2 reads 1.5 sigma high."""
+    path, doc = measured
+    archive = open_archive(spec)
+    rng = np.random.default_rng(2)
+    for i in range(n):
+        station = f"QA{i % 2 + 1}"
+        fs = 70.0 + 0.4 * rng.standard_normal() + (0.8 if i >= drift_at else 0) + (0.6 if station == "QA2" else 0)
+        archive.store(path, unit(doc, fs=fs, RE=3.0 + 0.02 * rng.standard_normal()),
+                      {"station": station, "serial": f"SN{i:03d}", "driver": "W6",
+                       "measured_at": f"2024-05-01T{i // 60:02d}:{i % 60:02d}:00Z"})
+
+
+@pytest.fixture
+def window(qtbot, settings):
+    w = MainWindow(settings)
+    qtbot.addWidget(w)
+    w.resize(1280, 720)
+    w.show()
+    return w
+
+
+def show(qtbot, window):
+    page = window.production
+    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as shown:
+        window.pages.setCurrentWidget(page)
+    return page, shown.args[0]
+
+
+def test_statistics_chart_alarms_and_stations_of_the_archive(qtbot, window, measured, archive_root, tmp_path):
+    open_archive(str(archive_root)).store_limits(LIMITS)
+    fill(str(archive_root), measured)
+    page, data = show(qtbot, window)
+    assert len(data.population) == 120 and "120 measurement(s)" in page.summary.text()
+    names = [page.stats_table.item(r, 0).text() for r in range(page.stats_table.rowCount())]
+    assert "fs" in names and "RE" in names
+    page.stats_table.selectRow(names.index("fs"))
+    fs = data.stats.parameters["fs"]
+    assert page.parameter == "fs" and page.stats_table.item(names.index("fs"), 4).text() == "70 ± 6 Hz"
+    assert page.chart.alarm_points.size > 0                      # flagged in red on the chart
+    assert set(page.chart.alarm_points.tolist()) == set(fs.chart.flagged().tolist())
+    assert page.alarms_table.rowCount() == len(fs.chart.alarms)
+    first = fs.chart.alarms[0]
+    assert page.alarms_table.item(0, 0).text() == first.rule
+    assert page.alarms_table.item(0, 3).toolTip().split("\n") == [fs.ids[i] for i in first.points]
+    reads = {page.stations_table.item(r, 0).text(): page.stations_table.item(r, 4).text()
+             for r in range(page.stations_table.rowCount())}
+    assert reads == {"QA1": "low", "QA2": "high"}        # two stations: each differs from the other
+    written = page.export_to(tmp_path / "units.dfq")
+    assert written and written.read_bytes().startswith(b"K0100 ")
+    assert len(json.loads(page.export_to(tmp_path / "units.json").read_text())["measurements"]) == 120
+    # One station only: the filter is the statistics' selection.
+    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as shown:
+        page.station_combo.setCurrentIndex(page.station_combo.findData("QA1"))
+    assert len(shown.args[0].population) == 60 and set(shown.args[0].population.stations) == {"QA1"}
+
+
+def test_an_empty_archive_and_a_lost_server_are_said_on_the_page(qtbot, window, monkeypatch):
+    page, data = show(qtbot, window)
+    assert len(data.population) == 0 and "0 measurement(s)" in page.summary.text()
+    assert not page.export_button.isEnabled()
+    monkeypatch.setenv("LINPAR_ARCHIVE_URL", "postgresql://nobody@127.0.0.1:1/linpar?connect_timeout=2")
+    with qtbot.waitSignal(page.failed, timeout=TIMEOUT_MS) as failed:
+        page.refresh()
+    assert "cannot reach the server" in failed.args[0]
+    assert "Cannot compute the production statistics" in page.message.text() and page.message.isVisible()
+
+
+def test_the_archive_page_lists_a_server_named_by_the_environment(qtbot, window, measured, pg_database, monkeypatch):
+    fill(pg_database.url("station_a"), measured, n=4)
+    monkeypatch.setenv("LINPAR_ARCHIVE_URL", pg_database.url("audrey"))
+    archive = window.archive
+    with qtbot.waitSignal(archive.listed, timeout=TIMEOUT_MS) as listed:
+        window.pages.setCurrentWidget(archive)
+    assert listed.args[0] == 4
+    assert archive.root_label.text() == pg_database.url("audrey")
+    assert not archive.root_button.isEnabled() and archive.rebuild_button.text() == "Send queue"
+    page, data = show(qtbot, window)
+    assert len(data.population) == 4 and data.location == pg_database.url("audrey")
