@@ -113,32 +113,38 @@ def control_chart(values, baseline: int = DEFAULT_BASELINE) -> ControlChart | No
 def _zone_alarms(z: np.ndarray, rule: str) -> list[Alarm]:
     window, needed, zone = _ZONE_RULES[rule]
     alarms: list[Alarm] = []
+    if z.size < window:
+        return alarms
     for side, sign in (("above", 1.0), ("below", -1.0)):
         beyond = sign * z > zone
-        if z.size < window:
-            continue
         counts = np.convolve(beyond.astype(int), np.ones(window, dtype=int), mode="valid")   # window ending at i
         fired = np.flatnonzero((counts >= needed) & beyond[window - 1:]) + window - 1
-        for i in fired:
-            points = [j for j in range(i - window + 1, i + 1) if beyond[j]]
-            _add(alarms, rule, side, points, int(i))
+        alarms += _grouped(rule, side, fired, fired - window + 1, beyond)
     return alarms
 
 
 def _jump_alarms(mr: np.ndarray, limit: float) -> list[Alarm]:
-    alarms: list[Alarm] = []
-    for k in np.flatnonzero(mr > limit):
-        _add(alarms, "MR", "", [int(k), int(k) + 1], int(k) + 1)
-    return alarms
+    # The moving range k is between points k and k + 1: it fires at k + 1 and involves both.
+    fired = np.flatnonzero(mr > limit) + 1
+    return _grouped("MR", "", fired, fired - 1, None)
 
 
-def _add(alarms: list[Alarm], rule: str, side: str, points: list[int], trigger: int) -> None:
-    """A firing joins the previous alarm of the rule and side when their points overlap or touch."""
-    for n in range(len(alarms) - 1, -1, -1):
-        a = alarms[n]
-        if a.rule == rule and a.side == side:
-            if points[0] <= a.points[-1] + 1:
-                alarms[n] = Alarm(rule, side, tuple(sorted(set(a.points) | set(points))), a.triggers + (trigger,))
-                return
-            break
-    alarms.append(Alarm(rule, side, tuple(points), (trigger,)))
+def _grouped(rule: str, side: str, fired: np.ndarray, starts: np.ndarray, beyond: np.ndarray | None) -> list[Alarm]:
+    """One alarm per run of firings whose windows overlap or touch: every point beyond the line in the run's
+    span (all of them for a jump), and the points where the rule fired. Linear in the number of points, and
+    array work but for one small step per alarm: a drift fires a rule at every unit of 100,000."""
+    if fired.size == 0:
+        return []
+    breaks = np.flatnonzero(starts[1:] > fired[:-1] + 1) + 1
+    first = np.concatenate(([0], breaks))
+    last = np.concatenate((breaks, [fired.size]))           # exclusive
+    low, high = starts[first], fired[last - 1]
+    if beyond is None:
+        positions = np.arange(int(low.min()), int(high.max()) + 1)
+    else:
+        positions = np.flatnonzero(beyond)
+    begin = np.searchsorted(positions, low, "left").tolist()
+    end = np.searchsorted(positions, high, "right").tolist()
+    points, fired_list = positions.tolist(), fired.tolist()
+    return [Alarm(rule, side, tuple(points[b:e]), tuple(fired_list[f:l]))
+            for b, e, f, l in zip(begin, end, first.tolist(), last.tolist())]
