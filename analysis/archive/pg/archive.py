@@ -261,7 +261,7 @@ class PostgresArchive:
     def golden(self) -> list[str]:
         with self._session("reading the golden units") as conn:
             return [r[0] for r in conn.execute("SELECT measurement_id FROM golden_units "
-                                                "ORDER BY added_at, measurement_id").fetchall()]
+                                                "ORDER BY marked").fetchall()]
 
     def set_golden(self, ids: Iterable[str], golden: bool = True) -> list[str]:
         wanted = [self.resolve(i)[0] for i in ids]

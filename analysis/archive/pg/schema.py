@@ -77,6 +77,7 @@ CREATE TABLE linpar.limits_versions (
 ALTER TABLE linpar.measurements ADD FOREIGN KEY (limits_version) REFERENCES linpar.limits_versions (version);
 CREATE TABLE linpar.golden_units (
     measurement_id text COLLATE "C" PRIMARY KEY REFERENCES linpar.measurements (id),
+    marked bigint GENERATED ALWAYS AS IDENTITY UNIQUE,   -- the order they were marked in (now() ties in a transaction)
     added_at timestamptz NOT NULL DEFAULT now(),
     added_by text NOT NULL DEFAULT session_user);
 
