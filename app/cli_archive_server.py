@@ -28,6 +28,11 @@ def add_archive_options(parser: argparse.ArgumentParser) -> None:
 def spec_of(args) -> str:
     """The archive the options name; the environment's when they name none."""
     from analysis.archive.backends import archive_spec
+    from app.cli import CliError
+    for option in ("archive", "root"):
+        if getattr(args, option, None) is not None and not getattr(args, option).strip():
+            raise CliError(f"--{option}: empty: give a folder" + (" or postgresql://USER@HOST[:PORT]/DATABASE"
+                                                                 if option == "archive" else ""))
     explicit = getattr(args, "archive", None) or (str(Path(args.root).expanduser()) if getattr(args, "root", None)
                                                   else None)
     return archive_spec(explicit)

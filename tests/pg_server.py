@@ -140,6 +140,16 @@ class PostgresServer:
         with self.admin() as conn:
             conn.execute(sql.SQL("CREATE DATABASE {}").format(sql.Identifier(name)))
 
+    def require_password(self, user: str, password: str) -> None:
+        """From now on `user` logs in over TCP with `password` only (scram-sha-256); everyone else as before."""
+        from psycopg import sql
+        with self.admin() as conn:
+            conn.execute(sql.SQL("ALTER ROLE {} PASSWORD {}").format(sql.Identifier(user), sql.Literal(password)))
+            hba = self.data / "pg_hba.conf"        # rewritten in place: it keeps the server's user as its owner
+            rules = hba.read_text()
+            hba.write_text(f"host all {user} 127.0.0.1/32 scram-sha-256\n" + rules)
+            conn.execute("SELECT pg_reload_conf()")
+
     def wait_ready(self, timeout_s: float = 30) -> None:
         deadline = time.monotonic() + timeout_s
         while True:

@@ -92,3 +92,25 @@ def test_measure_queues_while_the_server_is_away_and_sync_sends_once(capsys, pg_
         assert server_serials(pg_database) == ["S1", "S2"]
     finally:
         proxy.close()
+
+
+def test_a_wrong_password_an_unknown_database_and_an_unresolvable_host_are_one_line_each(capsys, pg_database,
+                                                                                          monkeypatch):
+    from analysis.archive.pg import setup
+    monkeypatch.delenv("PGPASSWORD", raising=False)
+    setup(pg_database.url("linpar_admin"), {"paula": "auditor"})     # her own: the server is the session's
+    pg_database.server.require_password("paula", "right")
+    with_password = pg_database.url("paula").replace("paula@", "paula:{}@")
+    assert run(capsys, "qa", "stats", "--archive", with_password.format("right"))[0] == 0
+    server = pg_database.url("paula").rsplit("/", 1)[0]
+    for url, says in (
+            (with_password.format("wrong"), "password authentication failed for user \"paula\"; check the user "
+                                            "and the password"),
+            (pg_database.url("paula"), "no password supplied; check the user and the password"),
+            (f"{server}/no_such_db".replace("paula@", "eva@"), 'database "no_such_db" does not exist; check the '
+                                                                "URL's user and database"),
+            ("postgresql://eva:pw@no-such-host.invalid/line?connect_timeout=2", "cannot reach the server"),
+            ("", "--archive: empty")):
+        code, out, err = run(capsys, "qa", "stats", "--archive", url)
+        assert code == 2 and out == "" and err.startswith("linpar: error: ") and says in err, err
+        assert len(err.strip().splitlines()) == 1 and "wrong" not in err and ":pw@" not in err

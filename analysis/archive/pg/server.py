@@ -27,9 +27,20 @@ from analysis.errors import one_line
 
 CONNECT_TIMEOUT_S = 5
 SCHEMA = "linpar"
-# What libpq says when the server answered and said no, as opposed to not answering at all.
+# What libpq says when the name or the network failed (checked first: a host may be named "x.invalid")...
+_NO_ANSWER = ("failed to resolve host", "could not translate host name", "Connection refused", "timeout expired",
+              "No route to host", "Network is unreachable", "server closed the connection", "Connection reset")
+# ... and when the server answered and said no, as opposed to not answering at all.
 _REFUSALS = ("authentication failed", "does not exist", "pg_hba.conf", "permission denied", "password",
              "invalid", "too many connections", "not permitted", "SSL")
+# What to do about a refusal the user can mend, by what libpq says.
+_REMEDIES = (
+    (("password authentication failed", "no password supplied"),
+     "check the user and the password: in the URL (postgresql://USER:PASSWORD@HOST/DB), $PGPASSWORD or ~/.pgpass"),
+    (("does not exist",), "check the URL's user and database: the line's administrator creates them with "
+                          "'linpar archive setup'"),
+    (("pg_hba.conf",), "the server's administrator allows this station in the server's pg_hba.conf"),
+)
 
 
 class ServerUnreachable(ArchiveError):
@@ -105,7 +116,14 @@ def _unreachable(exc) -> bool:
     if state is not None:
         return state.startswith("08") or state in ("57P01", "57P02", "57P03")
     message = str(exc)
-    return not any(word in message for word in _REFUSALS)
+    if any(words in message for words in _NO_ANSWER):
+        return True
+    reason = message.rsplit("failed: ", 1)[-1]       # what follows "connection to server at HOST, port N failed: "
+    return not any(word in reason for word in _REFUSALS)
+
+
+def _remedy(message: str) -> str:
+    return next(("; " + what for words, what in _REMEDIES if any(w in message for w in words)), "")
 
 
 @contextlib.contextmanager
@@ -127,7 +145,8 @@ def server_errors(server: ServerURL, doing: str, needs: str = "") -> Iterator[No
         if _unreachable(exc):
             raise ServerUnreachable(f"{server.display}: cannot reach the server while {doing} "
                                     f"({_first_line(exc)})") from None
-        raise ServerRefused(f"{server.display}: the server refused {doing}: {_first_line(exc)}") from None
+        reason = _first_line(exc)
+        raise ServerRefused(f"{server.display}: the server refused {doing}: {reason}{_remedy(reason)}") from None
     except psycopg.Error as exc:
         raise ArchiveError(f"{server.display}: {doing}: {_first_line(exc)}") from None
 
