@@ -72,10 +72,13 @@ def pg_server():
     """A throw-away PostgreSQL server for the session (tests/pg_server.py).
 
     Skipped, saying what to install, only when PostgreSQL is not installed; a server that is installed
-    but does not start is an error, never a skip.
+    but does not start is an error, never a skip. With $LINPAR_REQUIRE_POSTGRES=1 (.ci/run sets it) a
+    missing PostgreSQL fails the tests too: CI runs them, it never passes them by skipping.
     """
     from tests.pg_server import PostgresServer, missing_reason
     reason = missing_reason()
+    if reason and os.environ.get("LINPAR_REQUIRE_POSTGRES") == "1":
+        pytest.fail(f"{reason} ($LINPAR_REQUIRE_POSTGRES=1: CI must run them)", pytrace=False)
     if reason:
         pytest.skip(reason)
     server = PostgresServer.start()
