@@ -23,7 +23,8 @@ def _text_edit(placeholder: str) -> QLineEdit:
     return edit
 
 
-def _date_edit(tooltip: str) -> QDateEdit:
+def date_edit(tooltip: str) -> QDateEdit:
+    """A day, or “any” (no limit): the archive's filter and the Production page's selection."""
     edit = QDateEdit()
     edit.setCalendarPopup(True)
     edit.setDisplayFormat("yyyy-MM-dd")
@@ -45,8 +46,8 @@ class FilterBar(QWidget):
         self.validity_combo = QComboBox()
         for text, value in VALIDITIES:
             self.validity_combo.addItem(text, value)
-        self.since_edit = _date_edit("Measured on or after this day")
-        self.until_edit = _date_edit("Measured on or before this day")
+        self.since_edit = date_edit("Measured on or after this day")
+        self.until_edit = date_edit("Measured on or before this day")
         self.text_row, self.choice_row = QHBoxLayout(), QHBoxLayout()
         for row, label, widget, stretch in (
                 (self.text_row, "Driver", self.driver_edit, 3), (self.text_row, "Serial", self.serial_edit, 2),

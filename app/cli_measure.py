@@ -110,6 +110,12 @@ def run(args: argparse.Namespace) -> int:
     from app.cli_large_signal import plan_options_checked
     plan_options_checked(args)          # a large-signal limit given to this single measurement is refused
     effects = _effects(args.model) if args.model else None
+    if not args.no_archive:     # a mistyped archive is said now, not after the measurement (nothing connects yet)
+        from analysis.archive.backends import archive_spec, check_spec
+        from app.cli import CliError
+        if args.archive is not None and not args.archive.strip():
+            raise CliError("--archive: empty: give a folder or postgresql://USER@HOST[:PORT]/DATABASE")
+        check_spec(archive_spec(args.archive or (str(args.archive_root) if args.archive_root else None)))
     for unfinished in find_unfinished(args.out):
         _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
              f"('linpar recover {args.out}' keeps, analyses or discards it)")

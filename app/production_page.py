@@ -14,18 +14,18 @@ from __future__ import annotations
 import html
 from pathlib import Path
 
-from PySide6.QtCore import QDate, Qt, QTimer, Signal
-from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QDateEdit, QFileDialog, QHBoxLayout, QHeaderView,
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QFileDialog, QHBoxLayout, QHeaderView,
                                QLabel, QPushButton, QSizePolicy, QSpinBox, QSplitter, QTableWidget, QTableWidgetItem,
                                QTabWidget, QVBoxLayout, QWidget)
 
 from analysis.archive.backends import shown
 from app import style
+from app.archive_filter import NO_DATE, date_edit
 from app.archive_page import archive_source
 from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit
 from app.production_worker import ProductionRequest, ProductionWorker
 
-NO_DATE = QDate(2000, 1, 1)
 FILTER_DELAY_MS = 300
 STATS_COLUMNS = ("Parameter", "n", "Mean", "σ", "Limit", "Cp", "Cpk", "Pp", "Ppk", "Yield", "Alarms")
 ALARM_COLUMNS = ("Rule", "Units", "What", "Measurements")
@@ -46,17 +46,6 @@ def _item(text: str, tooltip: str = "", colour: str | None = None) -> QTableWidg
     if colour:
         item.setForeground(Qt.GlobalColor.darkRed if colour == "red" else Qt.GlobalColor.darkGreen)
     return item
-
-
-def _date_edit(tooltip: str) -> QDateEdit:
-    edit = QDateEdit()
-    edit.setCalendarPopup(True)
-    edit.setDisplayFormat("yyyy-MM-dd")
-    edit.setMinimumDate(NO_DATE)
-    edit.setSpecialValueText("any")
-    edit.setDate(NO_DATE)
-    edit.setToolTip(tooltip + " (UTC)")
-    return edit
 
 
 def _table(columns) -> QTableWidget:
@@ -86,8 +75,8 @@ class ProductionPage(QWidget):
 
         self.source_label = QLabel()
         self.source_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
-        self.since_edit = _date_edit("Measured on or after this day")
-        self.until_edit = _date_edit("Measured on or before this day")
+        self.since_edit = date_edit("Measured on or after this day")
+        self.until_edit = date_edit("Measured on or before this day")
         self.station_combo, self.driver_combo = QComboBox(), QComboBox()
         self.station_combo.addItem("every station", None)
         self.driver_combo.addItem("every driver", None)

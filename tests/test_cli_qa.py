@@ -104,6 +104,10 @@ def test_export_csv_json_dfq(capsys, line, tmp_path):
     (["qa", "stats", "--archive", "postgresql://u@127.0.0.1:1/db?connect_timeout=2"], "cannot reach the server"),
     (["archive", "list", "--archive", "postgresql://u:pw@h:x/db"], "port 'x'"),
     (["archive", "setup", "--root", "ROOT"], "needs no setup"),
+    (["measure", "--rig", "soundcard", "--out", "m", "--archive", "mysql://u@h/db"], "unknown kind of archive"),
+    (["measure", "--rig", "soundcard", "--out", "m", "--archive", "postgresql://u:pw@h:x/db"], "port 'x'"),
+    (["measure", "--rig", "soundcard", "--out", "m", "--archive", " "], "--archive: empty"),
+    (["qa", "stats", "--archive", ""], "--archive: empty"),
     (["qa", "stats", "--root", "ROOT", "--archive", "ROOT"], "not allowed with argument"),
 ])
 def test_bad_input_is_one_line_and_exit_2(capsys, line, tmp_path, monkeypatch, argv, message):

@@ -109,13 +109,25 @@ def shown(spec: str) -> str:
     return re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", str(spec))
 
 
-def open_archive(spec: str | Path | None = None) -> ArchiveBackend:
-    """The archive a specification names (archive_spec says which when it is None)."""
-    spec = archive_spec(spec)
+def _factory(spec: str) -> Callable[[str], ArchiveBackend]:
     if not is_url(spec):
-        return _folder(spec)
+        return _folder
     scheme = spec.split("://", 1)[0].lower()
     if scheme not in BACKENDS:
         raise ArchiveError(f"{scheme}://...: unknown kind of archive: expected postgresql://USER@HOST[:PORT]/DATABASE "
                            "or a folder")
-    return BACKENDS[scheme](spec)
+    return BACKENDS[scheme]
+
+
+def check_spec(spec: str) -> None:
+    """ArchiveError when a specification cannot name an archive (a URL of no known kind, or not well formed);
+    nothing is opened or connected to: for a command that stores only after minutes of measuring."""
+    if _factory(spec) is _postgresql:
+        from analysis.archive.pg.server import parse_url
+        parse_url(spec)
+
+
+def open_archive(spec: str | Path | None = None) -> ArchiveBackend:
+    """The archive a specification names (archive_spec says which when it is None)."""
+    spec = archive_spec(spec)
+    return _factory(spec)(spec)

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from analysis.archive import open_archive
-from app.main_window import MainWindow
 from tests.production_helpers import LIMITS, small_measurement, unit
 
 TIMEOUT_MS = 120_000
@@ -30,16 +29,8 @@ def fill(spec, measured, n=120, drift_at=80):
                        "measured_at": f"2024-05-01T{i // 60:02d}:{i % 60:02d}:00Z"})
 
 
-@pytest.fixture
-def window(qtbot, settings):
-    w = MainWindow(settings)
-    qtbot.addWidget(w)
-    w.resize(1280, 720)
-    w.show()
-    return w
-
-
 def show(qtbot, window):
+    window.resize(1280, 720)                 # the smaller of the two screens the page is made for
     page = window.production
     with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as shown:
         window.pages.setCurrentWidget(page)
