@@ -147,6 +147,25 @@ def test_two_stations_that_draw_the_same_id_both_keep_their_measurement(pg_datab
     assert entries["B"].parameters["fs"]["value"] == 71.0
 
 
+def test_a_measurement_sent_under_a_new_id_and_never_acknowledged_is_not_stored_twice(pg_database, measured,
+                                                                                       monkeypatch):
+    path, doc = measured
+    import analysis.archive.archive as archive_module
+    monkeypatch.setattr(archive_module, "new_measurement_id", lambda now=None: "20240501-120000-abcdef")
+    open_archive(pg_database.url("station_a")).store(path, doc, {"serial": "A"})
+
+    class Killed(BaseException):
+        """Station B dies after the server committed its measurement under a new id, before it heard back."""
+    real = Archive.discard
+    monkeypatch.setattr(Archive, "discard", lambda self, mid: (_ for _ in ()).throw(Killed()))
+    with pytest.raises(Killed):
+        open_archive(pg_database.url("station_b")).store(path, unit(doc, fs=71.0), {"serial": "B"})
+    monkeypatch.setattr(Archive, "discard", real)
+    report = open_archive(pg_database.url("station_b")).sync()
+    assert report.already and not report.sent
+    assert len(server_ids(pg_database)) == 2
+
+
 def test_a_file_damaged_on_the_server_is_refused_by_its_checksum(pg_database, measured):
     path, doc = measured
     mid = open_archive(pg_database.url("station_a")).store(path, doc, {"serial": "SN1"})

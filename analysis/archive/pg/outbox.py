@@ -12,7 +12,8 @@ measurement's id, which the station chose when it queued it:
   the commit, or the station stopped before it removed its copy): nothing
   is stored again;
 - it had it with another record (two stations drew the same 24 random bits
-  in the same second): the measurement gets a new id and is sent under it.
+  in the same second): the measurement gets a new id, drawn from its own
+  record's SHA-256 (so that a resend draws the same one), and is sent under it.
 
 Only then is the local copy removed. So a measurement is on the server once
 whatever breaks when: the queue never deletes before the server has it, and
@@ -25,9 +26,9 @@ with it, and the verdict names that version.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import os
-import secrets
 from pathlib import Path
 from typing import Iterator
 
@@ -37,7 +38,7 @@ from analysis.archive.backends import SyncReport
 from analysis.archive.limits_store import LimitsVersion, version_json, version_of_json
 from analysis.archive.names import ArchiveError, folder_name
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, server_errors
-from analysis.archive.pg.upload import IdTaken, send_measurement
+from analysis.archive.pg.upload import IdTaken, record_sha256, send_measurement
 
 LIMITS_CACHE = "limits.json"
 LOCK_FILE = ".send.lock"
@@ -121,11 +122,15 @@ class Outbox:
     def _send_one(self, conn, server, mid: str) -> tuple[str, str]:
         m = self.archive.get(mid)
         record = m.record
-        for _attempt in range(5):
+        digest = record_sha256(m.record)
+        for attempt in range(5):
             try:
                 with server_errors(server, f"sending the measurement {record['id']}", needs="an operator"):
                     return record["id"], send_measurement(conn, record, m.folder)
             except IdTaken:
-                new = f"{record['id'][:15]}-{secrets.token_hex(3)}"
+                # The new id follows from the record, not from chance: sent again after a lost acknowledgement,
+                # the measurement draws the same ids in the same order and finds itself there (ALREADY).
+                tail = hashlib.sha256(f"{digest}/{attempt}".encode()).hexdigest()[:6]
+                new = f"{mid[:15]}-{tail}"
                 record = {**record, "id": new, "folder": folder_name(new, record["driver"], record["serial"])}
         raise ArchiveError(f"{mid}: the server has other measurements under five ids drawn for it")
