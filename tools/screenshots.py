@@ -385,6 +385,7 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
         written.append(path)
     window.resize(*SIZE)
     settle(app)
+    return written
 
 
 def production_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
