@@ -28,11 +28,13 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
-from analysis.derived import ParameterValue
 from analysis.errors import LinparError
 from analysis.files import read_text
+
+if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file
+    from analysis.derived import ParameterValue
 
 FORMAT = "linpar-limits/1"
 ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}

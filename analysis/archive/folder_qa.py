@@ -160,17 +160,18 @@ class FolderQA:
 
     # --- statistics ---------------------------------------------------------------------
 
-    def population(self, selection=None, names=None):
-        """The selected measurements' key parameters, oldest first (analysis.archive.population)."""
-        from analysis.archive.population import Selection, population_of_rows, population_sql
+    def population(self, selection=None, names=None, with_stds: bool = True):
+        """The selected measurements' key parameters, oldest first (analysis.archive.population); without
+        their standard deviations if not `with_stds` (the statistics need none)."""
+        from analysis.archive.population import Selection
+        from analysis.archive.population_read import empty_population, read_sqlite
         selection = selection or Selection()
-        sql, args, names = population_sql(selection, names, "?")
         if not self.root.is_dir():
-            return population_of_rows([], names)
+            return empty_population(names, with_stds)
         with self._index_errors("reading the population"):
             conn = self._connect()
             try:
-                return population_of_rows(conn.execute(sql, args).fetchall(), names)
+                return read_sqlite(conn, selection, names, with_stds)
             finally:
                 conn.close()
 

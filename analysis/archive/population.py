@@ -2,24 +2,21 @@
 
 `Selection` says which measurements (dates, stations, drivers, ids: exact
 names, not the substrings `archive list` matches: statistics of "QA1" must
-not take "QA10"). `population_sql` is the one query both back ends run
-(SQLite and PostgreSQL speak the same SQL here, but for the parameter mark):
-one row per measurement, its parameters pivoted into columns by the
-database, oldest first, so that a control chart reads them in the order they
-were measured. No numpy here: the statistics turn the columns into arrays.
+not take "QA10"). `Population` is what the archive gives for them, oldest
+first, so that a control chart reads them in the order they were measured:
+the who, where and when as columns of strings, each parameter as one float
+array. How each back end reads it in bulk: analysis.archive.population_read.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 
+import numpy as np
+
 from analysis.archive.names import ArchiveError, check_id_prefix
 from analysis.archive.record import one_line_text
-from analysis.archive.schema import KEY_PARAMETERS
 from analysis.bounds import YEAR
-
-# The row's leading columns, in the order population_sql selects them.
-COLUMNS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict", "limits_version")
 
 
 def selection_date(text: str | None, option: str) -> str | None:
@@ -67,7 +64,13 @@ class Selection:
 
 @dataclass(frozen=True)
 class Population:
-    """Columns of equal length, oldest measurement first; a parameter not measured is None."""
+    """Columns of equal length, oldest measurement first.
+
+    A parameter's values (SI) and standard deviations are one float array each, aligned with `ids`; NaN where
+    the measurement has no finite value (not measured, or undetermined). Arrays, not a row per unit: a line's
+    100,000 units are read in bulk and the statistics stay in numpy (analysis.archive.population_read).
+    Sequences with None (as tests write them) are taken too and turned into such arrays.
+    """
 
     ids: tuple[str, ...]
     measured_at: tuple[str, ...]
@@ -78,55 +81,32 @@ class Population:
     validity: tuple[str, ...]
     verdicts: tuple[str | None, ...]
     limits_versions: tuple[int | None, ...]
-    values: dict[str, tuple[float | None, ...]] = field(default_factory=dict)    # SI
-    stds: dict[str, tuple[float | None, ...]] = field(default_factory=dict)
+    values: dict[str, np.ndarray] = field(default_factory=dict)    # SI
+    stds: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "values", {n: finite_or_nan(v) for n, v in self.values.items()})
+        object.__setattr__(self, "stds", {n: finite_or_nan(v) for n, v in self.stds.items()})
 
     def __len__(self) -> int:
         return len(self.ids)
 
+    def value(self, name: str, unit: int) -> float | None:
+        """The unit's value of the parameter; None when it has none."""
+        return _number(self.values[name][unit])
 
-def population_sql(selection: Selection, names=None, mark: str = "?") -> tuple[str, list, tuple[str, ...]]:
-    """(SQL, arguments, parameter names) of the selection's population; `mark` is the driver's placeholder."""
-    names = tuple(KEY_PARAMETERS if names is None else names)
-    unknown = [n for n in names if n not in KEY_PARAMETERS]
-    if unknown:
-        raise ArchiveError(f"{', '.join(unknown)}: not a parameter the archive keeps for statistics "
-                           f"(expected one of {', '.join(KEY_PARAMETERS)})")
-    where, args = [], []
-    if selection.since:
-        where.append(f"m.measured_at >= {mark}")
-        args.append(selection.since)
-    if selection.until:
-        where.append(f"m.measured_at <= {mark}")
-        args.append(selection.until + ("T99" if len(selection.until) == 10 else ""))
-    for column, chosen in (("station", selection.stations), ("driver", selection.drivers), ("id", selection.ids)):
-        if chosen:
-            where.append(f"m.{column} IN ({', '.join([mark] * len(chosen))})")
-            args.extend(chosen)
-    pivot = []
-    for name in names:
-        pivot.append(f"max(CASE WHEN p.name = {mark} THEN p.value END)")
-        pivot.append(f"max(CASE WHEN p.name = {mark} THEN p.std END)")
-    pivot_args = [n for name in names for n in (name, name)]
-    sql = (f"SELECT {', '.join('m.' + c for c in COLUMNS)}{', ' if pivot else ''}{', '.join(pivot)} "
-           f"FROM measurements m LEFT JOIN parameters p ON p.measurement_id = m.id"
-           f"{' WHERE ' + ' AND '.join(where) if where else ''} "
-           f"GROUP BY {', '.join('m.' + c for c in COLUMNS)} ORDER BY m.measured_at, m.id")
-    return sql, pivot_args + args, names
+    def std(self, name: str, unit: int) -> float | None:
+        return _number(self.stds[name][unit]) if name in self.stds else None
 
 
-def population_of_rows(rows, names) -> Population:
-    n = len(COLUMNS)
-    columns = list(zip(*rows)) if rows else [()] * (n + 2 * len(names))
-    values = {name: tuple(_finite(v) for v in columns[n + 2 * i]) for i, name in enumerate(names)}
-    stds = {name: tuple(_finite(v) for v in columns[n + 2 * i + 1]) for i, name in enumerate(names)}
-    head = [tuple(c) for c in columns[:n]]
-    return Population(*head, values=values, stds=stds)
+def finite_or_nan(numbers) -> np.ndarray:
+    """A float array of `numbers` (None, NaN and infinities: NaN). The archive keeps what measurement.json
+    said, checked finite where it entered (analysis.archive.record); a non-finite value judges nothing."""
+    x = np.array([np.nan if v is None else v for v in numbers] if not isinstance(numbers, np.ndarray) else numbers,
+                 dtype=float)
+    x[~np.isfinite(x)] = np.nan
+    return x
 
 
-def _finite(v) -> float | None:
-    # The index keeps what measurement.json said, checked finite where it entered (analysis.archive.record).
-    if v is None:
-        return None
-    v = float(v)
-    return v if v == v and abs(v) != float("inf") else None
+def _number(v) -> float | None:
+    return None if v != v else float(v)

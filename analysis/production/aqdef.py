@@ -93,7 +93,7 @@ def write_dfq(population, stats_parameters, excluded_ids=()) -> str:
                 continue
             about = f"linpar {mid} station {population.stations[u]} operator {population.operators[u]}"
             for c, name in enumerate(names):
-                i, value = first + c, population.values[name][u]
+                i, value = first + c, population.value(name, u)
                 attribute = (PLACEHOLDER if value is None else
                              INVALID if mid in excluded or population.validity[u] == "red" else VALID)
                 shown = 0.0 if value is None else value * stats_parameters[name].display_scale

@@ -67,7 +67,9 @@ def _indices(mean: float, sigma: float | None, low: float | None, high: float | 
 
 def capability(values, low: float | None, high: float | None) -> Capability:
     """The capability of `values` (time order; None or NaN entries are dropped first) against [low, high]."""
-    x = np.asarray([np.nan if v is None else v for v in values], dtype=float)
+    if not isinstance(values, np.ndarray):          # a list from a caller; the statistics pass arrays
+        values = [np.nan if v is None else v for v in values]
+    x = np.asarray(values, dtype=float)
     x = x[np.isfinite(x)]
     n = int(x.size)
     below = int(np.count_nonzero(x < low)) if low is not None else 0

@@ -145,6 +145,6 @@ def _grouped(rule: str, side: str, fired: np.ndarray, starts: np.ndarray, beyond
         positions = np.flatnonzero(beyond)
     begin = np.searchsorted(positions, low, "left").tolist()
     end = np.searchsorted(positions, high, "right").tolist()
-    points, fired_list = positions.tolist(), fired.tolist()
-    return [Alarm(rule, side, tuple(points[b:e]), tuple(fired_list[f:l]))
+    points, fired_all = tuple(positions.tolist()), tuple(fired.tolist())     # slices of tuples are tuples
+    return [Alarm(rule, side, points[b:e], fired_all[f:l])
             for b, e, f, l in zip(begin, end, first.tolist(), last.tolist())]

@@ -31,8 +31,8 @@ def population_csv(population) -> str:
                 population.serials[u], population.operators[u], population.validity[u],
                 population.verdicts[u] or "", "" if population.limits_versions[u] is None
                 else population.limits_versions[u])
-        for name, values in population.values.items():
-            value, std = values[u], population.stds[name][u]
+        for name in population.values:
+            value, std = population.value(name, u), population.std(name, u)
             writer.writerow((*head, name, "" if value is None else repr(value), "" if std is None else repr(std),
                              units[name]))
     return out.getvalue()
@@ -48,6 +48,6 @@ def population_json(population, selection: str, location: str, limits=None) -> d
                  "driver": population.drivers[u], "serial": population.serials[u],
                  "operator": population.operators[u], "validity": population.validity[u],
                  "verdict": population.verdicts[u], "limits_version": population.limits_versions[u],
-                 "parameters": {name: {"value": population.values[name][u], "std": population.stds[name][u],
+                 "parameters": {name: {"value": population.value(name, u), "std": population.std(name, u),
                                        "unit": units[name]} for name in population.values}}
                 for u, mid in enumerate(population.ids)]}

@@ -73,12 +73,12 @@ def propose_limits(population, k: float, ids=(), name: str = "") -> tuple[dict, 
         notes.append(f"only {len(population)} golden units: a sigma from fewer than {FEW_GOLDEN} is uncertain by "
                      "more than +-25 %; measure more for limits to rely on")
     for pname, values in population.values.items():
-        x = np.array([np.nan if v is None else v for v in values], dtype=float)
+        x = values                                   # NaN: not measured (analysis.archive.population)
         if not np.all(np.isfinite(x)):
             if np.any(np.isfinite(x)):
                 notes.append(f"{pname}: not measured on every golden unit: no limit proposed")
             continue
-        s = np.array([np.nan if v is None else v for v in population.stds[pname]], dtype=float)
+        s = population.stds[pname]
         s = s[np.isfinite(s)]
         u = float(np.sqrt(np.mean(s ** 2))) if s.size else None
         sigma = float(np.std(x, ddof=1))

@@ -19,7 +19,7 @@ import numpy as np
 
 from analysis.production.capability import Capability, capability
 from analysis.production.control_chart import DEFAULT_BASELINE, ControlChart, control_chart
-from analysis.production.stations import StationComparison, compare_stations
+from analysis.production.stations import StationCodes, StationComparison, compare_station_codes
 
 NOT_JUDGEABLE = ("invalid", "not judged")
 UNJUDGED = "unjudged"          # stored when the archive had no limits: no verdict recorded
@@ -90,25 +90,37 @@ def _histogram(x: np.ndarray, low: float | None, high: float | None) -> tuple[np
     return edges, counts
 
 
+def _counts(population) -> tuple[np.ndarray, dict, dict, dict]:
+    """(which units count, excluded: reason -> units, verdicts -> units, limits version -> verdicts -> units).
+
+    Counted over the few distinct (validity, verdict, version) triples rather than unit by unit; every dict
+    keeps the order in which its keys first occur among the units."""
+    triples = Counter(zip(population.validity, population.verdicts, population.limits_versions))
+    reasons = {(v, d): _excluded_reason(v, d) for v, d, _version in triples}
+    excluded, verdicts, by_version = Counter(), Counter(), {}
+    for (validity, verdict, version), n in triples.items():
+        if reasons[validity, verdict] is not None:
+            excluded[reasons[validity, verdict]] += n
+        verdicts[verdict or UNJUDGED] += n
+        if version is not None:
+            by_version.setdefault(version, Counter())[verdict] += n
+    keep = np.fromiter((reasons[pair] is None for pair in zip(population.validity, population.verdicts)),
+                       dtype=bool, count=len(population))
+    return keep, dict(excluded), dict(verdicts), {k: dict(v) for k, v in sorted(by_version.items())}
+
+
 def production_stats(population, limits_version=None, baseline: int = DEFAULT_BASELINE,
                      names=None, selection: str = "") -> ProductionStats:
     """The statistics of an analysis.archive.population.Population against one limits version (or none)."""
     from analysis.limits import parameter_units
-    reasons = [_excluded_reason(v, d) for v, d in zip(population.validity, population.verdicts)]
-    keep = np.array([r is None for r in reasons], dtype=bool)
-    excluded = dict(Counter(r for r in reasons if r is not None))
-    verdicts = dict(Counter(v or UNJUDGED for v in population.verdicts))
-    by_version: dict[int, dict[str, int]] = {}
-    for verdict, version in zip(population.verdicts, population.limits_versions):
-        if version is not None:
-            by_version.setdefault(version, Counter())[verdict] += 1
+    keep, excluded, verdicts, by_version = _counts(population)
     limits = {lim.name: lim for lim in limits_version.limits().limits} if limits_version is not None else {}
     units = parameter_units()
-    stations = np.asarray(population.stations, dtype=object)
+    stations = StationCodes.of(population.stations)
     ids = np.asarray(population.ids, dtype=object)
     out = {}
     for name in (names or population.values):
-        raw = np.array([np.nan if v is None else v for v in population.values.get(name, ())], dtype=float)
+        raw = population.values.get(name, np.array([]))
         if raw.size != keep.size:
             continue
         use = keep & np.isfinite(raw)
@@ -120,6 +132,5 @@ def production_stats(population, limits_version=None, baseline: int = DEFAULT_BA
         si, display, scale = units.get(name, ("", "", 1.0))
         out[name] = ParameterStats(name, si, display, scale, tuple(ids[use]), capability(x, low, high),
                                    control_chart(x, baseline), _histogram(x, low, high),
-                                   compare_stations(x, stations[use]), limit.text if limit else None)
-    return ProductionStats(selection, len(population), excluded, limits_version, verdicts,
-                           {k: dict(v) for k, v in sorted(by_version.items())}, out)
+                                   compare_station_codes(x, stations.subset(use)), limit.text if limit else None)
+    return ProductionStats(selection, len(population), excluded, limits_version, verdicts, by_version, out)

@@ -28,7 +28,6 @@ from analysis.archive.pg.files import fetch_file
 from analysis.archive.pg.outbox import Outbox, queue_folder
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, connect, parse_url, server_errors
 from analysis.archive.record import RECORD_FILE, checked_parameter, entry_of, one_line_text, read_record
-from analysis.archive.schema import KEY_PARAMETERS
 
 LIST_COLUMNS = ("id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects, "
                 "verdict, limits_version")
@@ -276,10 +275,10 @@ class PostgresArchive:
 
     # --- statistics -------------------------------------------------------------------------------
 
-    def population(self, selection=None, names=None):
-        from analysis.archive.population import Selection, population_of_rows, population_sql
-        sql, args, names = population_sql(selection or Selection(), names or KEY_PARAMETERS, "%s")
+    def population(self, selection=None, names=None, with_stds: bool = True):
+        from analysis.archive.population import Selection
+        from analysis.archive.population_read import read_postgres
         with self._session("reading the population") as conn:
-            rows = conn.execute(sql, args).fetchall()
+            population = read_postgres(conn, selection or Selection(), names, with_stds)
         self._waiting_note()
-        return population_of_rows(rows, names)
+        return population

@@ -1,0 +1,115 @@
+"""The population read in bulk (analysis.archive.population_read) gives exactly what the row-by-row reading gave.
+
+The reference below is the reading `qa stats` used before: one pivot query
+(a row per unit, a column per parameter, grouped by the database) and every
+value turned into a Python float or None one at a time. Both back ends, a
+small population with what makes alignment go wrong: a parameter missing on
+one unit, a null value on another, units of several stations and drivers,
+failed verdicts, and selections by station, driver and date.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from analysis.archive.backends import open_archive
+from analysis.archive.population import Population, Selection
+from analysis.archive.schema import KEY_PARAMETERS
+from analysis.production import production_stats
+from tests.production_helpers import LIMITS, small_measurement, unit
+
+HEADS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict", "limits_version")
+
+
+def reference_population(conn, selection: Selection, mark: str) -> Population:
+    """The former reading: the pivot query and the values converted one by one."""
+    where, args = [], []
+    if selection.since:
+        where.append(f"m.measured_at >= {mark}")
+        args.append(selection.since)
+    if selection.until:
+        where.append(f"m.measured_at <= {mark}")
+        args.append(selection.until + ("T99" if len(selection.until) == 10 else ""))
+    for column, chosen in (("station", selection.stations), ("driver", selection.drivers)):
+        if chosen:
+            where.append(f"m.{column} IN ({', '.join([mark] * len(chosen))})")
+            args.extend(chosen)
+    pivot = [f"max(CASE WHEN p.name = {mark} THEN p.{c} END)" for _n in KEY_PARAMETERS for c in ("value", "std")]
+    sql = (f"SELECT {', '.join('m.' + c for c in HEADS)}, {', '.join(pivot)} FROM measurements m "
+           f"LEFT JOIN parameters p ON p.measurement_id = m.id{' WHERE ' + ' AND '.join(where) if where else ''} "
+           f"GROUP BY {', '.join('m.' + c for c in HEADS)} ORDER BY m.measured_at, m.id")
+    rows = conn.execute(sql, [n for n in KEY_PARAMETERS for _c in ("value", "std")] + args).fetchall()
+    columns = list(zip(*rows)) if rows else [()] * (len(HEADS) + 2 * len(KEY_PARAMETERS))
+
+    def finite(v):
+        return None if v is None or not math.isfinite(float(v)) else float(v)
+    n = len(HEADS)
+    values = {name: tuple(finite(v) for v in columns[n + 2 * i]) for i, name in enumerate(KEY_PARAMETERS)}
+    stds = {name: tuple(finite(v) for v in columns[n + 2 * i + 1]) for i, name in enumerate(KEY_PARAMETERS)}
+    return Population(*(tuple(c) for c in columns[:n]), values=values, stds=stds)
+
+
+@pytest.fixture(scope="module")
+def measured(tmp_path_factory):
+    return small_measurement(tmp_path_factory.mktemp("unit"))
+
+
+@pytest.fixture(params=["folder", "postgresql"])
+def archive_and_connection(request, tmp_path):
+    """(archive, a function giving a raw connection to its database, the driver's placeholder)."""
+    if request.param == "folder":
+        import sqlite3
+        root = tmp_path / "archive"
+        return open_archive(str(root)), lambda: sqlite3.connect(root / "index.sqlite"), "?"
+    import psycopg
+    db = request.getfixturevalue("pg_database")
+    return (open_archive(db.url("eva")),
+            lambda: psycopg.connect(db.url("eva"), autocommit=True, options="-c search_path=linpar"), "%s")
+
+
+def _store_population(archive, measured):
+    path, doc = measured
+    archive.store_limits(LIMITS)
+    rng = np.random.default_rng(7)
+    for i in range(40):
+        values = {"fs": 70.5 + rng.normal(0, 1.5) + (8.0 if i % 13 == 5 else 0.0),      # some fail the limits
+                  "RE": 3.0 * (1 + rng.normal(0, 0.01)), "Qts": 0.45 + rng.normal(0, 0.01)}
+        document = unit(doc, **values)
+        if i == 7:
+            del document["parameters"]["Bl"]                  # not measured on this unit
+        if i == 11:
+            document["parameters"]["Qts"]["value"] = None      # undetermined
+        archive.store(path, document, {"station": ("QA1", "QA2", "QA10")[i % 3], "driver": ("W6", "W8")[i % 5 == 0],
+                                       "serial": f"SN{i}", "measured_at": f"2024-06-{1 + i % 20:02d}T{i % 24:02d}:00:00Z"})
+
+
+def _same_population(new: Population, old: Population) -> None:
+    for column in ("ids", "measured_at", "stations", "drivers", "serials", "operators", "validity", "verdicts",
+                   "limits_versions"):
+        assert getattr(new, column) == getattr(old, column), column
+    assert set(new.values) == set(old.values) and set(new.stds) == set(old.stds)
+    for name in old.values:     # bit for bit, NaN (no value) at the same units
+        assert np.array_equal(new.values[name], old.values[name], equal_nan=True), name
+        assert np.array_equal(new.stds[name], old.stds[name], equal_nan=True), name
+
+
+@pytest.mark.parametrize("selection", [Selection(), Selection(stations=("QA1",)), Selection(drivers=("W8",)),
+                                       Selection(since="2024-06-05", until="2024-06-12", stations=("QA1", "QA10"))],
+                         ids=["all", "station", "driver", "dates"])
+def test_bulk_population_and_its_statistics_are_the_row_by_row_ones(archive_and_connection, measured, selection):
+    archive, connect, mark = archive_and_connection
+    _store_population(archive, measured)
+    selection = selection.checked()
+    conn = connect()
+    try:
+        old = reference_population(conn, selection, mark)
+    finally:
+        conn.close()
+    new = archive.population(selection)
+    assert len(new) > 0 and (len(new) == 40 or selection != Selection())
+    assert np.isnan(new.values["Bl"]).sum() == (selection == Selection())     # the unit without Bl, if chosen
+    _same_population(new, old)
+    without_stds = archive.population(selection, with_stds=False)
+    assert without_stds.stds == {}
+    limits = archive.limits()
+    assert production_stats(without_stds, limits).as_json() == production_stats(old, limits).as_json()
