@@ -59,7 +59,7 @@ class LevelSeriesPlot(pg.PlotWidget):
         self.error.setData(x=x, y=fs, top=err, bottom=err)
         self.small.setData(x[small], fs[small])
         self.large.setData(x[~small], fs[~small])
-        self.getPlotItem().setTitle("resonance frequency against peak excursion (Fig. 14)")
+        self.getPlotItem().setTitle("resonance frequency against peak excursion")
         self.getPlotItem().enableAutoRange()
 
     def clear_series(self) -> None:
@@ -111,7 +111,7 @@ class LevelSeriesTable(QTableWidget):
             if p is None or p.value is None:
                 cells.append(_item("n/a", "" if p is None else (p.reason or "")))
                 continue
-            value, std = format_value(p)
+            value, std = format_value(p, all_digits=True)
             drift = level.drift.get(n)
             tip = f"{n} = {value} ± {std} {p.display_unit}"
             if drift is not None and level is not self._reference:

@@ -22,10 +22,11 @@ from analysis import acceptance, residuals
 from analysis.derived import parameter_table
 from analysis.errors import LinparError
 from analysis.fit import FitData
+from analysis.fit_words import fit_headline
 from analysis.pipeline import AnalysisResult
 from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
 from app.layout_room import keep_room_when_hidden
-from app.model_lab_candidates import CandidatesPanel
+from app.model_lab_candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab_catalogue import EffectCatalogue
 from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
 from app.model_lab_sites import SitePanel
@@ -208,9 +209,10 @@ class ModelLab(QWidget):
         version = self.versions[-1]
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
-                f"<span style='color:#555'>({html.escape(version.how)})</span> &nbsp;·&nbsp; "
-                f"<b>reduced χ²</b> {chi2_text(fit.chi2_red_by_channel())} &nbsp;·&nbsp; BIC {fit.bic:.1f}"
-                f" &nbsp;·&nbsp; {fit.n_varying} parameters")
+                f"<span style='color:#555'>({html.escape(version.how)})</span><br>{html.escape(fit_headline(fit))}")
+        self.model_label.setToolTip(f"Effects: {', '.join(fit.model.effect_ids) or 'none'}\n"
+                                    f"Reduced χ²: {chi2_text(fit.chi2_red_by_channel())}; BIC {fit.bic:.1f}; "
+                                    f"{fit.n_varying} parameters")
         if not fit.success:
             text += (f"<br><span style='color:#8e1b1b'><b>The fit did not converge</b>: "
                      f"{html.escape(fit.message)}</span>")
@@ -225,7 +227,7 @@ class ModelLab(QWidget):
     def _show_parameters(self) -> None:
         result = self.versions[-1].fitted.result
         descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
-        self.parameter_table.set_parameters(result.parameters, descriptions)
+        self.parameter_table.set_parameters(result.parameters, descriptions, result.sd_m2)
 
     def _set_busy(self, busy: bool, text: str = "") -> None:
         self.progress.setVisible(busy)
@@ -239,8 +241,11 @@ class ModelLab(QWidget):
         self.candidates.diagnose_button.setEnabled(ready)
         self.candidates.follow_button.setEnabled(ready)
         row = self.candidates.selected()
-        self.candidates.apply_button.setEnabled(
-            ready and row is not None and row.fitted is not None and not self.candidates.stale)
+        # Only a candidate the diagnosis would take is on offer; another one is the catalogue's checkbox away.
+        refusal = self.candidates.apply_refusal()
+        self.candidates.apply_button.setEnabled(ready and row is not None and row.fitted is not None
+                                                and not self.candidates.stale and not refusal)
+        self.candidates.apply_button.setToolTip(refusal or APPLY_TIP)
 
     # -- jobs --------------------------------------------------------------
     def _drop_job(self) -> None:
@@ -311,14 +316,13 @@ class ModelLab(QWidget):
     @Slot()
     def on_apply(self) -> None:
         row = self.candidates.selected()
-        if row is None or row.fitted is None or self.busy or self.candidates.stale:
+        if row is None or row.fitted is None or self.busy or self.candidates.stale or not row.accepted:
             return
         old = self.current
         self._add_version(row.fitted, f"{move_text(old.fitted.fit.model, row.fitted.fit.model)} "
                                       f"from the diagnosis of version {old.number}")
-        # Applying a candidate the diagnosis would not take is the user's call, never a silent one.
-        caveat = "" if row.accepted else f"; not one the diagnosis would take ({row.judgement})"
-        self.status_label.setText(f"Applied: {row.move} (ΔBIC {row.delta_bic:+.4g}){caveat}")
+        self.status_label.setText(f"Applied: {move_text(old.fitted.fit.model, row.fitted.fit.model)} "
+                                  f"({fit_words(row.delta_bic)})")
 
     @Slot()
     def on_candidate_selected(self) -> None:

@@ -15,8 +15,12 @@ from analysis.diagnosis_words import VERDICT_TITLES
 from app.lab_worker import CandidateRow, DiagnosisOutcome
 from app.model_lab_catalogue import category_title
 
-COLUMNS = ("#", "Action", "Effect", "Category", "ΔBIC", "χ²ᵣ Z", "χ²ᵣ Hx", "Acceptable")
+COLUMNS = ("#", "Action", "Effect", "Category", "Fit", "χ²ᵣ Z", "χ²ᵣ Hx", "Acceptable")
 RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, CHI2_Z, CHI2_X, JUDGED = range(len(COLUMNS))
+# The word scale of a BIC change (Kass and Raftery's grades of evidence), the best grade first.
+FIT_WORDS = ((-10.0, "fits far better"), (-6.0, "fits better"), (-2.0, "slightly better"), (2.0, "no better"))
+WORSE = "fits worse"
+BAR_CELLS = 8
 CHI2_COLUMNS = {"impedance": CHI2_Z, "displacement": CHI2_X}
 NO_DIAGNOSIS = ("Diagnose tries every effect one move away from the current model (add one of a new category, "
                 "or swap one for an alternative), refits each and ranks them by how much they lower BIC. An effect "
@@ -33,6 +37,9 @@ JUDGEMENT_TIPS = {
     acceptance.MISFIT_LEFT: "it removes only part of what a smooth correction at its site removes: it absorbs a "
                             "misfit it does not explain",
 }
+APPLY_TIP = "Adopt the selected candidate: its fit is already computed"
+APPLY_REFUSED_TIP = ("The diagnosis would not take the selected candidate ({why}). To try it anyway, check its "
+                     "effect in the catalogue: that refits the model with it.")
 VERDICT_COLOURS = {acceptance.NOTHING_MISSING: "#2e7d32", acceptance.EXPLAINED: "#2e7d32",
                    acceptance.PARTLY_EXPLAINED: "#b26a00", acceptance.UNEXPLAINED: "#8e1b1b"}
 
@@ -40,6 +47,29 @@ VERDICT_COLOURS = {acceptance.NOTHING_MISSING: "#2e7d32", acceptance.EXPLAINED: 
 def bic_text(delta_bic: float) -> str:
     return f"{delta_bic:+.4g}" if math.isfinite(delta_bic) else "failed"
 
+
+def fit_words(delta_bic: float) -> str:
+    """How much better a candidate fits, in words: 'fits far better' … 'fits worse'."""
+    if not math.isfinite(delta_bic):
+        return "refit failed"
+    return next((words for limit, words in FIT_WORDS if delta_bic <= limit), WORSE)
+
+
+def fit_bar(delta_bic: float, best_gain: float) -> str:
+    """A bar of BAR_CELLS cells, as long as the candidate's gain on a log scale relative to the best one's."""
+    gain = -delta_bic if math.isfinite(delta_bic) else 0.0
+    if gain <= 2.0 or best_gain <= 2.0:
+        return "▱" * BAR_CELLS
+    filled = max(1, round(BAR_CELLS * math.log10(gain) / math.log10(best_gain)))
+    return "▰" * filled + "▱" * (BAR_CELLS - filled)
+
+
+def fit_tooltip(delta_bic: float) -> str:
+    if not math.isfinite(delta_bic):
+        return "The refit of this candidate failed."
+    return (f"{fit_words(delta_bic).capitalize()} than the current model, its extra parameters paid for.\n"
+            f"Details: the Bayesian information criterion changes by {bic_text(delta_bic)} "
+            "(below -10: far better; -6 to -10: better; -2 to -6: slightly; above -2: no better).")
 
 class CandidatesPanel(QWidget):
     selected_changed = Signal()
@@ -52,9 +82,9 @@ class CandidatesPanel(QWidget):
 
         self.diagnose_button = QPushButton("Diagnose")
         self.diagnose_button.setToolTip("Refit every candidate one move away from the current model and rank them "
-                                        "by ΔBIC (in the background, on every core)")
+                                        "by how much better they fit (in the background, on every core)")
         self.apply_button = QPushButton("Apply")
-        self.apply_button.setToolTip("Adopt the selected candidate: its fit is already computed")
+        self.apply_button.setToolTip(APPLY_TIP)
         self.follow_button = QPushButton("Follow the greedy path")
         self.follow_button.setToolTip("Take the best candidate that explains the misfit it removes, again and "
                                       "again, then stop; every step becomes a version")
@@ -105,11 +135,14 @@ class CandidatesPanel(QWidget):
         self.rows = outcome.candidates if outcome is not None else ()
         chosen = outcome.chosen if outcome is not None else None
         self.table.setRowCount(len(self.rows))
+        gains = [-row.delta_bic for row in self.rows if math.isfinite(row.delta_bic)]
+        best_gain = max(gains, default=0.0)
         for r, row in enumerate(self.rows):
-            # Read across, "replace lr2 by" + "lr3" is the move; the effect column stays a plain id.
-            action = f"replace {row.replaces.id} by" if row.replaces is not None else "add"
-            cells = {RANK: str(r + 1), ACTION: action, EFFECT: row.effect.id,
-                     CATEGORY: category_title(row.effect.category), DELTA_BIC: bic_text(row.delta_bic)}
+            # Read across, "replace <title> by" + "<title>" is the move; the ids are in the tooltips.
+            action = f"replace {row.replaces.title} by" if row.replaces is not None else "add"
+            cells = {RANK: str(r + 1), ACTION: action, EFFECT: row.effect.title,
+                     CATEGORY: category_title(row.effect.category),
+                     DELTA_BIC: f"{fit_bar(row.delta_bic, best_gain)} {fit_words(row.delta_bic)}"}
             for channel, column in CHI2_COLUMNS.items():
                 value = row.chi2_red.get(channel)
                 cells[column] = f"{value:.3g}" if value is not None else ("–" if row.fitted else "failed")
@@ -118,10 +151,18 @@ class CandidatesPanel(QWidget):
                 cells[JUDGED] = "yes: the best"
             for column, text in cells.items():
                 item = QTableWidgetItem(text)
-                if column in (RANK, DELTA_BIC, CHI2_Z, CHI2_X):
+                if column in (RANK, CHI2_Z, CHI2_X):
                     item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
                 if column == EFFECT:
-                    item.setToolTip(row.effect.title)
+                    item.setToolTip(f"{row.effect.title} (id {row.effect.id}): {row.effect.category} effect")
+                if column == ACTION and row.replaces is not None:
+                    item.setToolTip(f"replaces {row.replaces.title} (id {row.replaces.id})")
+                if column == CATEGORY:
+                    item.setToolTip(category_title(row.effect.category))
+                if column == DELTA_BIC:
+                    item.setToolTip(fit_tooltip(row.delta_bic))
+                if column in (CHI2_Z, CHI2_X):
+                    item.setToolTip("Reduced χ² of the channel with this candidate: 1 is a fit down to the noise")
                 if column == JUDGED:
                     item.setToolTip(JUDGEMENT_TIPS.get(row.judgement, ""))
                 if row.accepted and column in (DELTA_BIC, JUDGED):
@@ -139,12 +180,14 @@ class CandidatesPanel(QWidget):
             self.title.setText(f"{self._heading}: {len(self.rows)} candidates, best first")
             self.show_verdict(outcome)
             chosen = next((i for i, row in enumerate(self.rows) if row.accepted), None)
-            if chosen is not None:
-                self.table.selectRow(chosen)      # the one the diagnosis would take
-            else:                                 # none would be taken: nothing to offer first
+            # After a greedy path the candidates are what it refused: nothing is offered first.
+            if chosen is None or outcome.path:    # none would be taken, or the path took them: nothing first
                 self.explanation.setHtml(f"<p>{html.escape(outcome.verdict_text)}</p>" if outcome.verdict_text
                                          else "<p>No candidate was ranked from this model: Diagnose to rank "
                                               "from it.</p>")
+        self.table.setCurrentItem(None)       # no current cell either: a key press must not select one
+        if outcome is not None and not outcome.path and chosen is not None:
+            self.table.selectRow(chosen)
         self.selected_changed.emit()
 
     def show_verdict(self, outcome: DiagnosisOutcome) -> None:
@@ -173,6 +216,13 @@ class CandidatesPanel(QWidget):
             return None
         return self.rows[rows[0].row()]
 
+    def apply_refusal(self) -> str:
+        """Why Apply is off for the selected candidate ('' when it is on offer)."""
+        row = self.selected()
+        if row is None or row.accepted:
+            return ""
+        return APPLY_REFUSED_TIP.format(why=JUDGEMENT_WORDS.get(row.judgement, row.judgement))
+
     def select(self, index: int) -> None:
         self.table.selectRow(index)
 
@@ -181,6 +231,6 @@ class CandidatesPanel(QWidget):
         if row is not None:
             flags = "".join(f"<li>{html.escape(f.message)}</li>" for f in row.flags)
             self.explanation.setHtml(f"<p><b>{html.escape(row.move)}</b> ({html.escape(row.effect.title)}): "
-                                     f"{html.escape(row.explanation)}</p>"
+                                     f"{html.escape(fit_words(row.delta_bic))}. {html.escape(row.explanation)}</p>"
                                      + (f"<p>Flags:</p><ul>{flags}</ul>" if flags else ""))
         self.selected_changed.emit()

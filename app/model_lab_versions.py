@@ -16,20 +16,20 @@ class LabVersion:
 
     @property
     def effects(self) -> str:
-        return ", ".join(self.fitted.fit.model.effect_ids) or "textbook"
+        return ", ".join(e.title for e in self.fitted.fit.model.effects) or "textbook"
 
 
 def move_text(old: Model, new: Model) -> str:
-    """What changed from `old` to `new`, in the words of the catalogue: 'added delay-x; removed lr2'."""
+    """What changed from `old` to `new`, by the catalogue's titles: 'added Delay of the current channel; …'."""
     before = {e.category: e for e in old.effects}
     after = {e.category: e for e in new.effects}
     moves = []
     for category, effect in before.items():
         if category not in after:
-            moves.append(f"removed {effect.id}")
+            moves.append(f"removed {effect.title}")
         elif after[category].id != effect.id:
-            moves.append(f"replaced {effect.id} by {after[category].id}")
-    moves += [f"added {e.id}" for c, e in after.items() if c not in before]
+            moves.append(f"replaced {effect.title} by {after[category].title}")
+    moves += [f"added {e.title}" for c, e in after.items() if c not in before]
     return "; ".join(moves) or "refitted"
 
 

@@ -1,5 +1,10 @@
 """The parameter table: name, value, 1-sigma and unit in customary units.
 
+The Thiele-Small parameters come first, in the order a speaker engineer reads
+them; the model's own quantities (CMES, LCES, RES, L2, ...) follow under a
+section row that folds them away. Values are rounded to what their
+uncertainty supports, at most 4 significant digits unless "All digits" is on.
+
 Parameters that could not be determined stay in the table (a missing row
 would look like an oversight): greyed, with the reason in place of the value
 and in full in the tooltip.
@@ -11,13 +16,24 @@ from typing import Mapping
 
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QLabel, QTableView, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeaderView, QLabel, QTableView,
+                               QVBoxLayout, QWidget)
 
 from analysis.derived import NO_SD, ParameterValue
+from analysis.report.numbers import pretty_unit
 from app import style
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
 NAME, VALUE, STD, UNIT = range(4)
+
+# The Thiele-Small set, in reading order; everything else is one of the model's internal quantities.
+THIELE_SMALL = ("fs", "Qts", "Qes", "Qms", "Vas", "RE", "LE", "Bl", "Mms", "Cms", "Rms", "Kms", "Sd",
+                "SPL_2.83V_1m", "SPL_1W_1m", "eta0")
+# How the table names them where the code's name is not the customary one.
+DISPLAY_NAMES = {"RE": "Re", "LE": "Le", "SPL_2.83V_1m": "Sensitivity (2.83 V, 1 m)",
+                 "SPL_1W_1m": "Sensitivity (1 W, 1 m)", "eta0": "η₀ (efficiency)"}
+INTERNAL_TITLE = "Model's internal quantities"
+DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
 
 # Tooltips for the derived parameters (fitted ones carry their own description).
 DERIVED_DESCRIPTIONS = {
@@ -33,13 +49,36 @@ DERIVED_DESCRIPTIONS = {
     "eta0": "reference efficiency (piston in half space)",
     "SPL_1W_1m": "sensitivity at 1 W into RE, 1 m, half space",
     "SPL_2.83V_1m": "sensitivity at 2.83 V, 1 m, half space",
+    "Sd": "effective radiating area of the diaphragm (given, not measured)",
 }
 
 
-def format_value(p: ParameterValue) -> tuple[str, str]:
-    """(value, 1-sigma) in display units, the value rounded to the second digit of its sigma."""
+def display_name(name: str) -> str:
+    return DISPLAY_NAMES.get(name, name)
+
+
+def ordered_rows(parameters: Mapping[str, ParameterValue], sd_m2: float | None = None) -> list:
+    """Thiele-Small parameters first, then a section title (a str) and the model's internal quantities."""
+    named = dict(parameters)
+    if sd_m2:
+        named["Sd"] = ParameterValue("Sd", sd_m2, None, "m^2", "cm²", 1e4)
+    rows: list = [named[n] for n in THIELE_SMALL if n in named]
+    internal = [p for n, p in named.items() if n not in THIELE_SMALL]
+    if internal:
+        rows.append(INTERNAL_TITLE)
+        rows.extend(internal)
+    return rows
+
+
+def format_value(p: ParameterValue, all_digits: bool = True) -> tuple[str, str]:
+    """(value, 1-sigma) in display units, the value rounded to the second digit of its sigma.
+
+    all_digits=False: at most DEFAULT_DIGITS significant digits, fewer when the sigma allows fewer.
+    """
     if p.value is None:
         return "", ""
+    if not all_digits:
+        return short_value(p)
     value = p.value * p.display_scale
     std = None if p.std is None else p.std * abs(p.display_scale)
     if std is None or not math.isfinite(std) or std <= 0:
@@ -49,17 +88,39 @@ def format_value(p: ParameterValue) -> tuple[str, str]:
         return f"{value:.6g}", f"{std:.2g}"
     return f"{value:.{decimals}f}", f"{std:.{decimals}f}"
 
+
+def short_value(p: ParameterValue) -> tuple[str, str]:
+    """(value, 1-sigma): as many significant digits as the sigma supports (its second digit), at most 4."""
+    value = p.value * p.display_scale
+    std = None if p.std is None else p.std * abs(p.display_scale)
+    known = std is not None and math.isfinite(std) and std > 0
+    if value == 0 or not math.isfinite(value):
+        return (f"{value:.{DEFAULT_DIGITS}g}", f"{std:.2g}" if known else "–")
+    magnitude = math.floor(math.log10(abs(value)))
+    digits = DEFAULT_DIGITS
+    if known:
+        digits = max(1, min(DEFAULT_DIGITS, magnitude - math.floor(math.log10(std)) + 2))
+    decimals = digits - 1 - magnitude
+    if abs(value) >= 1e6 or decimals > 9:
+        return f"{value:.{digits}g}", (f"{std:.2g}" if known else "–")
+    text = f"{round(value, decimals):.{max(0, decimals)}f}"
+    return text, (f"{std:.2g}" if known else "–")
+
 class ParameterModel(QAbstractTableModel):
     def __init__(self, parent=None):
         super().__init__(parent)
-        self._rows: list[ParameterValue] = []
+        self._rows: list = []                      # ParameterValue, or a section title (str)
         self._descriptions: dict[str, str] = {}
         self._cells: list[list[dict]] = []         # per row and column: role -> value
+        self._parameters: Mapping[str, ParameterValue] = {}
+        self._sd_m2: float | None = None
+        self.all_digits = False
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
-                       descriptions: Mapping[str, str] | None = None) -> None:
+                       descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
         self.beginResetModel()
-        self._rows = list(parameters.values())
+        self._parameters, self._sd_m2 = parameters, sd_m2
+        self._rows = ordered_rows(parameters, sd_m2)
         self._descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
         # Every role of every cell, worked out once: a view asks for each of them on every repaint
         # (some 1,700 calls to show the table), and formatting them each time made up half of the
@@ -67,7 +128,21 @@ class ParameterModel(QAbstractTableModel):
         self._cells = [self._row_roles(p) for p in self._rows]
         self.endResetModel()
 
-    def _row_roles(self, p: ParameterValue) -> list[dict]:
+    def set_all_digits(self, on: bool) -> None:
+        self.all_digits = on
+        self.set_parameters(self._parameters, self._descriptions, self._sd_m2)
+
+    def is_section(self, row: int) -> bool:
+        return isinstance(self._rows[row], str)
+
+    def _row_roles(self, p) -> list[dict]:
+        if isinstance(p, str):          # a section title over the rows below it
+            font = QFont()
+            font.setBold(True)
+            tip = ("What the model computes with: the Thiele-Small parameters above derive from them. "
+                   "Click to fold them away or show them.")
+            return [{Qt.DisplayRole: f"▾ {p}" if col == NAME else "", Qt.FontRole: font, Qt.ToolTipRole: tip}
+                    for col in range(len(COLUMNS))]
         tooltip = self._tooltip(p)
         cells = []
         for col in range(len(COLUMNS)):
@@ -83,12 +158,14 @@ class ParameterModel(QAbstractTableModel):
             cells.append(roles)
         return cells
 
-    def parameter(self, row: int) -> ParameterValue:
-        return self._rows[row]
+    def parameter(self, row: int) -> ParameterValue | None:
+        """The row's parameter (None for a section row)."""
+        p = self._rows[row]
+        return None if isinstance(p, str) else p
 
     def row_of(self, name: str) -> int:
         for row, p in enumerate(self._rows):
-            if p.name == name:
+            if not isinstance(p, str) and p.name == name:
                 return row
         raise KeyError(name)
 
@@ -110,20 +187,27 @@ class ParameterModel(QAbstractTableModel):
 
     def _display(self, p: ParameterValue, col: int) -> str:
         if col == NAME:
-            return p.name
+            return display_name(p.name)
         if col == UNIT:
-            return p.display_unit
+            return pretty_unit(p.display_unit)
         if p.value is None:
             return f"n/a: {p.reason}" if col == VALUE else ""
-        value, std = format_value(p)
+        value, std = format_value(p, self.all_digits)
         return value if col == VALUE else std
 
     def _tooltip(self, p: ParameterValue) -> str:
-        kind = "fitted" if p.fitted else "derived from the fitted values"
-        text = f"{p.name} ({kind})"
+        kind = "given" if p.name == "Sd" else ("fitted" if p.fitted else "derived from the fitted values")
+        text = f"{display_name(p.name)} ({kind})"
         description = self._descriptions.get(p.name)
         if description:
             text += f": {description}"
+        if p.value is not None:
+            value, std = format_value(p, all_digits=True)
+            unit = pretty_unit(p.display_unit)
+            spread = f" ± {std}" if std not in ("", "–") else ""
+            text += f"\n= {value}{spread} {unit}".rstrip()
+            if spread:
+                text += "\n± is one standard deviation: the true value lies within it with about 68 % probability."
         if p.value is None:
             text += f"\nNot reported: {p.reason}"
             if p.reason == NO_SD:      # the analysis words it for the command line
@@ -150,27 +234,52 @@ class ParameterTable(QTableView):
         header.setSectionResizeMode(VALUE, QHeaderView.Stretch)
         header.setSectionResizeMode(STD, QHeaderView.ResizeToContents)
         header.setSectionResizeMode(UNIT, QHeaderView.ResizeToContents)
+        self.internal_folded = False
         self.parameter_model.modelReset.connect(self._apply_spans)
+        self.clicked.connect(self._on_clicked)
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
-                       descriptions: Mapping[str, str] | None = None) -> None:
-        self.parameter_model.set_parameters(parameters, descriptions)
+                       descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
+        self.parameter_model.set_parameters(parameters, descriptions, sd_m2)
+
+    def set_all_digits(self, on: bool) -> None:
+        self.parameter_model.set_all_digits(on)
 
     def _apply_spans(self) -> None:
         self.clearSpans()
-        for row in range(self.parameter_model.rowCount()):
-            if self.parameter_model.parameter(row).value is None:
+        model = self.parameter_model
+        below_section = False
+        for row in range(model.rowCount()):
+            if model.is_section(row):
+                self.setSpan(row, NAME, 1, len(COLUMNS))
+                below_section = True
+                continue
+            self.setRowHidden(row, below_section and self.internal_folded)
+            if model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
+
+    def _on_clicked(self, index: QModelIndex) -> None:
+        if index.isValid() and self.parameter_model.is_section(index.row()):
+            self.internal_folded = not self.internal_folded
+            self._apply_spans()
 
 
 def titled_parameter_table(title_html: str) -> tuple[QWidget, "ParameterTable"]:
-    """A ParameterTable under a bold title, in a box for a splitter: (box, table)."""
+    """A ParameterTable under a bold title and its "All digits" switch, in a box for a splitter: (box, table)."""
     table = ParameterTable()
     box = QWidget()
     layout = QVBoxLayout(box)
     layout.setContentsMargins(0, 0, 0, 0)
     title = QLabel(title_html)
     title.setWordWrap(True)
-    layout.addWidget(title)
+    all_digits = QCheckBox("All digits")
+    all_digits.setToolTip("Show every digit the uncertainty supports (to its second digit) instead of at most "
+                          f"{DEFAULT_DIGITS} significant digits")
+    all_digits.toggled.connect(table.set_all_digits)
+    table.all_digits_box = all_digits
+    top = QHBoxLayout()
+    top.addWidget(title, 1)
+    top.addWidget(all_digits)
+    layout.addLayout(top)
     layout.addWidget(table, 1)
     return box, table

@@ -11,6 +11,7 @@ from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QSplitter, QStackedW
 from analysis.derived import parameter_table
 from analysis.pipeline import AnalysisResult
 from app import style
+from app.fit_quality import FitQualityBox
 from app.parameter_table import titled_parameter_table
 from app.plots import TransferPlot
 from app.spl_panel import SplPanel
@@ -40,22 +41,6 @@ class ValidityBox(QLabel):
         self.setText(f"<b>Validity: {html.escape(state)}</b> — {html.escape(meaning)}")
 
 
-def fit_quality_text(result: AnalysisResult) -> str:
-    fit = result.fit
-    if fit is None:
-        return (f"<span style='color:#8e1b1b'><b>Nothing could be fitted</b>: "
-                f"{html.escape(str(result.not_fitted))}</span>")
-    effects = ", ".join(f"{e.title} ({e.id})" for e in fit.model.effects) or "none"
-    names = {"impedance": "Z", "displacement": "Hx"}
-    chi = ", ".join(f"{names.get(k, k)} {v:.2f}" for k, v in fit.chi2_red_by_channel().items())
-    text = (f"<b>Model</b>: lumped base + {html.escape(effects)} &nbsp;·&nbsp; <b>reduced χ²</b>: {chi}"
-            f" &nbsp;·&nbsp; AIC {fit.aic:.1f} &nbsp;·&nbsp; BIC {fit.bic:.1f}"
-            f" &nbsp;·&nbsp; {fit.n_data} data, {fit.n_varying} parameters")
-    if not fit.success:
-        text += f"<br><span style='color:#8e1b1b'><b>The fit did not converge</b>: {html.escape(fit.message)}</span>"
-    return text
-
-
 def source_text(result: AnalysisResult) -> str:
     s = result.spectra
     name = result.source.name if result.source else "recording"
@@ -83,10 +68,7 @@ class ResultsView(QWidget):
         self.source_label.setTextFormat(Qt.RichText)
         self.source_label.setWordWrap(True)
         self.validity_box = ValidityBox()
-        self.fit_quality = QLabel()
-        self.fit_quality.setTextFormat(Qt.RichText)
-        self.fit_quality.setWordWrap(True)
-        self.fit_quality.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.fit_quality = FitQualityBox()
 
         self.impedance_plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
         self.displacement_plot = TransferPlot("|Hx| (mm/V)", 1e3, log_y=True)
@@ -156,7 +138,7 @@ class ResultsView(QWidget):
         self.result, self.curves = result, curves
         self.source_label.setText(source_text(result))
         self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
-        self.fit_quality.setText(fit_quality_text(result))
+        self.fit_quality.set_result(result)
         self._show_parameters(result)
         if curves is None:          # a broken measurement: judged (validity, reasons), nothing to draw
             self.impedance_plot.clear_curves()
@@ -199,4 +181,4 @@ class ResultsView(QWidget):
 
     def _show_parameters(self, result: AnalysisResult) -> None:
         descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs} if result.fit else {}
-        self.parameter_table.set_parameters(result.parameters, descriptions)
+        self.parameter_table.set_parameters(result.parameters, descriptions, result.sd_m2)

@@ -155,11 +155,11 @@ class SeriesPage(QTabWidget):
         self.panels = {
             "repeatability": _SetPanel("Choose repeated recordings…",
                                        "The same driver measured several times (remounted between): mean, standard "
-                                       "deviation and percent per parameter, as the paper's Table I.",
+                                       "deviation and percent per parameter.",
                                        self.repeat_table, lambda: self.on_choose("repeatability"), self.worker.cancel),
             "levels": _SetPanel("Choose recordings at rising levels…",
-                                "The same driver at rising drive levels: the parameters against peak excursion "
-                                "(Table II) and fs against excursion (Fig. 14).",
+                                "The same driver at rising drive levels: the parameters and fs against peak "
+                                "excursion.",
                                 self.levels_view, lambda: self.on_choose("levels"), self.worker.cancel),
         }
         self.large_signal_button = QPushButton("Large-signal curves of these recordings…")
@@ -168,8 +168,8 @@ class SeriesPage(QTabWidget):
         self.large_signal_button.setEnabled(False)
         self.large_signal_button.clicked.connect(lambda: self.large_signal_requested.emit(list(self.level_paths)))
         self.panels["levels"].layout().itemAt(0).layout().insertWidget(2, self.large_signal_button)
-        self.addTab(self.panels["repeatability"], "Repeatability (Table I)")
-        self.addTab(self.panels["levels"], "Level series (Table II)")
+        self.addTab(self.panels["repeatability"], "Repeatability")
+        self.addTab(self.panels["levels"], "Level series")
         self.worker.progress.connect(self.on_progress)
         self.worker.finished.connect(self.on_finished)
         self.worker.failed.connect(self.on_failed)

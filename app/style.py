@@ -25,8 +25,7 @@ VALIDITY_TEXT = {
     "green": "every channel passed the signal, noise and distortion checks",
     "yellow": "some checks are doubtful: read the channel findings before trusting the parameters",
     "red": "the measurement failed a validity check: its parameters are not to be trusted",
-    "unknown": "not checked: the signal, noise and distortion checks (physics.md section 5) are not part "
-               "of this analysis yet",
+    "unknown": "not checked yet: the signal, noise and distortion checks have not run on this measurement",
 }
 
 MEASURED_SYMBOL_SIZE = 5

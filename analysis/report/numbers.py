@@ -6,7 +6,7 @@ import math
 from analysis.derived import ParameterValue
 
 # Display units written the way reports print them.
-PRETTY_UNITS = {"ohm": "Ω", "uF": "µF", "T*m": "T·m", "ohm*s^n": "Ω·sⁿ", "-": ""}
+PRETTY_UNITS = {"ohm": "Ω", "uF": "µF", "us": "µs", "T*m": "T·m", "ohm*s^n": "Ω·sⁿ", "-": ""}
 
 
 def pretty_unit(unit: str) -> str:

@@ -136,7 +136,7 @@ def test_audio(config: HardwareConfig, cancel: threading.Event | None = None, pr
         levels.append(_level_text(name, rms))
     stats = captured.stats
     problems = stats.problems()
-    found = f"{audio.describe()}: {', '.join(levels)} at {TEST_LEVEL_V:g} V rms out"
+    found = f"{config.describe()}: {', '.join(levels)} at {TEST_LEVEL_V:g} V rms out"
     if not config.has_displacement:
         found += "; no displacement input"
     return found + (". Problems: " + "; ".join(problems) if problems else "; no dropouts, nothing clipped.")

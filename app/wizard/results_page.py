@@ -4,10 +4,10 @@ from __future__ import annotations
 import html
 
 from PySide6.QtCore import Signal
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout
+from PySide6.QtWidgets import QHBoxLayout, QPushButton, QVBoxLayout
 
-from app.parameter_table import ParameterTable
-from app.results_view import fit_quality_text
+from app.fit_quality import FitQualityBox
+from app.parameter_table import titled_parameter_table
 from app.traffic_light import ValiditySummary
 from app.wizard.base import WizardPage, rich_label
 
@@ -22,8 +22,9 @@ class ResultsPage(WizardPage):
         super().__init__(state, session, parent)
         self.source = rich_label(selectable=True)
         self.validity = ValiditySummary()
-        self.fit_quality = rich_label(selectable=True)
-        self.table = ParameterTable()
+        self.fit_quality = FitQualityBox()
+        table_box, self.table = titled_parameter_table("<b>Parameters</b> (bold: fitted; the rest derived "
+                                                       "from them)")
         self.open_button = QPushButton("Open in the Results page")
         self.open_button.setToolTip("Z, Hx and SPL with their residuals; the Model lab starts from it too")
         self.again_button = QPushButton("Measure the next driver")
@@ -38,12 +39,9 @@ class ResultsPage(WizardPage):
         left.addWidget(self.fit_quality)
         left.addLayout(buttons)
         left.addStretch(1)
-        right = QVBoxLayout()
-        right.addWidget(QLabel("<b>Parameters</b> (bold: fitted; the rest derived from them)"))
-        right.addWidget(self.table, 1)
         layout = QHBoxLayout(self)
         layout.addLayout(left, 1)
-        layout.addLayout(right, 1)
+        layout.addWidget(table_box, 1)
         self.open_button.clicked.connect(self.on_open)
         self.again_button.clicked.connect(self.again_requested)
 
@@ -54,9 +52,9 @@ class ResultsPage(WizardPage):
         result = outcome.analysis.result
         self.source.setText(f"<b>{html.escape(outcome.path.name)}</b> in {html.escape(str(outcome.path.parent))}")
         self.validity.set_validity(result.validity)
-        self.fit_quality.setText(fit_quality_text(result))
+        self.fit_quality.set_result(result)
         descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs} if result.fit else {}
-        self.table.set_parameters(result.parameters, descriptions)
+        self.table.set_parameters(result.parameters, descriptions, result.sd_m2)
 
     def missing(self) -> str | None:
         return "This is the last step." if self.state.outcome is not None else "No measurement yet."

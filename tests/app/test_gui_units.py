@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from analysis.derived import ParameterValue
-from app.parameter_table import format_value
+from app.parameter_table import format_value, short_value
 from app.plots import LogFrequencyAxis
 from app.result_curves import aligned_phase_deg
 
@@ -19,6 +19,18 @@ from app.result_curves import aligned_phase_deg
 ])
 def test_format_value_rounds_to_the_sigma(value, std, scale, expected):
     assert format_value(ParameterValue("x", value, std, "u", "u", scale)) == expected
+
+
+@pytest.mark.parametrize("value, std, expected", [
+    (3.0200021, 5.02e-6, ("3.020", "5e-06")),       # the sigma allows more: four digits
+    (70.5597, 0.057, ("70.56", "0.057")),
+    (70.5597, 2.3, ("70.6", "2.3")),                # the sigma allows three
+    (12345.6, 230.0, ("12350", "2.3e+02")),
+    (0.0123456, None, ("0.01235", "–")),            # no sigma: four digits
+    (5.0, 40.0, ("5", "40")),                       # the sigma swamps it: one digit
+])
+def test_short_values_keep_what_the_sigma_supports_at_most_four_digits(value, std, expected):
+    assert short_value(ParameterValue("x", value, std, "u", "u", 1.0)) == expected
 
 
 def test_missing_value_formats_empty():

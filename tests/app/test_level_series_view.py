@@ -55,7 +55,7 @@ def test_plot_has_fs_against_peak_excursion(view, series):
     assert len(small_x) == 1 and len(large_x) == len(LEVELS_V) - 1
     assert small_x[0] == pytest.approx(series.levels[0].peak_displacement_m * 1e3)
     assert np.all(large_y < small_y[0])          # fs falls with level
-    assert "Fig. 14" in view.plot.getPlotItem().titleLabel.text
+    assert "against peak excursion" in view.plot.getPlotItem().titleLabel.text
     assert "fs 70.5" in view.summary.text() and "Cms" in view.summary.text()
 
 

@@ -125,8 +125,11 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
     top = outcome.candidates[0]
     assert top.effect.category == "creep"
     assert table.item(0, CATEGORY).text() == "Suspension creep"
-    assert table.item(0, ACTION).text() == "add" and table.item(0, EFFECT).text() == top.effect.id
-    assert float(table.item(0, DELTA_BIC).text()) < -MIN_BIC_GAIN
+    assert table.item(0, ACTION).text() == "add" and table.item(0, EFFECT).text() == top.effect.title
+    assert top.effect.id in table.item(0, EFFECT).toolTip()                  # the id, for who needs it
+    assert top.delta_bic < -MIN_BIC_GAIN
+    assert table.item(0, DELTA_BIC).text().endswith("fits far better")       # a word and a bar, no number
+    assert table.item(0, DELTA_BIC).text().startswith("▰")
     deltas = [c.delta_bic for c in outcome.candidates]
     assert deltas == sorted(deltas)
     assert lab.candidates.selected() is top
@@ -148,7 +151,7 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
         assert chi2[1] == pytest.approx(after[channel]) and chi2[1] < chi2[0] / 10
     spots = lab.chart.series["impedance"].scatter.points()
     tip = lab.chart.series["impedance"].scatter.opts["tip"](x=0.0, y=0.0, data=spots[-1].data())
-    assert tip.startswith("version 2: lr2, creep-log") and "added creep-log" in tip     # hovering the point
+    assert tip.startswith("version 2: LR-2") and "added Logarithmic creep" in tip     # hovering the point
     assert top.effect.id in lab.catalogue.checked()
     assert "noise floor" in lab.residual_panel.text.text()
     assert _parameter(lab, "lambda") == pytest.approx(PAPER.parameters["lambda"], rel=0.05)
@@ -159,7 +162,7 @@ def test_unchecking_an_effect_refits_and_raises_chi2(qtbot, make_lab, full_resul
     lab = make_lab(full_result)
     before = _chi2(lab)
     version = _toggle(qtbot, lab, "creep-log", checked=False)
-    assert version.number == 2 and version.how == "removed creep-log"
+    assert version.number == 2 and version.how == "removed Logarithmic creep (Knudsen and Jensen)"
     assert lab.current.fitted.fit.model.effect_ids == ("lr2",)
     assert lab.catalogue.checked() == ("lr2",)
     after = _chi2(lab)
@@ -177,7 +180,7 @@ def test_checking_a_second_effect_of_a_category_swaps_it(qtbot, lab):
         assert lab.catalogue.checked() == ("lr3",)         # swapped at once, before the refit ends
     version = blocker.args[0]
     assert version.fitted.fit.model.effect_ids == ("lr3",)
-    assert version.how == "replaced lr2 by lr3"
+    assert version.how == "replaced LR-2 (L2 shunted by R2) by LR-3 (two LR stages: L2||R2 and L3||R3)"
     assert "R3" in version.fitted.fit.values and "R2" in version.fitted.fit.values
 
 
@@ -320,12 +323,14 @@ def test_physics_the_catalogue_lacks_ends_unexplained_with_the_site_and_its_corr
     assert "compliance" in lab.site_panel.ranking.text()
 
 
-def test_a_flagged_candidate_can_be_applied_by_hand_and_says_so(qtbot, make_lab, odd_mechanical_result):
+def test_a_flagged_candidate_is_not_offered_and_the_button_says_how_to_try_it(qtbot, make_lab,
+                                                                              odd_mechanical_result):
     lab = make_lab(odd_mechanical_result)
     outcome = _diagnose(qtbot, lab)
     flagged = next(i for i, row in enumerate(outcome.candidates) if row.flags and row.fitted is not None)
     lab.candidates.select(flagged)
     assert "Flags:" in lab.candidates.explanation.toPlainText()
-    assert lab.candidates.apply_button.isEnabled()
+    assert not lab.candidates.apply_button.isEnabled()
+    assert "check its effect in the catalogue" in lab.candidates.apply_button.toolTip()
     qtbot.mouseClick(lab.candidates.apply_button, Qt.LeftButton)
-    assert lab.current.number == 2 and "not one the diagnosis would take" in lab.status_label.text()
+    assert lab.current.number == 1

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-from app.parameter_table import STD, UNIT, VALUE
+from app.parameter_table import NAME, STD, UNIT, VALUE
 
 from .conftest import PAPER, open_and_wait
 
@@ -28,7 +28,7 @@ def shown(qtbot, window, recordings):
 def test_parameter_table_shows_re_within_one_percent(shown):
     value = float(_cell(shown.parameter_table, "RE", VALUE))
     assert value == pytest.approx(PAPER.parameters["RE"], rel=0.01)
-    assert _cell(shown.parameter_table, "RE", UNIT) == "ohm"
+    assert _cell(shown.parameter_table, "RE", UNIT) == "Ω"
     assert float(_cell(shown.parameter_table, "RE", STD)) > 0
 
 
@@ -67,9 +67,20 @@ def test_model_line_follows_the_measured_points(shown):
 
 
 def test_fit_quality_and_validity(shown):
-    text = shown.fit_quality.text()
+    headline = shown.fit_quality.headline.text()
+    # In words: the model by its effects' titles, and how well it explains each channel.
+    assert "LR-2" in headline and "Logarithmic creep" in headline
+    assert "explains the impedance down to its noise" in headline
+    assert "explains the displacement down to its noise" in headline
+    for part in ("χ²", "AIC", "BIC", "lr2"):
+        assert part not in headline
+    # The numbers behind it, folded away until asked for.
+    details = shown.fit_quality.details
+    assert not details.isVisible()
+    shown.fit_quality.toggle.click()
+    assert details.isVisible()
     for part in ("lr2", "creep-log", "reduced χ²", "Z ", "Hx ", "AIC", "BIC"):
-        assert part in text
+        assert part in details.text()
     # a clean simulated measurement: the validity checks find nothing wrong
     assert shown.validity_box.state == "green"
     assert "green" in shown.validity_box.text().lower()
@@ -130,3 +141,47 @@ def test_validity_box_shows_each_state_in_its_colour(qapp, state):
     box.set_state(state)
     background, _ = style.validity_colours(state)
     assert state in box.text() and background in box.styleSheet()
+
+
+def _names(table) -> list[str]:
+    model = table.parameter_model
+    return [model.data(model.index(row, NAME)) for row in range(model.rowCount())]
+
+
+def test_parameter_table_reads_thiele_small_first_then_the_model_quantities(shown):
+    table = shown.parameter_table
+    names = _names(table)
+    assert names[:5] == ["fs", "Qts", "Qes", "Qms", "Vas"]
+    assert names[5:9] == ["Re", "Le", "Bl", "Mms"]
+    assert "Sd" in names and "Sensitivity (2.83 V, 1 m)" in names      # the given Sd and the sensitivity
+    section = next(row for row, name in enumerate(names) if "internal quantities" in name)
+    assert {"CMES", "LCES", "RES", "L2", "R2", "lambda"} <= set(names[section + 1:])
+    assert section > names.index("Sensitivity (2.83 V, 1 m)")
+    # The section folds away and back with a click on its row.
+    model = table.parameter_model
+    qtbot_click_row = lambda: table.clicked.emit(model.index(section, NAME))      # noqa: E731
+    qtbot_click_row()
+    assert table.isRowHidden(model.row_of("CMES")) and not table.isRowHidden(model.row_of("fs"))
+    qtbot_click_row()
+    assert not table.isRowHidden(model.row_of("CMES"))
+
+
+def test_parameter_units_are_written_properly(shown):
+    table = shown.parameter_table
+    expected = {"RE": "Ω", "LE": "mH", "Bl": "T·m", "Mms": "g", "Cms": "mm/N", "Vas": "l", "CMES": "µF",
+                "SPL_2.83V_1m": "dB SPL", "Qts": ""}
+    assert {name: _cell(table, name, UNIT) for name in expected} == expected
+
+
+def test_values_show_at_most_four_digits_unless_all_digits_is_on(shown):
+    table = shown.parameter_table
+
+    def digits(text: str) -> int:
+        return len(text.replace("-", "").replace(".", "").lstrip("0"))
+    for name in ("RE", "fs", "Qts", "Bl", "Mms", "CMES"):
+        assert digits(_cell(table, name, VALUE)) <= 4, name
+    short = _cell(table, "RE", VALUE)
+    table.all_digits_box.setChecked(True)
+    full = _cell(table, "RE", VALUE)
+    assert digits(full) > digits(short) and float(full) == pytest.approx(float(short), rel=1e-3)
+    assert "±" in _cell(table, "RE", VALUE, Qt.ToolTipRole)       # every value explains itself
