@@ -53,9 +53,12 @@ def channel_clause(ch: ChannelFit) -> str:
 
 def fit_headline(fit: FitResult) -> str:
     """'The model explains the impedance down to its noise and misses 3 % of the displacement between …'."""
-    clauses = [channel_clause(ch) for ch in fit.channels.values()]
-    if not clauses:
+    if not fit.channels:
         return "The model was fitted to no data."
+    if len(fit.channels) > 1 and fit_is_at_noise(fit):
+        what = " and the ".join(CHANNEL_NAMES.get(name, name) for name in fit.channels)
+        return f"The model explains the {what} down to their noise."
+    clauses = [channel_clause(ch) for ch in fit.channels.values()]
     text = "The model " + (clauses[0] if len(clauses) == 1 else ", ".join(clauses[:-1]) + " and " + clauses[-1])
     return text + "."
 

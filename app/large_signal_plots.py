@@ -12,10 +12,12 @@ from PySide6.QtCore import Qt
 
 from app import style
 from app.grid_axis import show_grid
+from app.plot_placeholder import PlotPlaceholder
 from app.plots import LogFrequencyAxis, style_plot
 
 BAND = (209, 73, 91, 55)              # the model's red, translucent: the 2-sigma band
 RANGE = (31, 95, 191, 22)             # the measured range: a light blue background
+EMPTY_HINT = "Choose recordings of one driver at large signal, or measure with the Large signal template."
 LIMIT = "#e08a00"
 OUTSIDE_STYLE = Qt.DashLine
 SAMPLES = 201
@@ -44,14 +46,17 @@ class CurvePlot(pg.PlotWidget):
         for item in (self.region, self.upper, self.lower, self.band, self.inside, *self.outside):
             plot.addItem(item)
         self.marks: list = []
+        self.placeholder = PlotPlaceholder(self, f"{name}(x): no curve yet. {EMPTY_HINT}")
 
     def clear_curve(self) -> None:
         for item in (self.upper, self.lower, self.inside, *self.outside):
             item.setData([], [])
         self._clear_marks()
+        self.placeholder.show_text(f"{self.name}(x): no curve yet. {EMPTY_HINT}")
 
     def set_curve(self, curve, limits=(), threshold=None, extra_marks=()) -> None:
         """``limits``: (x_m, text) vertical lines; ``threshold``: (value in the curve's unit, text) horizontal."""
+        self.placeholder.hide()
         lo, hi = curve.x_range
         width = hi - lo
         x = np.linspace(lo - MARGIN * width, hi + MARGIN * width, SAMPLES)
@@ -111,6 +116,7 @@ class DistortionPlot(pg.PlotWidget):
             for item in (measured, predicted, noise):
                 plot.addItem(item)
             self.items[name] = (measured, predicted, noise)
+        self.placeholder = PlotPlaceholder(self, f"Distortion: no data yet. {EMPTY_HINT}")
 
     def set_fit(self, fit) -> None:
         for name, (measured, predicted, noise) in self.items.items():
@@ -127,3 +133,4 @@ class DistortionPlot(pg.PlotWidget):
                 item.setData(hz[ok], y[ok])
         self.getPlotItem().setTitle(None if fit is None else f"{fit.label}, {fit.drive_rms_v:.3g} V RMS")
         self.getPlotItem().enableAutoRange()
+        self.placeholder.show_text("" if fit is not None else f"Distortion: no data yet. {EMPTY_HINT}")

@@ -22,11 +22,15 @@ from analysis.level_series import TABLE_PARAMETERS, Level, LevelSeries, concise
 from app import style
 from app.grid_axis import show_grid
 from app.parameter_table import format_value
+from app.plot_placeholder import PlotPlaceholder
 
 FIXED_COLUMNS = ("Level (V RMS)", "Peak (mm)", "Small signal")
 LARGE = "#e08a00"               # levels beyond small signal: orange, beside the blue small-signal points
 SYMBOL_SIZE = 9
 EMPTY_TEXT = "No level series: analyse recordings made at rising drive levels (linpar levels FILE...)."
+
+
+EMPTY_PLOT = "No data yet: choose recordings at rising levels."
 
 
 class LevelSeriesPlot(pg.PlotWidget):
@@ -48,6 +52,7 @@ class LevelSeriesPlot(pg.PlotWidget):
                                      symbolBrush=pg.mkBrush(LARGE), name="large signal (distortion)")
         for item in (self.line, self.error, self.small, self.large):
             plot.addItem(item)
+        self.placeholder = PlotPlaceholder(self, EMPTY_PLOT)
 
     def set_series(self, series: LevelSeries) -> None:
         curve = series.fs_curve()
@@ -61,11 +66,13 @@ class LevelSeriesPlot(pg.PlotWidget):
         self.large.setData(x[~small], fs[~small])
         self.getPlotItem().setTitle("resonance frequency against peak excursion")
         self.getPlotItem().enableAutoRange()
+        self.placeholder.hide()
 
     def clear_series(self) -> None:
         for item in (self.line, self.small, self.large):
             item.setData([], [])
         self.error.setData(x=np.zeros(0), y=np.zeros(0), top=np.zeros(0), bottom=np.zeros(0))
+        self.placeholder.show_text(EMPTY_PLOT)
 
 
 class LevelSeriesTable(QTableWidget):

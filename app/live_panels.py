@@ -24,6 +24,7 @@ from analysis.live import DB_FLOOR, LiveFrame
 from analysis.recording import UNITS
 from app import style
 from app.grid_axis import show_grid
+from app.plot_placeholder import PlotPlaceholder
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
 from app.traffic_light import CHANNELS, ChannelLight
 
@@ -63,11 +64,13 @@ class CompactPlotWidget(pg.PlotWidget):
 
     pyqtgraph's views ask for 640 x 480; in a scrolled page with word-wrapped
     labels the page's height follows the sum of the hints, so three panels
-    would ask for a page two screens tall.
+    would ask for a page two screens tall. The hint is the minimum: a page with word-wrapped labels is
+    laid out at its hinted height, and three panels asking for more pushed the Displacement panel
+    below a scroll bar on a 720 px screen; they stretch into whatever room the page has.
     """
 
     def sizeHint(self) -> QSize:
-        return QSize(400, 150)
+        return QSize(400, 80)
 
 
 class LogBuckets:
@@ -105,7 +108,7 @@ class LiveChannelPanel(QWidget):
         self.channel = channel
         self.light = ChannelLight(channel, 14, compact=True)
         self.plot_widget = CompactPlotWidget(axisItems={"bottom": SparseFrequencyAxis("bottom")})
-        self.plot_widget.setMinimumHeight(120)
+        self.plot_widget.setMinimumHeight(80)      # three of them fit a 720 px screen
         plot = self.plot = self.plot_widget.getPlotItem()
         plot.setLogMode(x=True, y=False)
         # The axis' own horizontal grid costs ~10 ms a panel per repaint (the GIL held all along): the
@@ -145,12 +148,16 @@ class LiveChannelPanel(QWidget):
         layout.setSpacing(2)
         layout.addWidget(self.light)
         layout.addWidget(self.plot_widget, 1)
+        self.empty_text = "No data yet."
+        self.placeholder = PlotPlaceholder(self.plot_widget, self.empty_text)
 
     def show_frame(self, frame: LiveFrame) -> None:
         ch = frame.channels.get(self.channel)
         if ch is None:
             self.clear("absent")
+            self.placeholder.show_text(f"No {self.channel} channel in this measurement.")
             return
+        self.placeholder.hide()
         self.light.set_state(ch.status, ch.findings)
         if ch.unit != self._unit:          # a new label re-lays the axis out: only when it changes
             self._unit = ch.unit
@@ -206,6 +213,7 @@ class LiveChannelPanel(QWidget):
         for item in (self.lines, self.distortion, self.noise, self.y_grid):
             item.setData([], [])
         self.light.set_state(status, ())
+        self.placeholder.show_text(self.empty_text)
         self._y_range = None
         self._freqs_key = None             # the next frame sets the frequency axis to its own lines
         if band_hz is not None:            # the axis laid out before the first frame, not with it
@@ -218,9 +226,13 @@ class LivePanels(QWidget):
 
     repainted = Signal(int)         # the frame's n_periods, after it was drawn
 
-    def __init__(self, parent=None):
+    def __init__(self, empty_text: str = "No data yet.", parent=None):
         super().__init__(parent)
         self.panels = {name: LiveChannelPanel(name, frequency_label=name == CHANNELS[-1]) for name in CHANNELS}
+        self.empty_text = empty_text
+        for panel in self.panels.values():
+            panel.empty_text = empty_text
+            panel.placeholder.show_text(empty_text)
         self.status = QLabel("No measurement running: the spectra appear here period by period.")
         self.status.setWordWrap(True)
         self.status.setTextFormat(Qt.RichText)
@@ -292,6 +304,8 @@ class LivePanels(QWidget):
         self._drawing += 1
         self.timer.stop()
         self.status.setText(f"{text} {LEGEND}")
+        for panel in self.panels.values():       # until the first period, say so where the lines will be
+            panel.empty_text = text
         self._clear_channel(self._drawing, list(self.panels.values()), band_hz)
 
     def _clear_channel(self, drawing: int, panels: list, band_hz: tuple[float, float] | None) -> None:

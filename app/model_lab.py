@@ -102,8 +102,11 @@ class ModelLab(QWidget):
         splitter.addWidget(self.catalogue)
         splitter.addWidget(middle)
         splitter.addWidget(right)
-        splitter.setStretchFactor(1, 1)
-        splitter.setSizes([330, 640, 410])
+        # Every column gives and takes space in proportion: on a 1280 px screen the middle one, with the
+        # residual plots and the candidates, would otherwise be squeezed to what the sides leave.
+        for index, stretch in enumerate((2, 5, 3)):
+            splitter.setStretchFactor(index, stretch)
+        splitter.setSizes([280, 640, 380])
         self.splitter = splitter
 
         content = QWidget()

@@ -15,13 +15,14 @@ from analysis.diagnosis_words import VERDICT_TITLES
 from app.lab_worker import CandidateRow, DiagnosisOutcome
 from app.model_lab_catalogue import category_title
 
-COLUMNS = ("#", "Action", "Effect", "Category", "Fit", "χ²ᵣ Z", "χ²ᵣ Hx", "Acceptable")
-RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, CHI2_Z, CHI2_X, JUDGED = range(len(COLUMNS))
+# The reduced chi^2 per channel is in the Fit cell's tooltip: the columns must fit a 1280 px screen.
+COLUMNS = ("#", "Action", "Effect", "Category", "Fit", "Acceptable")
+RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, JUDGED = range(len(COLUMNS))
 # The word scale of a BIC change (Kass and Raftery's grades of evidence), the best grade first.
 FIT_WORDS = ((-10.0, "fits far better"), (-6.0, "fits better"), (-2.0, "slightly better"), (2.0, "no better"))
 WORSE = "fits worse"
 BAR_CELLS = 8
-CHI2_COLUMNS = {"impedance": CHI2_Z, "displacement": CHI2_X}
+CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
 NO_DIAGNOSIS = ("Diagnose tries every effect one move away from the current model (add one of a new category, "
                 "or swap one for an alternative), refits each and ranks them by how much they lower BIC. An effect "
                 "is taken only when it also explains the misfit it removes; when none does, the diagnosis says "
@@ -64,12 +65,14 @@ def fit_bar(delta_bic: float, best_gain: float) -> str:
     return "▰" * filled + "▱" * (BAR_CELLS - filled)
 
 
-def fit_tooltip(delta_bic: float) -> str:
-    if not math.isfinite(delta_bic):
-        return "The refit of this candidate failed."
-    return (f"{fit_words(delta_bic).capitalize()} than the current model, its extra parameters paid for.\n"
-            f"Details: the Bayesian information criterion changes by {bic_text(delta_bic)} "
-            "(below -10: far better; -6 to -10: better; -2 to -6: slightly; above -2: no better).")
+def fit_tooltip(row: CandidateRow) -> str:
+    if not math.isfinite(row.delta_bic) or row.fitted is None:
+        return "The refit of this candidate failed" + (f": {row.error}" if row.error else ".")
+    chi2 = ", ".join(f"{CHANNEL_SHORT.get(k, k)} {v:.3g}" for k, v in row.chi2_red.items())
+    return (f"{fit_words(row.delta_bic).capitalize()} than the current model, its extra parameters paid for.\n"
+            f"Details: the Bayesian information criterion changes by {bic_text(row.delta_bic)} "
+            "(below -10: far better; -6 to -10: better; -2 to -6: slightly; above -2: no better); "
+            f"reduced χ² with it: {chi2} (1 is the noise floor).")
 
 class CandidatesPanel(QWidget):
     selected_changed = Signal()
@@ -113,7 +116,10 @@ class CandidatesPanel(QWidget):
         header = self.table.horizontalHeader()
         for column in range(len(COLUMNS)):
             header.setSectionResizeMode(column, QHeaderView.ResizeToContents)
-        header.setSectionResizeMode(CATEGORY, QHeaderView.Stretch)
+        # The effect's title takes what is left, elided (whole in its tooltip); the category is read whole.
+        header.setSectionResizeMode(EFFECT, QHeaderView.Stretch)
+        self.table.setTextElideMode(Qt.ElideRight)
+        self.table.setWordWrap(False)
         self.table.itemSelectionChanged.connect(self.on_selection_changed)
 
         self.explanation = QTextBrowser()
@@ -139,19 +145,17 @@ class CandidatesPanel(QWidget):
         best_gain = max(gains, default=0.0)
         for r, row in enumerate(self.rows):
             # Read across, "replace <title> by" + "<title>" is the move; the ids are in the tooltips.
-            action = f"replace {row.replaces.title} by" if row.replaces is not None else "add"
-            cells = {RANK: str(r + 1), ACTION: action, EFFECT: row.effect.title,
+            action = "replace" if row.replaces is not None else "add"
+            effect = row.effect.title if row.replaces is None else f"{row.effect.title} for {row.replaces.title}"
+            cells = {RANK: str(r + 1), ACTION: action, EFFECT: effect,
                      CATEGORY: category_title(row.effect.category),
                      DELTA_BIC: f"{fit_bar(row.delta_bic, best_gain)} {fit_words(row.delta_bic)}"}
-            for channel, column in CHI2_COLUMNS.items():
-                value = row.chi2_red.get(channel)
-                cells[column] = f"{value:.3g}" if value is not None else ("–" if row.fitted else "failed")
             cells[JUDGED] = JUDGEMENT_WORDS.get(row.judgement, row.judgement)
             if row is chosen:
                 cells[JUDGED] = "yes: the best"
             for column, text in cells.items():
                 item = QTableWidgetItem(text)
-                if column in (RANK, CHI2_Z, CHI2_X):
+                if column == RANK:
                     item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
                 if column == EFFECT:
                     item.setToolTip(f"{row.effect.title} (id {row.effect.id}): {row.effect.category} effect")
@@ -160,9 +164,7 @@ class CandidatesPanel(QWidget):
                 if column == CATEGORY:
                     item.setToolTip(category_title(row.effect.category))
                 if column == DELTA_BIC:
-                    item.setToolTip(fit_tooltip(row.delta_bic))
-                if column in (CHI2_Z, CHI2_X):
-                    item.setToolTip("Reduced χ² of the channel with this candidate: 1 is a fit down to the noise")
+                    item.setToolTip(fit_tooltip(row))
                 if column == JUDGED:
                     item.setToolTip(JUDGEMENT_TIPS.get(row.judgement, ""))
                 if row.accepted and column in (DELTA_BIC, JUDGED):

@@ -60,12 +60,12 @@ class ResidualPlot(pg.PlotWidget):
         res = curves.residual
         self.real.setData(curves.freqs, res.real)
         self.imag.setData(curves.freqs, np.imag(res))
-        name = "Impedance Z" if self.channel == "impedance" else "Displacement Hx"
-        # In the title rather than a legend: a legend would cover the points.
+        # In the title rather than a legend: a legend would cover the points. Short: a title wider than the
+        # plot would set its minimum width, and the lab's middle column is ~500 px on a 1280 px screen.
         self.getPlotItem().setTitle(
-            f"{name}, (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span> "
-            f"<span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span> part; "
-            f"reduced χ² = {curves.chi2_red:.3g}",
+            f"{CHANNEL_SHORT[self.channel]}: (model − measured)/σ, "
+            f"<span style='color:{style.RESIDUAL_REAL}'>● real</span> "
+            f"<span style='color:{style.RESIDUAL_IMAG}'>▼ imag.</span>, χ²ᵣ {curves.chi2_red:.3g}",
             size="9pt")
         # Every point in view, unlike the Results page's clipped strip: here the size of a misfit
         # (thousands of sigma before an effect is added, one after) is the point.

@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 from typing import Mapping
 
+import numpy as np
+
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
 from PySide6.QtGui import QBrush, QColor, QFont
 from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeaderView, QLabel, QTableView,
@@ -90,21 +92,24 @@ def format_value(p: ParameterValue, all_digits: bool = True) -> tuple[str, str]:
 
 
 def short_value(p: ParameterValue) -> tuple[str, str]:
-    """(value, 1-sigma): as many significant digits as the sigma supports (its second digit), at most 4."""
+    """(value, 1-sigma): as many significant digits as the sigma supports (its second digit), at most 4;
+    the sigma with 2 significant digits, written out without an exponent."""
     value = p.value * p.display_scale
     std = None if p.std is None else p.std * abs(p.display_scale)
     known = std is not None and math.isfinite(std) and std > 0
+    std_text = (np.format_float_positional(std, precision=2, unique=False, fractional=False, trim="-")
+                if known else "–")
     if value == 0 or not math.isfinite(value):
-        return (f"{value:.{DEFAULT_DIGITS}g}", f"{std:.2g}" if known else "–")
+        return f"{value:.{DEFAULT_DIGITS}g}", std_text
     magnitude = math.floor(math.log10(abs(value)))
     digits = DEFAULT_DIGITS
     if known:
         digits = max(1, min(DEFAULT_DIGITS, magnitude - math.floor(math.log10(std)) + 2))
     decimals = digits - 1 - magnitude
     if abs(value) >= 1e6 or decimals > 9:
-        return f"{value:.{digits}g}", (f"{std:.2g}" if known else "–")
-    text = f"{round(value, decimals):.{max(0, decimals)}f}"
-    return text, (f"{std:.2g}" if known else "–")
+        return f"{value:.{digits}g}", std_text
+    return f"{round(value, decimals):.{max(0, decimals)}f}", std_text
+
 
 class ParameterModel(QAbstractTableModel):
     def __init__(self, parent=None):

@@ -13,10 +13,12 @@ from PySide6.QtCore import Qt
 
 from app import style
 from app.grid_axis import OpaqueGridAxis, show_grid
+from app.plot_placeholder import PlotPlaceholder
 
 LEFT_AXIS_WIDTH = 72          # the same on every row, so that the x axes line up
 RESIDUAL_MIN_RANGE = 4.0      # sigma: the +-3 guides always stay in view
 RESIDUAL_MAX_RANGE = 30.0     # beyond that, outliers are clipped so the rest stays readable
+NO_CURVES = "Nothing to draw: no fitted measurement (the validity above says why)."
 
 
 class LogFrequencyAxis(OpaqueGridAxis):
@@ -136,10 +138,12 @@ class TransferPlot(pg.GraphicsLayoutWidget):
                                              symbolBrush=pg.mkBrush(style.RESIDUAL_IMAG), name="imag")
         self.residual.addItem(self.residual_real)
         self.residual.addItem(self.residual_imag)
+        self.placeholder = PlotPlaceholder(self, NO_CURVES)
 
     def set_curves(self, curves, title: str) -> None:
         """Draw an app.result_curves.ChannelCurves."""
         k = self.display_scale
+        self.placeholder.hide()
         self.magnitude.setTitle(title)
         magnitude = np.abs(curves.measured) * k
         self.magnitude_measured.setData(curves.freqs, magnitude)
@@ -176,6 +180,7 @@ class TransferPlot(pg.GraphicsLayoutWidget):
             item.setData([], [])
         for item in (self.magnitude_error, self.phase_error):
             item.setData(x=np.zeros(0), y=np.zeros(0), top=np.zeros(0), bottom=np.zeros(0))
+        self.placeholder.show_text(NO_CURVES)
 
 
 class SplPlot(pg.GraphicsLayoutWidget):

@@ -27,6 +27,7 @@ production-1280x720.png and production-1920x1080.png: the Production page
 over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
 station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
+--only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
 """
@@ -500,8 +501,14 @@ def settle(app: QApplication, ms: int = 300) -> None:
     app.processEvents()
 
 
+def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_pages import every_page_screenshots
+    return every_page_screenshots(app, window, folder, out)
+
+
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
-        "large-signal": large_signal_screenshots, "production": production_screenshots}
+        "large-signal": large_signal_screenshots, "production": production_screenshots,
+        "pages": pages_screenshots}
 
 
 def main(argv: list[str]) -> int:

@@ -79,7 +79,7 @@ class MeasurePage(WizardPage):
         self.large_signal = LargeSignalLimits()
         self.large_signal.setVisible(False)
         self.large_signal_done = None           # the last large-signal plan's LargeSignalMeasured
-        self.panels = LivePanels()
+        self.panels = LivePanels("No data yet: start the measurement.")
         top = QHBoxLayout()
         top.addWidget(self.summary, 1)
         top.addWidget(self.folder_button)

@@ -70,8 +70,7 @@ def test_fit_quality_and_validity(shown):
     headline = shown.fit_quality.headline.text()
     # In words: the model by its effects' titles, and how well it explains each channel.
     assert "LR-2" in headline and "Logarithmic creep" in headline
-    assert "explains the impedance down to its noise" in headline
-    assert "explains the displacement down to its noise" in headline
+    assert "explains the impedance and the displacement down to their noise" in headline
     for part in ("χ²", "AIC", "BIC", "lr2"):
         assert part not in headline
     # The numbers behind it, folded away until asked for.
