@@ -2,8 +2,9 @@
 
 One clause per channel:
 - reduced chi^2 up to NOISE_LEVEL: "explains the impedance down to its noise";
-- a band of misfit (analysis.residuals): "misses 12 % of the impedance between 200 and 800 Hz",
-  the percentage being the largest relative deviation |measured - model| / |model| in the band;
+- a band of misfit (analysis.residuals) holding at least BAND_SHARE of the channel's misfit: "misses 12 % of
+  the impedance between 200 and 800 Hz", the percentage being the largest relative deviation
+  |measured - model| / |model| in the band;
 - otherwise: "explains the impedance to within 2.3 times its noise" (misfit spread over the range).
 The numbers (reduced chi^2, AIC, BIC, counts) go to the details, never to the headline.
 """
@@ -18,6 +19,9 @@ from analysis.residuals import channel_finding
 
 # A reduced chi^2 this close to 1 is noise: the model has nothing left to explain.
 NOISE_LEVEL = 1.5
+# A band holding less of the channel's misfit than this is a peak of a misfit spread everywhere, not the place
+# the model misses.
+BAND_SHARE = 0.25
 CHANNEL_NAMES = {"impedance": "impedance", "displacement": "displacement"}
 
 
@@ -43,7 +47,7 @@ def channel_clause(ch: ChannelFit) -> str:
     if ch.chi2_red <= NOISE_LEVEL:
         return f"explains the {what} down to its noise"
     finding = channel_finding(ch)
-    if finding is not None:
+    if finding is not None and finding.share >= BAND_SHARE:
         percent = _band_deviation_percent(ch, finding.f_low, finding.f_high)
         if math.isfinite(percent):
             amount = f"{percent:.2g} %" if percent >= 0.1 else "less than 0.1 %"

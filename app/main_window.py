@@ -198,7 +198,7 @@ class MainWindow(QMainWindow):
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {self._titles.get(outcome.path, outcome.path.name)}")
         fit = outcome.result.fit
-        model = f"model {fit.model.describe()}" if fit is not None else "nothing could be fitted"
+        model = "fitted" if fit is not None else "nothing could be fitted"
         self.status_label.setText(f"Loaded {outcome.path} — {model}, analysed in {elapsed:.2g} s")
         self.result_pages.after(lambda: self.analysis_shown.emit(outcome))
 
