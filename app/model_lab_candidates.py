@@ -69,7 +69,8 @@ def fit_tooltip(row: CandidateRow) -> str:
     if not math.isfinite(row.delta_bic) or row.fitted is None:
         return "The refit of this candidate failed" + (f": {row.error}" if row.error else ".")
     chi2 = ", ".join(f"{CHANNEL_SHORT.get(k, k)} {v:.3g}" for k, v in row.chi2_red.items())
-    return (f"{fit_words(row.delta_bic).capitalize()} than the current model, its extra parameters paid for.\n"
+    return (f"{fit_words(row.delta_bic).capitalize()} than the current model, once its extra parameters are "
+            "paid for.\n"
             f"Details: the Bayesian information criterion changes by {bic_text(row.delta_bic)} "
             "(below -10: far better; -6 to -10: better; -2 to -6: slightly; above -2: no better); "
             f"reduced χ² with it: {chi2} (1 is the noise floor).")
@@ -144,7 +145,7 @@ class CandidatesPanel(QWidget):
         gains = [-row.delta_bic for row in self.rows if math.isfinite(row.delta_bic)]
         best_gain = max(gains, default=0.0)
         for r, row in enumerate(self.rows):
-            # Read across, "replace <title> by" + "<title>" is the move; the ids are in the tooltips.
+            # Read across: "replace" + "<new title> for <old title>" is the move; the ids are in the tooltips.
             action = "replace" if row.replaces is not None else "add"
             effect = row.effect.title if row.replaces is None else f"{row.effect.title} for {row.replaces.title}"
             cells = {RANK: str(r + 1), ACTION: action, EFFECT: effect,
@@ -182,8 +183,9 @@ class CandidatesPanel(QWidget):
             self.title.setText(f"{self._heading}: {len(self.rows)} candidates, best first")
             self.show_verdict(outcome)
             chosen = next((i for i, row in enumerate(self.rows) if row.accepted), None)
-            # After a greedy path the candidates are what it refused: nothing is offered first.
-            if chosen is None or outcome.path:    # none would be taken, or the path took them: nothing first
+            # None would be taken, or a greedy path took them and these are what it refused: the verdict
+            # instead of a candidate offered first.
+            if chosen is None or outcome.path:
                 self.explanation.setHtml(f"<p>{html.escape(outcome.verdict_text)}</p>" if outcome.verdict_text
                                          else "<p>No candidate was ranked from this model: Diagnose to rank "
                                               "from it.</p>")

@@ -77,5 +77,8 @@ def test_series_and_large_signal_analyses_show_their_work_at_once(qtbot, window,
     large.analyse(paths)
     _shows_work(large.progress, large.cancel_button, large.status.text())
     qtbot.mouseClick(large.cancel_button, Qt.LeftButton)
+    # The workers' threads end before the window goes: a thread emitting into a deleted page raises.
+    assert series.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)
+    assert large.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)
     qtbot.waitUntil(lambda: large.choose_button.isEnabled() and panel.choose_button.isEnabled(),
                     timeout=ANALYSIS_TIMEOUT_MS)

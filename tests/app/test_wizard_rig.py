@@ -24,7 +24,7 @@ def test_a_whole_run_on_the_virtual_rig(qtbot, settings, tmp_path, virtual_rig):
         assert hardware.rig_radio.isChecked()            # the rig runs: it is the default
         assert "running" in plain(hardware.rig_status)
         run_job(qtbot, hardware.test_audio_button, hardware.audio_jobs)
-        assert "Found: SoundDeviceAudio" in plain(hardware.audio_result)
+        assert f"Found: JACK virtual rig '{virtual_rig.name}'" in plain(hardware.audio_result)
         wizard.next_button.click()
         assert wizard.next_button.isEnabled()            # the rig needs no corrections
         wizard.next_button.click()
