@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import argparse
 import json
+from typing import TYPE_CHECKING
 
-from analysis.effects import CATALOGUE, Effect, categories
-from analysis.effects import registry
+from analysis.config_folder import EFFECTS_FOLDER_ENV, config_folder
+
+if TYPE_CHECKING:       # the catalogue (and scipy) is loaded by the commands that use it, not by every start
+    from analysis.effects import Effect
 
 # The commands that build models from effect ids (and so may name effects of the user's own).
 COMMANDS = ("analyze", "diagnose", "effects", "report", "export", "archive", "addedmass", "stats", "levels")
@@ -19,11 +22,12 @@ COMMANDS = ("analyze", "diagnose", "effects", "report", "export", "archive", "ad
 def add_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--effects-file", dest="effects_files", action="append", default=[], metavar="FILE",
                         help="an effect of your own (TOML; repeatable), beside the catalogue and the user folder "
-                             f"(${registry.FOLDER_ENV} or {registry.config_folder() / 'effects'})")
+                             f"(${EFFECTS_FOLDER_ENV} or {config_folder() / 'effects'})")
 
 
 def load(args: argparse.Namespace) -> tuple[Effect, ...]:
     """Read and register the user's effects (registry.EffectFileError, one line, when one is bad)."""
+    from analysis.effects import registry
     effects = registry.load_user_effects(getattr(args, "effects_files", None) or ())
     registry.register(effects)
     return effects
@@ -35,6 +39,7 @@ def _parameters_text(effect: Effect) -> str:
 
 
 def cmd_effects(args: argparse.Namespace) -> int:
+    from analysis.effects import CATALOGUE, categories, registry
     users = registry.user_effects()
     if args.json:
         print(json.dumps([e.describe() for e in (*CATALOGUE.values(), *users)], indent=1))

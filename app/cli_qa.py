@@ -86,10 +86,10 @@ def _limits_version(archive, args):
     return archive.limits(args.limits_version) if args.limits_version else archive.limits()
 
 
-def _stats(archive, args):
+def _stats(archive, args, with_stds: bool = True):
     from analysis.production import production_stats
     selection = _selection(args)
-    population = archive.population(selection, args.parameter or None)
+    population = archive.population(selection, args.parameter or None, with_stds)
     limits = _limits_version(archive, args)
     return population, production_stats(population, limits, getattr(args, "baseline", 50), args.parameter or None,
                                         selection.describe())
@@ -105,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_stats(archive, args) -> int:
-    _population, stats = _stats(archive, args)
+    _population, stats = _stats(archive, args, with_stds=False)     # the statistics need no standard deviations
     if args.json:
         print(dumps({"archive": archive.location, **stats.as_json()}))
     else:

@@ -35,7 +35,7 @@ from analysis.archive.leftovers import STALE_AFTER_S, sweep
 from analysis.archive.names import ArchiveError, check_id
 from analysis.archive.record import (Entry, checked_entry, checked_parameter, checked_qa, entry_of, one_line_text,
                                      read_record)
-from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate
+from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate, std_column, value_column
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
 INDEX_FILE = "index.sqlite"
@@ -362,14 +362,16 @@ def insert(conn: sqlite3.Connection, record: dict) -> None:
 def _insert(conn: sqlite3.Connection, record: dict) -> None:
     e = entry_of(record)
     conn.execute("DELETE FROM parameters WHERE measurement_id = ?", (e.id,))
-    conn.execute("INSERT INTO measurements (id, folder, measured_at, stored_at, driver, serial, operator, station, "
-                 "validity, effects, verdict, limits_version) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
-                 (e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station,
-                  e.validity, ",".join(e.effects), e.verdict, e.limits_version))
-    for name in KEY_PARAMETERS:
-        p = e.parameters.get(name)
-        if p is None:
-            continue
+    kept = {name: p for name in KEY_PARAMETERS if (p := e.parameters.get(name)) is not None}
+    columns = ["id", "folder", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity",
+               "effects", "verdict", "limits_version"]
+    values = [e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station, e.validity,
+              ",".join(e.effects), e.verdict, e.limits_version]
+    for name, p in kept.items():        # the statistics' copy of the key parameters (schema.value_column)
+        columns += [value_column(name), std_column(name)]
+        values += [_real(p.get("value")), _real(p.get("std"))]
+    conn.execute(f"INSERT INTO measurements ({', '.join(columns)}) VALUES ({', '.join('?' * len(values))})", values)
+    for name, p in kept.items():
         conn.execute("INSERT INTO parameters VALUES (?, ?, ?, ?, ?)",
                      (e.id, name, _real(p.get("value")), _real(p.get("std")), str(p.get("unit", ""))))
 

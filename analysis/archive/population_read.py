@@ -2,19 +2,11 @@
 
 `linpar qa stats` over a line's 100,000 units must take about a second, and
 turning 2.4 million numbers into Python objects one at a time takes more than
-that alone. So each back end hands its numbers over in the cheapest way it has:
-
-PostgreSQL  the server packs each parameter's (position, value, std) into one
-            bytea of fixed-size binary records (int4send, float8send: network
-            byte order), read as one numpy structured array; the who, where and
-            when (strings) come as plain rows. The two queries run in one
-            REPEATABLE READ transaction, so that both see the same units and
-            the positions, row numbers in the time order, match.
-SQLite      the sqlite3 module can only give rows, so one statement gives one
-            row per unit with its parameters beside it (a left join per
-            parameter on the key (measurement_id, name): no grouping) and the
-            numbers go into arrays column by column. One statement: one
-            snapshot.
+that alone. So the key parameters are also columns of the measurement's own
+row (analysis.archive.schema.value_column, written with it): one statement
+gives one row per unit, without joining the 1.2 million parameter rows or
+grouping, and the numbers go into arrays a column at a time. PostgreSQL sends
+its rows in binary (the doubles as they are). One statement: one snapshot.
 
 Both order the units by (measured_at, id): oldest first, ties broken the same
 way every time. Values are exact: binary doubles on PostgreSQL, the REAL
@@ -26,7 +18,7 @@ import numpy as np
 
 from analysis.archive.names import ArchiveError
 from analysis.archive.population import Population, Selection, finite_or_nan
-from analysis.archive.schema import KEY_PARAMETERS
+from analysis.archive.schema import KEY_PARAMETERS, std_column, value_column
 
 # The columns that say who, where and when, in the order the readers select them (Population's first fields).
 HEADS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict", "limits_version")
@@ -67,20 +59,30 @@ def empty_population(names=None, with_stds: bool = True) -> Population:
     return _population([()] * len(HEADS), {n: () for n in names}, {n: () for n in names} if with_stds else {})
 
 
-# --- SQLite ------------------------------------------------------------------------------------------
+def population_sql(names, with_stds: bool, where: str) -> str:
+    """One row per unit, oldest first: HEADS, then each name's value (and std) from the measurement's own
+    columns (schema.value_column): no join, no grouping."""
+    numbers = [c for n in names for c in ((value_column(n), std_column(n)) if with_stds else (value_column(n),))]
+    return f"SELECT {', '.join(f'm.{c}' for c in (*HEADS, *numbers))} FROM measurements m{where} ORDER BY {ORDER}"
 
 
 def read_sqlite(conn, selection: Selection, names=None, with_stds: bool = True) -> Population:
     """The population from an index (a sqlite3 connection): one statement, one row per unit."""
     names = checked_names(names)
     where, args = where_clause(selection, "?")
-    selected = [f"m.{c}" for c in HEADS]
-    for i in range(len(names)):
-        selected += [f"p{i}.value", f"p{i}.std"] if with_stds else [f"p{i}.value"]
-    joins = "".join(f" LEFT JOIN parameters p{i} ON p{i}.measurement_id = m.id AND p{i}.name = ?"
-                    for i in range(len(names)))
-    sql = f"SELECT {', '.join(selected)} FROM measurements m{joins}{where} ORDER BY {ORDER}"
-    rows = conn.execute(sql, [*names, *args]).fetchall()
+    return _from_rows(conn.execute(population_sql(names, with_stds, where), args).fetchall(), names, with_stds)
+
+
+def read_postgres(conn, selection: Selection, names=None, with_stds: bool = True) -> Population:
+    """The population from the server (a psycopg connection, search_path linpar): one statement, binary rows."""
+    names = checked_names(names)
+    where, args = where_clause(selection, "%s")
+    rows = conn.cursor(binary=True).execute(population_sql(names, with_stds, where), args).fetchall()
+    return _from_rows(rows, names, with_stds)
+
+
+def _from_rows(rows, names, with_stds: bool) -> Population:
+    """Rows of HEADS then each name's value (and std) -> a Population, the numbers a column at a time."""
     by_column = list(zip(*rows)) if rows else [()] * (len(HEADS) + len(names) * (2 if with_stds else 1))
     numbers = iter(by_column[len(HEADS):])
     values, stds = {}, {}
@@ -89,45 +91,3 @@ def read_sqlite(conn, selection: Selection, names=None, with_stds: bool = True) 
         if with_stds:
             stds[name] = finite_or_nan(np.array(next(numbers), dtype=float))
     return _population(by_column[:len(HEADS)], values, stds)
-
-
-# --- PostgreSQL --------------------------------------------------------------------------------------
-
-_RECORD = [("position", ">i4"), ("value", ">f8")]
-_RECORD_STD = _RECORD + [("std", ">f8")]
-
-
-def packed_sql(where: str, with_stds: bool) -> str:
-    """Per parameter one bytea of records (position in the time order, value[, std]); NULL packed as NaN."""
-    record = "int4send(c.k) || float8send(coalesce(p.value, 'NaN'))"
-    if with_stds:
-        record += " || float8send(coalesce(p.std, 'NaN'))"
-    return (f"SELECT p.name, string_agg({record}, ''::bytea) "
-            f"FROM (SELECT m.id, (row_number() OVER (ORDER BY {ORDER}) - 1)::int4 AS k FROM measurements m{where}) c "
-            f"JOIN parameters p ON p.measurement_id = c.id WHERE p.name = ANY(%s) GROUP BY p.name")
-
-
-def read_postgres(conn, selection: Selection, names=None, with_stds: bool = True) -> Population:
-    """The population from the server (a psycopg connection in autocommit, search_path linpar)."""
-    from psycopg import IsolationLevel
-    names = checked_names(names)
-    where, args = where_clause(selection, "%s")
-    conn.isolation_level, conn.read_only = IsolationLevel.REPEATABLE_READ, True
-    try:
-        with conn.transaction():
-            heads = conn.execute(f"SELECT {', '.join(f'm.{c}' for c in HEADS)} FROM measurements m{where} "
-                                 f"ORDER BY {ORDER}", args).fetchall()
-            packed = conn.cursor(binary=True).execute(packed_sql(where, with_stds), [*args, list(names)]).fetchall()
-    finally:
-        conn.isolation_level, conn.read_only = None, None
-    n = len(heads)
-    values = {name: np.full(n, np.nan) for name in names}
-    stds = {name: np.full(n, np.nan) for name in names} if with_stds else {}
-    for name, blob in packed:
-        records = np.frombuffer(blob, dtype=_RECORD_STD if with_stds else _RECORD)
-        values[name][records["position"]] = records["value"]
-        if with_stds:
-            stds[name][records["position"]] = records["std"]
-    for column in (*values.values(), *stds.values()):
-        column[~np.isfinite(column)] = np.nan           # an infinity the server kept judges nothing
-    return _population(zip(*heads) if heads else [()] * len(HEADS), values, stds)

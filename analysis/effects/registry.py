@@ -18,29 +18,18 @@ from __future__ import annotations
 
 import importlib.metadata
 import os
-import sys
 from pathlib import Path
 from typing import Iterable, Sequence
 
+from analysis.config_folder import EFFECTS_FOLDER_ENV, config_folder
 from analysis.effects.base import Effect, ParamSpec
 from analysis.effects.user import EffectFileError, UserEffect, load_effect_file
 
 ENTRY_POINT_GROUP = "linpar.effects"
-FOLDER_ENV = "LINPAR_EFFECTS"
+FOLDER_ENV = EFFECTS_FOLDER_ENV
 
 _USER: dict[str, Effect] = {}      # by id, in the order loaded
 _PACKAGE_SOURCES: dict[str, str] = {}   # id -> the entry point an effect of a package came from
-
-
-def config_folder() -> Path:
-    """linpar's folder in the platform's configuration folder."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("APPDATA") or Path.home() / "AppData" / "Roaming")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config")
-    return base / "linpar"
 
 
 def user_folder() -> Path:

@@ -21,6 +21,7 @@ length): an alarm is a reason to look, not a verdict.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,7 +69,7 @@ class ControlChart:
     sigma: float                    # within, from the baseline's moving ranges
     moving_ranges: np.ndarray       # |x[i] - x[i-1]|, i = 1 ... n-1
     mr_centre: float
-    alarms: tuple[Alarm, ...]
+    alarms: Sequence[Alarm]         # an AlarmList: each Alarm made when it is read
 
     @property
     def ucl(self) -> float:
@@ -105,34 +106,51 @@ def control_chart(values, baseline: int = DEFAULT_BASELINE) -> ControlChart | No
         return None
     centre = float(np.mean(x[:b]))
     z = (x - centre) / sigma
-    alarms = [a for rule in _ZONE_RULES for a in _zone_alarms(z, rule)] + _jump_alarms(mr, D4_PAIRS * mr_centre)
-    alarms.sort(key=lambda a: (a.triggers[0], a.rule))
-    return ControlChart(x, b, centre, sigma, mr, mr_centre, tuple(alarms))
+    runs = [r for rule in _ZONE_RULES for r in _zone_alarms(z, rule)] + _jump_alarms(mr, D4_PAIRS * mr_centre)
+    return ControlChart(x, b, centre, sigma, mr, mr_centre, AlarmList(runs))
 
 
-def _zone_alarms(z: np.ndarray, rule: str) -> list[Alarm]:
+def _zone_alarms(z: np.ndarray, rule: str) -> list["_Runs"]:
     window, needed, zone = _ZONE_RULES[rule]
-    alarms: list[Alarm] = []
+    runs: list[_Runs] = []
     if z.size < window:
-        return alarms
+        return runs
     for side, sign in (("above", 1.0), ("below", -1.0)):
         beyond = sign * z > zone
         counts = np.convolve(beyond.astype(int), np.ones(window, dtype=int), mode="valid")   # window ending at i
         fired = np.flatnonzero((counts >= needed) & beyond[window - 1:]) + window - 1
-        alarms += _grouped(rule, side, fired, fired - window + 1, beyond)
-    return alarms
+        runs += _grouped(rule, side, fired, fired - window + 1, beyond)
+    return runs
 
 
-def _jump_alarms(mr: np.ndarray, limit: float) -> list[Alarm]:
+def _jump_alarms(mr: np.ndarray, limit: float) -> list["_Runs"]:
     # The moving range k is between points k and k + 1: it fires at k + 1 and involves both.
     fired = np.flatnonzero(mr > limit) + 1
     return _grouped("MR", "", fired, fired - 1, None)
 
 
-def _grouped(rule: str, side: str, fired: np.ndarray, starts: np.ndarray, beyond: np.ndarray | None) -> list[Alarm]:
+@dataclass(frozen=True)
+class _Runs:
+    """The alarms of one rule on one side, as arrays: alarm j involves points[begin[j]:end[j]] and fired at
+    fired[first[j]:last[j]]."""
+    rule: str
+    side: str
+    points: np.ndarray
+    fired: np.ndarray
+    begin: np.ndarray
+    end: np.ndarray
+    first: np.ndarray
+    last: np.ndarray
+
+    def alarm(self, j: int) -> Alarm:
+        return Alarm(self.rule, self.side, tuple(self.points[self.begin[j]:self.end[j]].tolist()),
+                     tuple(self.fired[self.first[j]:self.last[j]].tolist()))
+
+
+def _grouped(rule: str, side: str, fired: np.ndarray, starts: np.ndarray, beyond: np.ndarray | None) -> list[_Runs]:
     """One alarm per run of firings whose windows overlap or touch: every point beyond the line in the run's
-    span (all of them for a jump), and the points where the rule fired. Linear in the number of points, and
-    array work but for one small step per alarm: a drift fires a rule at every unit of 100,000."""
+    span (all of them for a jump), and the points where the rule fired. Array work only, linear in the number
+    of points: a drift fires a rule at every unit of 100,000."""
     if fired.size == 0:
         return []
     breaks = np.flatnonzero(starts[1:] > fired[:-1] + 1) + 1
@@ -143,8 +161,29 @@ def _grouped(rule: str, side: str, fired: np.ndarray, starts: np.ndarray, beyond
         positions = np.arange(int(low.min()), int(high.max()) + 1)
     else:
         positions = np.flatnonzero(beyond)
-    begin = np.searchsorted(positions, low, "left").tolist()
-    end = np.searchsorted(positions, high, "right").tolist()
-    points, fired_all = tuple(positions.tolist()), tuple(fired.tolist())     # slices of tuples are tuples
-    return [Alarm(rule, side, points[b:e], fired_all[f:l])
-            for b, e, f, l in zip(begin, end, first.tolist(), last.tolist())]
+    begin = np.searchsorted(positions, low, "left")
+    end = np.searchsorted(positions, high, "right")
+    return [_Runs(rule, side, positions, fired, begin, end, first, last)]
+
+
+class AlarmList(Sequence):
+    """A chart's alarms in the order (first trigger, rule), every rule's alarms merged, each Alarm made only
+    when it is read: a drifting line raises tens of thousands, and `qa stats` prints ten of them."""
+
+    def __init__(self, runs: list[_Runs]):
+        self._runs = runs
+        which = np.concatenate([np.full(r.first.size, k) for k, r in enumerate(runs)] or [np.zeros(0, int)])
+        index = np.concatenate([np.arange(r.first.size) for r in runs] or [np.zeros(0, int)])
+        trigger = np.concatenate([r.fired[r.first] for r in runs] or [np.zeros(0, int)])
+        ranks = {rule: i for i, rule in enumerate(sorted({r.rule for r in runs}))}
+        rank = np.array([ranks[r.rule] for r in runs], dtype=int)[which] if runs else which
+        order = np.lexsort((rank, trigger))                  # by trigger, then rule's name (a stable sort)
+        self._which, self._index = which[order].tolist(), index[order].tolist()
+
+    def __len__(self) -> int:
+        return len(self._which)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return tuple(self[k] for k in range(*i.indices(len(self))))
+        return self._runs[self._which[i]].alarm(self._index[i])

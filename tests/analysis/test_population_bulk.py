@@ -113,3 +113,49 @@ def test_bulk_population_and_its_statistics_are_the_row_by_row_ones(archive_and_
     assert without_stds.stds == {}
     limits = archive.limits()
     assert production_stats(without_stds, limits).as_json() == production_stats(old, limits).as_json()
+
+
+def _back_to_the_schema_without_columns(archive_and_connection, request) -> None:
+    """Make the archive what the previous schema made: no key parameter columns on measurements."""
+    from analysis.archive.schema import std_column, value_column
+    drops = [f"DROP COLUMN {c(n)}" for n in KEY_PARAMETERS for c in (value_column, std_column)]
+    archive, connect, mark = archive_and_connection
+    if mark == "?":
+        conn = connect()
+        with conn:
+            for drop in drops:
+                conn.execute(f"ALTER TABLE measurements {drop}")
+            conn.execute("UPDATE schema_version SET version = 3")
+        conn.close()
+        return
+    with request.getfixturevalue("pg_database").admin() as conn:
+        conn.execute(f"ALTER TABLE linpar.measurements {', '.join(drops)}")
+        conn.execute("UPDATE linpar.schema_version SET version = 1")
+
+
+def test_an_archive_of_the_previous_schema_is_migrated_with_its_key_parameter_columns_filled(
+        archive_and_connection, measured, request):
+    """The columns the statistics read (SQLite schema 4, PostgreSQL 2) are filled from the parameters table:
+    the population afterwards is the row-by-row one."""
+    archive, connect, mark = archive_and_connection
+    _store_population(archive, measured)
+    _back_to_the_schema_without_columns(archive_and_connection, request)
+    if mark == "%s":
+        from analysis.archive.pg import ServerRefused, setup
+        from tests.pg_server import ADMIN
+        db = request.getfixturevalue("pg_database")
+        with pytest.raises(ServerRefused, match="linpar archive setup"):      # a station asks for the migration
+            open_archive(db.url("eva")).population()
+        assert setup(db.server.url(ADMIN, db.name)).schema_from == 1
+        archive = open_archive(db.url("eva"))
+    else:
+        archive = open_archive(str(archive.root))       # the index migrates as it is opened
+    conn = connect()
+    try:
+        old = reference_population(conn, Selection(), mark)
+        assert conn.execute("SELECT count(*) FROM measurements WHERE \"fs\" IS NOT NULL").fetchone()[0] == 40
+    finally:
+        conn.close()
+    new = archive.population()
+    assert len(new) == 40 and np.isnan(new.values["Bl"]).sum() == 1 and np.isnan(new.values["Qts"]).sum() == 1
+    _same_population(new, old)

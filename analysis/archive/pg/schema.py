@@ -136,7 +136,21 @@ REVOKE ALL ON FUNCTION linpar.file_create(), linpar.file_write(oid, bigint, byte
     linpar.file_seal(text, text, text, oid, bigint, text) FROM PUBLIC;
 """
 
-MIGRATIONS: tuple[str, ...] = (_V1,)
+def _v2() -> str:
+    # The key parameters beside the measurement's row (analysis.archive.schema.value_column), written with it
+    # (analysis.archive.pg.upload); the existing rows' are filled from the parameters table here.
+    from analysis.archive.schema import KEY_PARAMETERS, std_column, value_column
+    columns = [c for n in KEY_PARAMETERS for c in (value_column(n), std_column(n))]
+    fill = ", ".join(f"{value_column(n)} = p.{value_column(n)}, {std_column(n)} = p.{std_column(n)}"
+                     for n in KEY_PARAMETERS)
+    pivot = ", ".join(f"max(value) FILTER (WHERE name = '{n}') AS {value_column(n)}, "
+                      f"max(std) FILTER (WHERE name = '{n}') AS {std_column(n)}" for n in KEY_PARAMETERS)
+    return (f"ALTER TABLE linpar.measurements {', '.join(f'ADD COLUMN {c} double precision' for c in columns)};\n"
+            f"UPDATE linpar.measurements m SET {fill} FROM (SELECT measurement_id, {pivot} FROM linpar.parameters "
+            f"GROUP BY measurement_id) p WHERE p.measurement_id = m.id;\n")
+
+
+MIGRATIONS: tuple[str, ...] = (_V1, _v2())
 CURRENT_VERSION = len(MIGRATIONS)
 _LOCK_KEY = 0x6C696E706172      # "linpar": the advisory lock that serialises migrations
 

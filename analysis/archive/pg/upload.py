@@ -15,7 +15,7 @@ from pathlib import Path
 from analysis.archive.names import ArchiveError, inside
 from analysis.archive.pg.files import send_file
 from analysis.archive.record import entry_of
-from analysis.archive.schema import KEY_PARAMETERS
+from analysis.archive.schema import KEY_PARAMETERS, std_column, value_column
 
 SENT, ALREADY = "sent", "already"
 
@@ -38,20 +38,24 @@ def send_measurement(conn, record: dict, folder: Path) -> str:
     from psycopg.types.json import Jsonb
     digest = record_sha256(record)
     e = entry_of(record)
+    kept = {name: p for name in KEY_PARAMETERS if (p := e.parameters.get(name)) is not None}
+    columns = ["id", "folder", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity",
+               "effects", "verdict", "limits_version", "record", "record_sha256"]
+    values = [e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station, e.validity,
+              ",".join(e.effects), e.verdict, e.limits_version, Jsonb(record), digest]
+    for name, p in kept.items():        # the statistics' copy of the key parameters (schema version 2)
+        columns += [value_column(name), std_column(name)]
+        values += [p.get("value"), p.get("std")]
     with conn.transaction():
         row = conn.execute(
-            "INSERT INTO measurements (id, folder, measured_at, stored_at, driver, serial, operator, station, "
-            "validity, effects, verdict, limits_version, record, record_sha256) "
-            "VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s) ON CONFLICT (id) DO NOTHING RETURNING id",
-            (e.id, e.folder, e.measured_at, e.stored_at, e.driver, e.serial, e.operator, e.station, e.validity,
-             ",".join(e.effects), e.verdict, e.limits_version, Jsonb(record), digest)).fetchone()
+            f"INSERT INTO measurements ({', '.join(columns)}) VALUES ({', '.join(['%s'] * len(values))}) "
+            "ON CONFLICT (id) DO NOTHING RETURNING id", values).fetchone()
         if row is None:
             existing = conn.execute("SELECT record_sha256 FROM measurements WHERE id = %s", (e.id,)).fetchone()
             if existing is not None and existing[0] == digest:
                 return ALREADY
             raise IdTaken(e.id)
-        rows = [(e.id, name, p.get("value"), p.get("std"), str(p.get("unit", "")))
-                for name in KEY_PARAMETERS if (p := e.parameters.get(name)) is not None]
+        rows = [(e.id, name, p.get("value"), p.get("std"), str(p.get("unit", ""))) for name, p in kept.items()]
         if rows:
             with conn.cursor() as cur:
                 cur.executemany("INSERT INTO parameters (measurement_id, name, value, std, unit) "
