@@ -2,10 +2,18 @@
 # Installs the Debian packages linpar needs (PortAudio for the sound card,
 # jackd2 for the virtual rig, the libraries Qt loads, poppler-utils' pdftoppm for
 # the report tests, postgresql for the PostgreSQL archive's tests: a throw-away
-# server is started from its binaries, the package's own cluster is not used), when they are missing.
+# server is started from its binaries, the package's own cluster is not used, xvfb for the
+# test that opens the real window), when they are missing.
+# Qt's xcb platform plugin (libqxcb.so, libQt6XcbQpa.so.6) loads every libxcb-* below:
+# without libxcb-icccm4 and libxcb-keysyms1 a desktop gets "Could not load the Qt platform
+# plugin 'xcb'" and no window. Check with ldd on both: no line may say "not found".
 # As root it installs them with apt-get; otherwise it says what to install.
 set -u
-needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 libfontconfig1 libdbus-1-3 libxcb-cursor0 libglib2.0-0 poppler-utils postgresql)
+needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 libfontconfig1 libdbus-1-3 libglib2.0-0
+        libx11-6 libx11-xcb1 libxcb1 libxcb-cursor0 libxcb-glx0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
+        libxcb-randr0 libxcb-render0 libxcb-render-util0 libxcb-shape0 libxcb-shm0 libxcb-sync1 libxcb-util1
+        libxcb-xfixes0 libxcb-xkb1
+        poppler-utils postgresql xvfb)
 missing=()
 for pkg in "${needed[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
