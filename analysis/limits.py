@@ -280,7 +280,7 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
         lines.append(f"  {limit.name:<14}{shown:>18}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))
     if doc["verdict"] == "invalid":
-        lines.append("QA: INVALID: the measurement is not valid (validity red): fix it and measure again")
+        lines.append(f"QA: INVALID: {doc['why']}")
     elif doc["verdict"] == "not judged":
         lines.append(f"QA: NOT JUDGED: {doc['why']}")
     else:

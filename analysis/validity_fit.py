@@ -99,11 +99,22 @@ def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT
             validity.get("overall", "unknown")}
 
 
+def red_findings_text(validity: Mapping) -> str:
+    """The first red finding of a validity (as JSON) in words, with its code and remedy, and how many more."""
+    red = [f for channel in (validity.get("channels") or {}).values() for f in channel.get("findings") or ()
+           if f.get("severity") == "red"]
+    if not red:
+        return "a channel is red"
+    first = red[0]
+    more = f" (and {len(red) - 1} more red finding{'s' if len(red) > 2 else ''})" if len(red) > 1 else ""
+    return f"{first.get('message')} [{first.get('code')}]{more}; remedy: {first.get('remedy')}"
+
+
 def qa_blocker(validity: Mapping) -> tuple[str, str] | None:
     """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None."""
     if validity.get("overall") == "red":
-        return INVALID, ("the measurement is invalid (validity red): its parameters judge nothing; fix what the "
-                         "findings say and measure this driver again")
+        return INVALID, (f"the measurement is invalid: {red_findings_text(validity)}; its parameters judge "
+                         "nothing: fix this and measure this driver again")
     for channel in (validity.get("channels") or {}).values():
         for finding in channel.get("findings") or ():
             if finding.get("code") == MODEL_MISFIT:

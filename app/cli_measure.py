@@ -126,7 +126,12 @@ def run(args: argparse.Namespace) -> int:
         audio, laser, driver = _devices(args, stack)
         if args.sd is not None:
             driver = {**driver, "sd_m2": args.sd}
-        plan = dataclasses.replace(plan, driver={k: v for k, v in driver.items() if v is not None})
+        if args.serial:
+            driver = {**driver, "serial": args.serial}
+        # Who, where, when, with what: into the recording's sidecar (analysis.session), and from there on.
+        from analysis.session import new_session
+        plan = dataclasses.replace(plan, driver={k: v for k, v in driver.items() if v is not None},
+                                   session=new_session(args.operator or "", args.station or "", plan.template))
         cancel = _Cancel()
         _say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
              f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"

@@ -53,12 +53,10 @@ def display(value: float | None, parameter) -> str:
 
 def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str, str]:
     """(verdict, why): the measurement's validity first (analysis.validity_fit.qa_blocker), then the limits."""
-    from analysis.validity_fit import INVALID, qa_blocker
+    from analysis.validity_fit import qa_blocker
     validity = {"overall": validity} if isinstance(validity, str) else validity
     validity_overall = str(validity.get("overall", "unknown"))
     blocker = qa_blocker(validity)
-    if blocker is not None and blocker[0] == INVALID:
-        return "not judged", "the measurement is invalid (see the red channels): measure this driver again"
     if blocker is not None:
         return "not judged", blocker[1]
     if limits_verdict is None:
@@ -90,16 +88,15 @@ class ReportWorker(QObject):
 
     def _run(self, job: int, result: AnalysisResult, path: Path, cancel: threading.Event, limits) -> None:
         try:
-            from analysis.archive.results import StoredResult, results_document
+            from analysis.archive.results import (StoredResult, calibration_of, header_of_recording,
+                                                  results_document)
             from analysis.recording import read_recording
             from analysis.report import build_report, write_report
             recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
             stored = StoredResult.from_json(results_document(result, recording))
-            driver = dict(recording.driver) if recording is not None else {}
-            header = {"driver": driver.get("name", ""), "serial": driver.get("serial", ""),
-                      "source": str(result.source or "")}
-            extra = dict(recording.extra) if recording is not None else {}
-            calibration = {k: extra[k] for k in ("calibration", "capture") if k in extra}
+            # The header a report of the same recording has from the command line or the archive.
+            header = header_of_recording(recording) if recording is not None else {}
+            calibration = calibration_of(recording) if recording is not None else {}
             content = build_report(stored, header, None, calibration, limits)
             if cancel.is_set():
                 return
@@ -278,11 +275,15 @@ class QAView(QWidget):
         self.table.setRowCount(len(self.verdicts))
         for row, v in enumerate(self.verdicts):
             parameter = self.result.parameters.get(v.limit.name)
-            measured = display(v.value, parameter) if v.value is not None else v.note
+            # Why a value is missing is long (the finding and its remedy): in the tooltip, so that the
+            # Limit and Result columns stay in view.
+            measured = display(v.value, parameter) if v.value is not None else "not measured"
             outcome = "not judged" if invalid else ("pass" if v.passed else "FAIL")
             cells = (v.limit.name, measured, v.limit.text, outcome)
             for col, text in enumerate(cells):
                 item = QTableWidgetItem(text)
+                if v.value is None and v.note:
+                    item.setToolTip(v.note)
                 if invalid:
                     item.setForeground(Qt.gray)
                 elif col == 3:

@@ -68,6 +68,9 @@ def findings_html(findings: Iterable, empty: str = "") -> str:
         severity, message, remedy = finding_parts(finding)
         colour = style.validity_colours(severity)[1]
         text = f"<span style='color:{colour}'>●</span> {html.escape(message)}"
+        code = finding.get("code") if isinstance(finding, Mapping) else getattr(finding, "code", "")
+        if code:        # the stable code: the user guide, the report and the CLI's JSON name it too
+            text += f" <span style='color:#666666'>[{html.escape(str(code))}]</span>"
         if remedy:
             text += f" — <i>{html.escape(remedy)}</i>"
         items.append(text)

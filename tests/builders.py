@@ -2,9 +2,12 @@
 from __future__ import annotations
 
 import os
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from analysis.drivers import load_driver
 from analysis.effects import parse_effects
@@ -51,3 +54,13 @@ TYPICAL_NOISE = ChannelNoise(voltage=1e-4, current=1e-4, displacement=1e-8)
 # The real measurements of ../shared/data/real (beside the repository, in CI too).
 REPO_ROOT = Path(__file__).resolve().parent.parent
 REAL_DATA = Path(os.environ.get("LINPAR_SHARED", REPO_ROOT.parent / "shared")) / "data" / "real"
+
+
+needs_pdftotext = pytest.mark.skipif(shutil.which("pdftotext") is None,
+                                     reason="pdftotext is missing: install poppler-utils (tools/system-packages.sh)")
+
+
+def pdf_text(pdf) -> str:
+    """The text of a PDF as pdftotext lays it out (poppler-utils)."""
+    return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], check=True, capture_output=True,
+                          text=True).stdout

@@ -61,9 +61,7 @@ COMMANDS = {
     "diagnose": ["diagnose", "REC"],
     "stats": ["stats", "GOOD", "REC"],
     "levels": ["levels", "REC", "GOOD"],
-    "report": ["report", "REC", "--html", "OUT/r.html"],
-    "export": ["export", "REC", "--csv", "OUT/p.csv"],
-    "archive store": ["archive", "store", "REC", "--root", "OUT/archive"],
+    "export driver file": ["export", "REC", "--driver", "OUT/p.wdr"],
 }
 
 
@@ -86,6 +84,29 @@ def test_a_silent_voltage_is_one_line_for_every_command_that_needs_a_fit(capsys,
     line = one_line(err)
     assert "silent-voltage.wav" in line and "voltage" in line and "no signal" in line
     assert "check that the amplifier is on" in line
+
+
+def test_a_silent_voltage_is_reported_exported_and_archived_as_judged(capsys, recordings, tmp_path):
+    """Judged, not refused: the report, the parameters' files and the archive keep the broken measurement
+    with its red light and why (a driver file or a curve, which need a fit, are one line: above)."""
+    limits = tmp_path / "limits.json"
+    limits.write_text(json.dumps({"format": "linpar-limits/1", "parameters": {
+        "RE": {"min": 0.5, "max": 20.0, "unit": "ohm"}}}))
+    code, out, _ = run(capsys, "report", recordings["silent-voltage"], "--html", tmp_path / "r.html",
+                       "--limits", limits)
+    html = (tmp_path / "r.html").read_text(encoding="utf-8")
+    assert code == 0 and "QA: NOT JUDGED" in out and "[no-signal]" in out
+    assert "QA: NOT JUDGED" in html and "<b>no-signal</b>" in html and "check that the amplifier is on" in html
+    assert "Nothing was fitted" in html
+    code, out, _ = run(capsys, "export", recordings["silent-voltage"], "--csv", tmp_path / "p.csv",
+                       "--json", tmp_path / "p.json")
+    doc = json.loads((tmp_path / "p.json").read_text(encoding="utf-8"))
+    assert code == 0 and doc["validity"] == "red"
+    assert doc["parameters"]["RE"]["value"] is None and "no signal" in doc["parameters"]["RE"]["reason"]
+    code, out, _ = run(capsys, "archive", "store", recordings["silent-voltage"], "--root", tmp_path / "archive")
+    assert code == 0
+    code, out, _ = run(capsys, "archive", "list", "--root", tmp_path / "archive")
+    assert code == 0 and "red" in out
 
 
 def test_a_channel_scale_of_5e_324_is_refused_where_it_is_read(capsys, recordings, tmp_path):

@@ -39,6 +39,7 @@ from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, cle
 from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
 from analysis.archive.schema import KEY_PARAMETERS
 from analysis.bounds import YEAR
+from analysis.session import recording_header
 from analysis.files import read_text, regular_file
 
 MeasurementId = str
@@ -151,6 +152,14 @@ def _iso(text: str | None, field_name: str) -> str | None:
     return when.astimezone(timezone.utc).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
+def _sidecar_date(text: str | None) -> str | None:
+    """The sidecar's session date as the archive writes dates; None (the time of storing) when it is no date."""
+    try:
+        return _iso(text, "measured_at")
+    except ArchiveError:
+        return None
+
+
 def _share(folder: Path) -> None:
     """mkdtemp and mkstemp make private files; an archive is shared by the people at the station."""
     os.chmod(folder, DIR_MODE)
@@ -213,11 +222,12 @@ class Archive(FolderQA):
 
         stored_at = (now or datetime.now(timezone.utc)).astimezone(timezone.utc)
         mid = new_measurement_id(stored_at)
-        text = {k: clean_text(getattr(meta, k), k) for k in TEXT_FIELDS}
-        if not text["driver"]:
-            text["driver"] = clean_text(str((rec_obj.driver or {}).get("name", "")), "driver")
+        # What the caller does not say, the recording's sidecar does (analysis.session): who, where, when.
+        traced = recording_header(rec_obj)
+        text = {k: clean_text(getattr(meta, k) or traced.get(k, ""), k) for k in TEXT_FIELDS}
         name = folder_name(mid, text["driver"], text["serial"])
         self.folders.mkdir(parents=True, exist_ok=True)
+        measured_at = _iso(meta.measured_at, "measured_at") or _sidecar_date(traced.get("measured_at"))
         final = inside(self.folders, name)
         if final.exists():
             raise ArchiveError(f"{final}: already exists")
@@ -237,7 +247,7 @@ class Archive(FolderQA):
         params = doc["parameters"]
         record = {
             "format": RECORD_FORMAT, "id": mid, "folder": name,
-            "measured_at": _iso(meta.measured_at, "measured_at") or stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
+            "measured_at": measured_at or stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
             "stored_at": stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
             **text, "notes": clean_text(meta.notes, "notes", 2000),
             "validity": str(doc["validity"].get("overall", "unknown")),

@@ -22,6 +22,7 @@ import numpy as np
 from analysis.bounds import FREQUENCY, SD
 from analysis.derived import ParameterValue
 from analysis.errors import LinparError
+from analysis.session import session_of
 
 FORMAT = "linpar-results/1"
 CHANNELS = ("impedance", "displacement")
@@ -40,7 +41,10 @@ def _list(a) -> list:
 
 def _settings_of(recording, result) -> dict:
     spectra = result.spectra
-    freqs = result.fit.channels["impedance"].freqs
+    if result.fit is not None:
+        freqs = result.fit.channels["impedance"].freqs
+    else:       # nothing fitted: the band the excitation drove
+        freqs = np.asarray(spectra.excited_bins, dtype=float) * spectra.bin_width
     out = {
         "sample_rate_hz": spectra.sample_rate,
         "period_samples": spectra.period_samples,
@@ -62,38 +66,58 @@ def _settings_of(recording, result) -> dict:
 def results_document(result, recording=None) -> dict:
     """The JSON document of an analysis.pipeline.AnalysisResult (and of its recording's settings).
 
-    A result with nothing fitted (analysis.pipeline.require_fit) raises NotAnalysable: it has no curves
-    or model to keep, report or export.
+    A result with nothing fitted (a broken measurement: analysis.validity_fit) is kept too, so that it can
+    be archived, reported and exported as judged: its parameters are "not measured" with the reason, its
+    model has no effects and says why under "not_fitted", and it has no curves.
     """
-    from analysis.pipeline import require_fit
-    fit = require_fit(result, "be stored, reported or exported")
+    fit = result.fit
+    parameters = {}
+    for name, p in result.parameters.items():
+        parameters[name] = {"value": _num(p.value), "std": _num(p.std), "unit": p.unit,
+                            "display_unit": p.display_unit, "display_scale": p.display_scale,
+                            "reason": p.reason, "fitted": p.fitted}
+    doc = {
+        "format": FORMAT,
+        "parameters": parameters,
+        "model": _model_json(fit) if fit is not None else not_fitted_model(result.not_fitted),
+        "validity": result.validity,
+        "sd_m2": _num(result.sd_m2),
+        "settings": _settings_of(recording, result),
+        "curves": {} if fit is None else _curves_json(fit),
+    }
+    session = session_of(recording) if recording is not None else {}
+    if session:
+        doc["session"] = session
+    return doc
+
+
+def not_fitted_model(why: str | None) -> dict:
+    """The "model" of a result with nothing fitted: no effects, no values, and why."""
+    why = why or "nothing could be fitted"
+    return {"effects": [], "with_displacement": False, "user_effects": [], "values": {}, "stderr": {},
+            "chi2_red": {}, "aic": None, "bic": None, "n_data": 0, "n_parameters": 0, "converged": False,
+            "message": why, "not_fitted": why}
+
+
+def _model_json(fit) -> dict:
+    return {"effects": list(fit.model.effect_ids), "with_displacement": fit.model.with_displacement,
+            "user_effects": user_effects_json(fit.model.effects),
+            "values": {k: _num(v) for k, v in fit.values.items()},
+            "stderr": {k: _num(v) for k, v in fit.stderr.items()},
+            "chi2_red": {k: _num(v) for k, v in fit.chi2_red_by_channel().items()},
+            "aic": _num(fit.aic), "bic": _num(fit.bic), "n_data": fit.n_data,
+            "n_parameters": fit.n_varying, "converged": bool(fit.success), "message": fit.message,
+            "noise_known": fit.noise_known}
+
+
+def _curves_json(fit) -> dict:
     curves = {}
     for name, ch in fit.channels.items():
         curves[name] = {"unit": "ohm" if name == "impedance" else "m/V", "has_phase": bool(ch.has_phase),
                         "freqs_hz": _list(ch.freqs), "measured_re": _list(np.real(ch.measured)),
                         "measured_im": _list(np.imag(ch.measured)), "std": _list(ch.std),
                         "model_re": _list(np.real(ch.model)), "model_im": _list(np.imag(ch.model))}
-    parameters = {}
-    for name, p in result.parameters.items():
-        parameters[name] = {"value": _num(p.value), "std": _num(p.std), "unit": p.unit,
-                            "display_unit": p.display_unit, "display_scale": p.display_scale,
-                            "reason": p.reason, "fitted": p.fitted}
-    return {
-        "format": FORMAT,
-        "parameters": parameters,
-        "model": {"effects": list(fit.model.effect_ids), "with_displacement": fit.model.with_displacement,
-                  "user_effects": user_effects_json(fit.model.effects),
-                  "values": {k: _num(v) for k, v in fit.values.items()},
-                  "stderr": {k: _num(v) for k, v in fit.stderr.items()},
-                  "chi2_red": {k: _num(v) for k, v in fit.chi2_red_by_channel().items()},
-                  "aic": _num(fit.aic), "bic": _num(fit.bic), "n_data": fit.n_data,
-                  "n_parameters": fit.n_varying, "converged": bool(fit.success), "message": fit.message,
-                  "noise_known": fit.noise_known},
-        "validity": result.validity,
-        "sd_m2": _num(result.sd_m2),
-        "settings": _settings_of(recording, result),
-        "curves": curves,
-    }
+    return curves
 
 
 def user_effects_json(effects) -> list[dict]:
@@ -197,6 +221,7 @@ class StoredResult:
     settings: dict
     curves: dict[str, Curve] = field(default_factory=dict)
     user_effects: dict = field(default_factory=dict)     # id -> the Effect rebuilt from its stored file text
+    session: dict = field(default_factory=dict)          # the recording's traceability (analysis.session)
 
     @classmethod
     def from_json(cls, doc: Mapping) -> "StoredResult":
@@ -242,7 +267,7 @@ class StoredResult:
         return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
                    dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
                    None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
-                   curves, _user_effects(model))
+                   curves, _user_effects(model), _session(doc))
 
     def model(self):
         """The analysis.model.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
@@ -260,23 +285,54 @@ class StoredResult:
     def overall(self) -> str:
         return str(self.validity.get("overall", "unknown"))
 
+    @property
+    def not_fitted(self) -> str | None:
+        """Why nothing was fitted (a broken measurement), or None for a fitted result."""
+        why = self.model_info.get("not_fitted")
+        return str(why) if why else None
+
+
+def _session(doc: Mapping) -> dict:
+    session = doc.get("session")
+    if session is not None and not isinstance(session, Mapping):
+        raise ResultsFormatError("session: expected a JSON object")
+    from analysis.session import trace_header
+    return trace_header({}, session)
+
 
 def stored_from_recording(path, sd_m2: float | None = None, effects=None):
     """Analyse a recording file now: (StoredResult, header, calibration), as an archived copy would give."""
-    from datetime import datetime, timezone
-    from pathlib import Path
-
     from analysis.pipeline import analyze_recording
     from analysis.recording import read_recording
     recording = read_recording(path)
     result = analyze_recording(recording, sd_m2, effects)
     stored = StoredResult.from_json(results_document(result, recording))
-    try:   # the best date a bare recording carries: when its file was written
-        when = datetime.fromtimestamp(Path(recording.source).stat().st_mtime, timezone.utc)
-        date = when.isoformat(timespec="seconds").replace("+00:00", "Z") + " (file time)"
-    except (OSError, TypeError):
-        date = ""
-    header = {"driver": str((recording.driver or {}).get("name", "")), "measured_at": date,
-              "source": str(recording.source or path)}
-    calibration = {k: recording.extra[k] for k in ("calibration", "capture") if k in (recording.extra or {})}
-    return stored, header, calibration
+    return stored, header_of_recording(recording, path), calibration_of(recording)
+
+
+def header_of_recording(recording, path=None) -> dict:
+    """The report's header of a recording (analysis.session.trace_header), and its file as the source.
+
+    A recording made without a session (another tool, an old file) is dated by its file's time.
+    """
+    from datetime import datetime, timezone
+    from pathlib import Path
+
+    from analysis.session import recording_header
+    header = recording_header(recording)
+    source = recording.source or path
+    if "measured_at" not in header and source is not None:
+        try:
+            when = datetime.fromtimestamp(Path(source).stat().st_mtime, timezone.utc)
+            header["measured_at"] = when.isoformat(timespec="seconds").replace("+00:00", "Z") + " (file time)"
+        except (OSError, TypeError, ValueError):
+            pass
+    if source is not None:
+        header["source"] = str(source)
+    return header
+
+
+def calibration_of(recording) -> dict:
+    """What a report shows under Calibration: the sidecar's "calibration" and "capture"."""
+    extra = recording.extra or {}
+    return {k: extra[k] for k in ("calibration", "capture") if k in extra}

@@ -14,12 +14,28 @@ from analysis.archive.results import StoredResult
 from analysis.export.curves import ExportError, frd_text, zma_text
 from analysis.export.parameters import parameters_csv, parameters_json
 from analysis.export.winisd import wdr_bytes
+from analysis.session import HEADER_KEYS
 
 KINDS = ("csv", "json", "zma", "zma_model", "frd", "frd_model", "driver")
 
 
+# Exports of a result with nothing fitted (a broken measurement): its parameters, each "not measured" and why.
+JUDGED_WITHOUT_FIT = ("csv", "json")
+
+
+def trace_line(header: Mapping) -> str:
+    """The header (analysis.session) on one line, for the comment lines of curve files."""
+    return ", ".join(f"{k.replace('_', ' ')} {header[k]}" for k in HEADER_KEYS if header.get(k))
+
+
 def export_bytes(kind: str, result: StoredResult, header: Mapping | None = None) -> bytes:
-    title = " ".join(str(header.get(k) or "") for k in ("driver", "serial")).strip() if header else ""
+    # The recording's session is the base, as in reports: the same header from a recording or the archive.
+    header = {**result.session, **{k: v for k, v in dict(header or {}).items() if v}}
+    if result.not_fitted and kind not in JUDGED_WITHOUT_FIT:
+        where = header.get("source") or header.get("id")
+        raise ExportError(f"{where + ': ' if where else ''}a {kind.replace('_', ' ')} export needs a fit, and "
+                          f"nothing was fitted: {result.not_fitted}")
+    title = trace_line(header)
     if kind == "csv":
         return parameters_csv(result).encode("utf-8")
     if kind == "json":

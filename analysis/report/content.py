@@ -18,7 +18,11 @@ from analysis.report.qa import LimitRow, QASection, qa_section
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
 HEADER_FIELDS = (("driver", "Driver"), ("serial", "Serial number"), ("measured_at", "Date"),
-                 ("operator", "Operator"), ("station", "Station"), ("id", "Measurement id"), ("source", "Source"))
+                 ("operator", "Operator"), ("station", "Station"), ("template", "Template"),
+                 ("software", "Measured with"), ("id", "Measurement id"), ("source", "Source"),
+                 ("reported_with", "Reported with"))
+# Shown with "–" when unknown: a reader sees that they are missing.
+ALWAYS_SHOWN = ("driver", "serial", "measured_at", "operator", "station")
 SETTING_LABELS = {
     "sample_rate_hz": ("Sample rate", "Hz"), "period_samples": ("Period", "samples"),
     "periods_analysed": ("Periods analysed", ""), "settle_periods": ("Settle periods", ""),
@@ -101,6 +105,8 @@ def _user_effect_rows(result: StoredResult) -> list[tuple[str, str]]:
 
 
 def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
+    if result.not_fitted:
+        return (("Model", "nothing fitted"), ("Why", result.not_fitted))
     info = result.model_info
     effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
     chi = info.get("chi2_red") or {}
@@ -155,8 +161,12 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     limits: an analysis.limits.Limits to judge the parameters against (the report then carries the
     QA verdict); None: the report says nothing about limits.
     """
+    from analysis.session import software
+    # The recording's session is the base (analysis.session): the same header from the recording, the
+    # archive or an export; what the caller knows (the archive's id, the file) is added.
+    header = {**result.session, **{k: v for k, v in header.items() if v}, "reported_with": software()}
     head = tuple((label, str(header.get(key) or "–")) for key, label in HEADER_FIELDS
-                 if header.get(key) or key in ("driver", "serial", "measured_at", "operator", "station"))
+                 if header.get(key) or key in ALWAYS_SHOWN)
     params = []
     for p in result.parameters.values():
         value, std, unit, rel = parameter_cells(p)
@@ -166,7 +176,9 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     cal: list[tuple[str, str]] = []
     _flatten("", dict(calibration or {}), cal)
     notes = []
-    if "displacement" not in result.curves:
+    if result.not_fitted:
+        notes.append(f"Nothing was fitted, so there are no parameters and no plots: {result.not_fitted}")
+    elif "displacement" not in result.curves:
         notes.append("No displacement channel: Bl, the mechanical parameters, Hx and SPL cannot be shown.")
     elif result.sd_m2 is None:
         notes.append("Sd unknown: no SPL prediction (give the effective radiating area).")

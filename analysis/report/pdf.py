@@ -275,8 +275,10 @@ def _flow(pages: _Pages, c: ReportContent) -> None:
         pages.wrapped(note, style="italic", color="#555555")
 
     plots = ["impedance"] + (["hx"] if c.has_displacement else []) + (["spl"] if c.has_spl else [])
+    if not c.result.curves:        # nothing was fitted (a broken measurement): the notes say why
+        plots = []
     heights = {**PLOT_HEIGHTS, "residuals": PLOT_HEIGHTS["residuals"] * len(c.result.curves)}
-    for i, what in enumerate(plots + ["residuals"]):
+    for i, what in enumerate(plots + (["residuals"] if plots else [])):
         if i == 0:      # the heading goes with the first plot, never alone at the foot of a page
             pages.heading("Plots", keep=0.5 + PLOT_SHRINK * heights[what] * pages.plot_scale)
         pages.plot(what, heights[what])

@@ -158,6 +158,8 @@ def figures(result: StoredResult, width_in: float = 7.2) -> list[tuple[str, Figu
 
 def _figures(result: StoredResult, width_in: float) -> list[tuple[str, Figure]]:
     out = []
+    if "impedance" not in result.curves:        # nothing was fitted (a broken measurement): no plots
+        return out
     fig = Figure(figsize=(width_in, 4.6), layout="constrained")
     draw_impedance(result, *fig.subplots(2, 1, sharex=True, height_ratios=[3, 2]))
     out.append(("Impedance", fig))

@@ -24,6 +24,7 @@ import numpy as np
 from analysis.level_check import LevelDecision, LevelProbe, level_check
 from analysis.live import LiveAccumulator, LiveFrame
 from analysis.recording import make_recording, read_recording, write_recording
+from analysis.session import SESSION_KEY, new_session
 from app.wizard.calibration import Corrections
 from app.wizard.corrected_audio import corrected_audio
 from app.wizard.hardware import SERIAL_LASER, HardwareConfig, open_audio
@@ -120,6 +121,12 @@ def run_level_check(hardware: HardwareConfig, template: Template, corrections: C
         return level_check(measure_at, v_min, v_max, x_limit_m)
 
 
+def session_of_request(request: MeasurementRequest) -> dict:
+    """The recording's "session" (analysis.session): the operator and station the Driver step asked for."""
+    driver = request.driver
+    return new_session(driver.operator, driver.station, request.template.key)
+
+
 def run_measurement(request: MeasurementRequest, on_frame: FrameSink | None = None,
                     cancel: threading.Event | None = None, progress: Progress | None = None):
     """Measure, write the recording, then analyse it: (wav path, AnalysisResult)."""
@@ -130,7 +137,8 @@ def run_measurement(request: MeasurementRequest, on_frame: FrameSink | None = No
     hw = request.hardware
     plan = MeasurementPlan.from_template(request.template.key, level_v_rms=request.level_v,
                                          driver=request.driver.as_json(), laser_rate_hz=hw.laser_rate_hz,
-                                         calibration={"corrections": request.corrections.to_dict()})
+                                         calibration={"corrections": request.corrections.to_dict()},
+                                         session=session_of_request(request))
     audio, laser = open_devices(hw, request.corrections)
     outcome = runner(plan, audio, laser, request.out_dir, name=recording_stem(request.driver),
                      listeners=[on_frame] if on_frame else (), cancel=cancel, progress=runner_progress(progress),
@@ -204,6 +212,7 @@ def run_measurement_fallback(request: MeasurementRequest, on_frame: FrameSink | 
     if request.hardware.laser == SERIAL_LASER:
         raise ValueError("the serial laser needs instruments.measurement's runner, which is not installed")
     mt = multitone_for(t)
+    session = session_of_request(request)       # dated when the measurement starts
     audio, _ = open_devices(request.hardware, request.corrections)
 
     def periods_done(kept: int, wanted: int) -> None:
@@ -212,6 +221,7 @@ def run_measurement_fallback(request: MeasurementRequest, on_frame: FrameSink | 
     captured = captured_with_frames(audio, mt.scaled(rms=request.level_v).waveform, t.n_periods, t.settle_periods,
                                     mt.excited_bins, on_frame, cancel, periods_done)
     extra = {"capture": captured.stats.capture_info(), "audio_capture": captured.stats.as_dict(),
+             SESSION_KEY: session,
              "measurement": {"template": t.as_json(), "level_v_rms": request.level_v,
                              "level_reason": request.level_reason, "hardware": request.hardware.describe(),
                              "corrections": request.corrections.to_dict(), "runner": "app.wizard.tasks"}}
@@ -252,7 +262,8 @@ def run_large_signal_plan(request: MeasurementRequest, on_frame: FrameSink | Non
     hw = request.hardware
     base = MeasurementPlan.from_template(request.template.key, driver=request.driver.as_json(),
                                          laser_rate_hz=hw.laser_rate_hz,
-                                         calibration={"corrections": request.corrections.to_dict()})
+                                         calibration={"corrections": request.corrections.to_dict()},
+                                         session=session_of_request(request))
     limits = request.limits or StepLimits()
     if request.level_v > limits.max_voltage_v:
         from instruments.measurement import MeasurementError

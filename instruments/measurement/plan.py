@@ -79,6 +79,8 @@ class MeasurementPlan:
     # What the caller knows of the chain's calibration (e.g. the wizard's reference-resistor corrections);
     # written into the recording's sidecar as "calibration", with the sound card's constants added.
     calibration: Mapping[str, Any] = field(default_factory=dict)
+    # Who measures and where (analysis.session): the sidecar's "session", with the template, date and software.
+    session: Mapping[str, Any] = field(default_factory=dict)
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -147,5 +149,6 @@ class MeasurementPlan:
         d = asdict(self)
         d["driver"] = dict(self.driver)
         d["calibration"] = dict(self.calibration)
+        d["session"] = dict(self.session)
         d["settle_periods"] = self.settle
         return d

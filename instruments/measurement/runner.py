@@ -46,6 +46,7 @@ import numpy as np
 
 from analysis.pipeline import AnalysisResult
 from analysis.recording import Recording, make_recording, read_recording, write_recording
+from analysis.session import SESSION_KEY, new_session
 from instruments.audio import capture as _capture_name      # first: see the NB at `capture` below
 from instruments.audio import CapturedSignals
 from instruments.audio.errors import AudioError, CaptureCancelled
@@ -383,6 +384,7 @@ def _recording(captured: CapturedSignals, aligned: AlignedDisplacement | None, n
     calibration = plan.sidecar_calibration(getattr(audio, "calibration", None))
     if calibration:
         extra["calibration"] = calibration
+    extra[SESSION_KEY] = {**new_session(template=plan.template), **dict(plan.session)}
     if aligned is not None:
         extra[DISPLACEMENT_MAX_KEY] = aligned.max_hz
         extra["laser_alignment"] = aligned.as_json(captured.sample_rate, plan.laser_rate_hz)

@@ -13,7 +13,7 @@ from analysis.pipeline import analyze_recording
 from analysis.recording import write_recording
 from analysis.report import build_report, render_html, report_for_measurement, report_for_recording, write_report
 from instruments.simulation import faults
-from tests.builders import TYPICAL_NOISE, recording
+from tests.builders import TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
 HEADER = {"driver": "Acme <W6> & co", "serial": "SN-42", "measured_at": "2024-05-01T10:00:00Z",
           "operator": "Ana", "station": "QA-1"}
@@ -175,13 +175,7 @@ def test_html_carries_the_verdict_banner_and_table_only_with_limits(stored, tmp_
     assert "QA:" not in none and "QA limits" not in none and "qa-verdict" not in none
 
 
-needs_pdftotext = pytest.mark.skipif(shutil.which("pdftotext") is None,
-                                     reason="pdftotext is missing: install poppler-utils (tools/system-packages.sh)")
-
-
-def _pdf_text(pdf) -> str:
-    return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], check=True, capture_output=True,
-                          text=True).stdout
+_pdf_text = pdf_text
 
 
 @needs_pdftotext

@@ -1,6 +1,8 @@
 """The Archive page: list, filter, open, compare, errors as messages; a wizard measurement lands in the archive."""
 from __future__ import annotations
 
+import json
+import re
 import shutil
 
 import numpy as np
@@ -12,9 +14,11 @@ from analysis.archive.index import INDEX_FILE
 from analysis.archive.results import results_document
 from analysis.pipeline import analyze_recording
 from analysis.recording import read_recording, write_recording
+from analysis.report import report_for_measurement, report_for_recording, write_report
+from analysis.session import software
 from app.archive_page import ROOT_KEY
 from app.archive_table import FIRST_PARAMETER, HEADERS
-from tests.builders import DRIVERS, TYPICAL_NOISE, recording
+from tests.builders import DRIVERS, TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
 from .conftest import ANALYSIS_TIMEOUT_MS
 from .test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
@@ -246,6 +250,7 @@ def test_a_store_that_fails_keeps_the_recording_and_says_so(qtbot, window, measu
     assert "was not stored in the archive" in window.archive.message.text()
 
 
+@needs_pdftotext
 def test_a_wizard_measurement_ends_up_in_the_archive(qtbot, window, settings, tmp_path, archive_root):
     settings.qsettings.setValue("measure/out_dir", str(tmp_path / "measurements"))
     wizard = window.wizard
@@ -268,6 +273,18 @@ def test_a_wizard_measurement_ends_up_in_the_archive(qtbot, window, settings, tm
     assert f"stored in the archive as {mid}" in window.status_label.text()
     assert shown_ids(window.archive) == [mid]              # the page listed it again after storing
     assert settings.qsettings.value("measure/operator") == "ana"
+    # Traceable: the sidecar says who, where, with what; the archive and every report say the same.
+    session = json.loads(outcome.path.with_suffix(".json").read_text(encoding="utf-8"))["session"]
+    assert (session["operator"], session["station"], session["template"]) == ("ana", "bench 3", "midrange")
+    assert session["software"] == software() and session["measured_at"] == m.record["measured_at"]
+    archived, fresh = report_for_measurement(m), report_for_recording(outcome.path)
+    traced = {"Driver", "Serial number", "Date", "Operator", "Station", "Template", "Measured with"}
+    assert {k: v for k, v in archived.header if k in traced} == {k: v for k, v in fresh.header if k in traced}
+    assert dict(archived.header)["Operator"] == "ana" and dict(archived.header)["Template"] == "midrange"
+    write_report(archived, pdf=tmp_path / "archived.pdf")
+    text = pdf_text(tmp_path / "archived.pdf")
+    assert re.search(r"Operator\s+ana", text) and re.search(r"Station\s+bench 3", text)
+    assert re.search(r"Serial number\s+0042", text) and software() in text
 
 
 def test_a_narrow_window_puts_the_filters_on_two_rows(qtbot, window, archive):

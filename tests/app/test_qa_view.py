@@ -9,7 +9,9 @@ import pytest
 import app.qa_view as qa_view
 from analysis.recording import make_recording, write_recording
 from app.qa_view import NO_LIMITS, NO_REPORT, QAView
+from analysis.validity_findings import NO_SIGNAL
 from instruments.simulation import faults
+from tests.builders import needs_pdftotext, pdf_text
 
 from .conftest import open_and_wait
 from .test_wizard_helpers import plain
@@ -60,15 +62,31 @@ def zeroed_current(tmp_path_factory):
     return wav
 
 
-def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_current, dialogs):
+@needs_pdftotext
+def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_current, dialogs, limits_file, tmp_path):
     outcome, = open_and_wait(qtbot, window, zeroed_current)
     assert dialogs == [] and outcome.result.fit is None
     qa = window.qa
     assert qa.channels["current"].light.status == "red" and qa.channels["voltage"].light.status == "green"
     assert "no signal" in plain(qa.channels["current"].details)
+    assert f"[{NO_SIGNAL}]" in plain(qa.channels["current"].details)        # the finding's code, on the light
     assert qa.verdict == "not judged"
     assert "Nothing could be fitted" in window.results.fit_quality.text()
     assert "Nothing to model" in window.model_lab.empty.text()
+    # Judged against limits: every row "not judged", and the verdict says which finding and what to do.
+    assert qa.load_limits(limits_file)
+    assert {qa.table.item(r, 3).text() for r in range(qa.table.rowCount())} == {"not judged"}
+    verdict = plain(qa.verdict_label)
+    assert "NOT JUDGED" in verdict and NO_SIGNAL in verdict and "check the current sense" in verdict
+    # The report of the broken measurement is written, and says why.
+    assert qa.export_button.isEnabled()
+    target = tmp_path / "broken-report.pdf"
+    with qtbot.waitSignal(qa.report_written, timeout=60_000):
+        qa.export_to(target)
+    assert "Written" in qa.export_label.text()
+    text = " ".join(pdf_text(target).split())
+    assert "QA: NOT JUDGED" in text and f"{NO_SIGNAL}: current: only 0%" in text
+    assert "Remedy: check the current sense" in text and "Nothing was fitted" in text
 
 
 def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limits_file):
