@@ -5,7 +5,6 @@ import time
 from pathlib import Path
 
 from PySide6.QtCore import QTimer, Signal, Slot
-from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton,
                                QTabWidget)
 
@@ -13,6 +12,7 @@ from app import style
 from app.archive_page import ArchivePage
 from app.job_book import failure_text
 from app.large_signal_page import LargeSignalPage
+from app.menus import Menus
 from app.model_lab import ModelLab
 from app.placeholders import PlaceholderPage
 from app.production_page import ProductionPage
@@ -89,7 +89,9 @@ class MainWindow(QMainWindow):
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
             self.pages.addTab(built[name] if name in built else PlaceholderPage(name), name)
-        self.pages.setCurrentWidget(self.results)
+        # A first start (no window saved yet) opens on the wizard's first step: a newcomer starts by measuring.
+        first_start = self.settings.window_geometry()[0] is None
+        self.pages.setCurrentWidget(self.wizard if first_start else self.results)
         self.setCentralWidget(self.pages)
 
         self._build_menus()
@@ -102,15 +104,9 @@ class MainWindow(QMainWindow):
 
     # -- construction ------------------------------------------------------
     def _build_menus(self) -> None:
-        file_menu = self.menuBar().addMenu("&File")
-        self.open_action = QAction("&Open recording…", self, shortcut=QKeySequence.Open)
-        self.open_action.triggered.connect(self.on_open)
-        file_menu.addAction(self.open_action)
-        self.recent_menu = file_menu.addMenu("Open &recent")
-        file_menu.addSeparator()
-        self.quit_action = QAction("&Quit", self, shortcut=QKeySequence("Ctrl+Q"))
-        self.quit_action.triggered.connect(self.close)
-        file_menu.addAction(self.quit_action)
+        self.menus = Menus(self)            # File, View, Help (app/menus.py)
+        self.open_action, self.quit_action = self.menus.open_action, self.menus.quit_action
+        self.results.result_changed.connect(self.menus.update)
         self._rebuild_recent_menu()
 
     def _build_status_bar(self) -> None:

@@ -20,7 +20,6 @@ from .conftest import ANALYSIS_TIMEOUT_MS, open_and_wait
 def test_pages_are_built_and_none_is_a_placeholder(window):
     names = [window.pages.tabText(i) for i in range(window.pages.count())]
     assert names == ["Measure", "Results", "Model lab", "Series", "Large signal", "QA", "Production", "Archive"]
-    assert window.pages.currentWidget() is window.results
     assert window.pages.widget(0) is window.wizard
     assert window.pages.widget(2) is window.model_lab
     assert window.pages.widget(3) is window.series
