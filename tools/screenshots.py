@@ -1,6 +1,6 @@
 """Screenshots of the main window on a synthetic recording, for docs and for looking at.
 
-    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] [--only archive|model-lab|large-signal]
+    QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] [--only archive|model-lab|large-signal|production|qa]
 
 Writes results.png (and one PNG per Results plot tab and per other page) to
 docs/screenshots/ unless OUTDIR is given, then model-lab-before.png and
@@ -28,6 +28,9 @@ over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
 station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
+qa-current-zeroed-1280x720.png and -1920x1080.png: the QA page judging a recording
+whose current lead is broken against limits; help-guide.png and help-about.png:
+Help's user guide and About (--only qa: just these).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
 """
@@ -506,9 +509,47 @@ def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> lis
     return every_page_screenshots(app, window, folder, out)
 
 
+def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """--only qa: the QA page judging a recording whose current lead is broken (zeroed) against limits, at
+    both screen sizes; then Help's guide and About."""
+    import numpy as np
+
+    from analysis.recording import make_recording, read_recording
+    good = read_recording(synthetic_recording(folder))
+    signals = {c.signal: good.signal(c.signal) for c in good.channels}
+    signals["current"] = np.zeros_like(signals["current"])
+    broken, _ = write_recording(folder / "current-zeroed", make_recording(
+        good.sample_rate, signals, good.period_samples, good.settle_periods, good.excited_bins, dict(good.driver)))
+    limits = folder / "w18-limits.json"
+    limits.write_text(json.dumps({"format": "linpar-limits/1", "name": "W18 production QA", "parameters": {
+        "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"}, "fs": {"nominal": 70, "tolerance": 7, "unit": "Hz"},
+        "Bl": {"min": 5.0, "unit": "T*m"}}}, indent=1))
+    window.qa.load_limits(limits)
+    window.open_path(broken)
+    if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
+        return []
+    window.pages.setCurrentWidget(window.qa)
+    written = []
+    for size in SMALL_AND_LARGE:
+        window.resize(*size)
+        settle(app)
+        path = out / f"qa-current-zeroed-{size[0]}x{size[1]}.png"
+        window.grab().save(str(path))
+        written.append(path)
+    for name, show in (("help-guide", window.menus.show_guide), ("help-about", window.menus.show_about)):
+        dialog = show()
+        settle(app)
+        path = out / f"{name}.png"
+        dialog.grab().save(str(path))
+        dialog.close()
+        written.append(path)
+    window.resize(*SIZE)
+    return written
+
+
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
-        "pages": pages_screenshots}
+        "pages": pages_screenshots, "qa": qa_broken_screenshots}
 
 
 def main(argv: list[str]) -> int:
@@ -578,6 +619,7 @@ def main(argv: list[str]) -> int:
         written += series_screenshots(app, window, folder, out)
         written += large_signal_screenshots(app, window, folder, out)
         written += archive_screenshots(app, window, folder, out)
+        written += qa_broken_screenshots(app, window, folder, out)
         window.archive.set_root(folder / "production-archive")      # a line's worth of units of its own
         written += production_screenshots(app, window, folder, out)
         window.close()
