@@ -291,7 +291,7 @@ def archive_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
 
     driver = load_driver("paper")
     mt = design_multitone(48000, 16384, 5.0, 10000.0, rms=1.0)
-    archive = Archive(window.archive.root)
+    archive = Archive(Path(window.archive.source))
     for number, (serial, operator, station, days, hours, bl, mms, cms, re) in enumerate(ARCHIVE_BATCH):
         p = dict(driver.parameters)
         b, m, c = p["Bl"] * (1 + bl), p["CMES"] * p["Bl"] ** 2 * (1 + mms), p["LCES"] / p["Bl"] ** 2 * (1 + cms)
