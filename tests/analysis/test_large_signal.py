@@ -95,10 +95,7 @@ def test_the_two_sigma_band_holds_the_truth_at_90_percent_of_the_points_over_20_
     coverage = {name: float(np.mean(hits)) for name, hits in inside.items()}
     for name, value in coverage.items():
         record_property(f"coverage_{name}", value)
-    assert coverage["Bl"] >= 0.9 and coverage["Kms"] >= 0.9, coverage
-    # Le(x)'s band is narrower than its scatter (~1.3x) and sits on a ~1e-4 offset this test cannot tell from the
-    # simulator's: reported, held to what it reaches (see docs/large-signal.md).
-    assert coverage["Le"] >= 0.7, coverage
+    assert coverage["Bl"] >= 0.9 and coverage["Kms"] >= 0.9 and coverage["Le"] >= 0.9, coverage
 
 
 def test_the_distortion_predicted_at_a_second_level_is_the_simulators_within_1_db(known, record_property):
