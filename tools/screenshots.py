@@ -130,12 +130,16 @@ def model_lab_unexplained_screenshots(app: QApplication, window, folder: Path, o
     return grab_small_and_large(app, window, out, "model-lab-unexplained")
 
 
-def grab_small_and_large(app: QApplication, window, out: Path, stem: str) -> list[Path]:
-    """The window as it is, at 1280x720 and at 1920x1080 (OUT/STEM-WxH.png); then back to its usual size."""
+def grab_small_and_large(app: QApplication, window, out: Path, stem: str, prepare=None) -> list[Path]:
+    """The window (or a dialog) as it is, at 1280x720 and at 1920x1080 (OUT/STEM-WxH.png); then back to its
+    usual size. `prepare()`, if given, runs after each resize, before the grab (to scroll something into view)."""
     written = []
     for width, height in SMALL_AND_LARGE:
         window.resize(width, height)
         settle(app, 600)
+        if prepare is not None:
+            prepare()
+            settle(app)
         path = out / f"{stem}-{width}x{height}.png"
         window.grab().save(str(path))
         written.append(path)
@@ -363,13 +367,7 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
     dialog.formula_edit.setText("r * (sqrt(w / ws) - 1)")
     dialog.formula_edit.setFocus()
     dialog.formula_edit.setCursorPosition(len(dialog.formula_edit.text()))
-    written = []
-    for width, height in SMALL_AND_LARGE:
-        dialog.resize(width, height)
-        settle(app, 600)
-        path = out / f"model-lab-new-effect-{width}x{height}.png"
-        dialog.grab().save(str(path))
-        written.append(path)
+    written = grab_small_and_large(app, dialog, out, "model-lab-new-effect")
     dialog.save_button.click()
     settle(app)
     item = lab.catalogue.item("rms-sqrt-f")
@@ -379,17 +377,9 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
     if not wait_for(lab.version_added, ANALYSIS_TIMEOUT_S):
         print("screenshots: the refit with the new effect did not finish in time", file=sys.stderr)
         return written
-    for width, height in SMALL_AND_LARGE:
-        window.resize(width, height)
-        settle(app, 600)
-        lab.catalogue.tree.scrollToItem(item)          # the User effects branch, with the effect checked
-        settle(app)
-        path = out / f"model-lab-own-effect-{width}x{height}.png"
-        window.grab().save(str(path))
-        written.append(path)
-    window.resize(*SIZE)
-    settle(app)
-    return written
+    # the User effects branch in view, with the effect checked
+    return written + grab_small_and_large(app, window, out, "model-lab-own-effect",
+                                          prepare=lambda: lab.catalogue.tree.scrollToItem(item))
 
 
 def production_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:

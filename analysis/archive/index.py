@@ -35,7 +35,8 @@ from analysis.archive.leftovers import STALE_AFTER_S, sweep
 from analysis.archive.names import ArchiveError, check_id
 from analysis.archive.record import (Entry, checked_entry, checked_parameter, checked_qa, entry_of, one_line_text,
                                      read_record)
-from analysis.archive.schema import KEY_PARAMETERS, SchemaError, check_columns, migrate, std_column, value_column
+from analysis.archive.schema import (KEY_PARAMETERS, SchemaError, check_columns, measured_until, migrate, std_column,
+                                     value_column)
 
 SQLITE_MAGIC = b"SQLite format 3\x00"
 INDEX_FILE = "index.sqlite"
@@ -54,6 +55,28 @@ class Filter:
     since: str | None = None       # ISO date or date-time, inclusive
     until: str | None = None       # ISO date or date-time, inclusive (a bare date means the whole day)
     limit: int | None = None
+
+    def sql(self, placeholder: str, like: str = "LIKE") -> tuple[str, list]:
+        """The WHERE, ORDER BY and LIMIT that select this filter's measurements (newest first), and their
+        arguments; `placeholder` and `like` are the database's ("?" and LIKE for SQLite, "%s" and ILIKE for
+        PostgreSQL)."""
+        where, args = [], []
+        for column in ("driver", "serial", "operator", "station"):
+            text = getattr(self, column)
+            if text:
+                where.append(f"{column} {like} {placeholder} ESCAPE '\\'")
+                args.append(_like(text))
+        until = self.until and measured_until(self.until)
+        for column, op, value in (("validity", "=", self.validity), ("measured_at", ">=", self.since),
+                                  ("measured_at", "<=", until)):
+            if value:
+                where.append(f"{column} {op} {placeholder}")
+                args.append(value)
+        sql = (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY measured_at DESC, id DESC"
+        if self.limit is not None:
+            sql += f" LIMIT {placeholder}"
+            args.append(int(self.limit))
+        return sql, args
 
 
 @dataclass
@@ -258,27 +281,9 @@ class Index:
     # --- reading ----------------------------------------------------------------
 
     def query(self, conn: sqlite3.Connection, flt: Filter = Filter()) -> list[Entry]:
-        where, args = [], []
-        for column in ("driver", "serial", "operator", "station"):
-            text = getattr(flt, column)
-            if text:
-                where.append(f"{column} LIKE ? ESCAPE '\\'")
-                args.append(_like(text))
-        if flt.validity:
-            where.append("validity = ?")
-            args.append(flt.validity)
-        if flt.since:
-            where.append("measured_at >= ?")
-            args.append(flt.since)
-        if flt.until:
-            where.append("measured_at <= ?")
-            args.append(flt.until + ("T99" if len(flt.until) == 10 else ""))   # a bare date: the whole day
+        selection, args = flt.sql("?")
         sql = "SELECT id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects, " \
-              "verdict, limits_version FROM measurements" + (" WHERE " + " AND ".join(where) if where else "") + \
-              " ORDER BY measured_at DESC, id DESC"
-        if flt.limit is not None:
-            sql += " LIMIT ?"
-            args.append(int(flt.limit))
+              "verdict, limits_version FROM measurements" + selection
         entries: dict[str, Entry] = {}
         refused: list[str] = []
         for row in conn.execute(sql, args).fetchall():

@@ -18,7 +18,7 @@ import numpy as np
 
 from analysis.archive.names import ArchiveError
 from analysis.archive.population import Population, Selection, finite_or_nan
-from analysis.archive.schema import KEY_PARAMETERS, std_column, value_column
+from analysis.archive.schema import KEY_PARAMETERS, measured_until, std_column, value_column
 
 # The columns that say who, where and when, in the order the readers select them (Population's first fields).
 HEADS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict", "limits_version")
@@ -42,7 +42,7 @@ def where_clause(selection: Selection, mark: str) -> tuple[str, list]:
         args.append(selection.since)
     if selection.until:
         where.append(f"m.measured_at <= {mark}")
-        args.append(selection.until + ("T99" if len(selection.until) == 10 else ""))   # a bare date: all of it
+        args.append(measured_until(selection.until))
     for column, chosen in (("station", selection.stations), ("driver", selection.drivers), ("id", selection.ids)):
         if chosen:
             where.append(f"m.{column} IN ({', '.join([mark] * len(chosen))})")

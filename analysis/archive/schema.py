@@ -32,6 +32,11 @@ def std_column(name: str) -> str:
     return value_column(name + "_std")
 
 
+def measured_until(until: str) -> str:
+    """The upper bound of measured_at (ISO text) for an inclusive "until": a bare date means the whole day."""
+    return until + ("T99" if len(until) == 10 else "")
+
+
 def _v1(conn: sqlite3.Connection) -> None:
     conn.execute("""CREATE TABLE measurements (
         id TEXT PRIMARY KEY,

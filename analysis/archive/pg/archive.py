@@ -21,7 +21,7 @@ from typing import Callable, Iterable, Iterator
 
 from analysis.archive.archive import Measurement, export_folder
 from analysis.archive.backends import SyncReport
-from analysis.archive.index import Filter, _entry_of_row, _like
+from analysis.archive.index import Filter, _entry_of_row
 from analysis.archive.limits_store import LimitsVersion, checked_document, checked_note, version_of_json
 from analysis.archive.names import ArchiveError, check_id, check_id_prefix, inside
 from analysis.archive.pg.files import fetch_file
@@ -137,22 +137,8 @@ class PostgresArchive:
 
     def list(self, flt: Filter | None = None, **kwargs) -> list:
         flt = flt or Filter(**kwargs)
-        where, args = [], []
-        for column in ("driver", "serial", "operator", "station"):
-            text = getattr(flt, column)
-            if text:
-                where.append(f"{column} ILIKE %s ESCAPE '\\'")
-                args.append(_like(text))
-        for column, op, value in (("validity", "=", flt.validity), ("measured_at", ">=", flt.since),
-                                  ("measured_at", "<=", flt.until and flt.until + ("T99" if len(flt.until) == 10
-                                                                                    else ""))):
-            if value:
-                where.append(f"{column} {op} %s")
-                args.append(value)
-        sql = f"SELECT {LIST_COLUMNS} FROM measurements" + (" WHERE " + " AND ".join(where) if where else "") + \
-              " ORDER BY measured_at DESC, id DESC" + (" LIMIT %s" if flt.limit is not None else "")
-        if flt.limit is not None:
-            args.append(int(flt.limit))
+        selection, args = flt.sql("%s", like="ILIKE")
+        sql = f"SELECT {LIST_COLUMNS} FROM measurements" + selection
         with self._session("listing") as conn:
             rows = conn.execute(sql, args).fetchall()
             params = conn.execute("SELECT measurement_id, name, value, std, unit FROM parameters "
