@@ -38,6 +38,7 @@ from scipy.optimize import minimize_scalar
 
 from analysis.curve_fit import (CurveFitError, FitRange, covariance_with_bounds, curve_validity, fit_curves,
                                 relative_residual)
+from analysis.default_model import ADDED_MASS_EFFECTS
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import Site
@@ -55,10 +56,7 @@ from analysis.startvalues import start_context
 AGREE_SIGMA, DISAGREE_SIGMA = 2.0, 3.0
 AGREE_PERCENT, DISAGREE_PERCENT = 2.0, 5.0
 COMPARED = ("Bl", "Mms", "Cms")
-# The impedance-only fits need the semi-inductance: with LR-2 the blocked
-# impedance of real coils leaks into RE and the motional branch (SEAS L16RNX:
-# Bl 4 % low over 10 Hz-20 kHz with lr2,creep-log; within 1 % with this).
-DEFAULT_EFFECTS = "leach,creep-log-causal"
+DEFAULT_EFFECTS = ",".join(ADDED_MASS_EFFECTS)      # why these: analysis.default_model
 MODEL_FREE_BAND = (0.8, 1.2)     # x fs, Speakerbench's averaging band
 REPORTED = ("Bl", "Mms", "Cms", "Rms", "Vas", "fs", "Qms", "Qes", "Qts", "RE")
 

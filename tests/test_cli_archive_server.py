@@ -65,9 +65,9 @@ def test_setup_users_and_a_role_s_refusal_as_one_line(capsys, pg_database, tmp_p
 
 
 def test_measure_queues_while_the_server_is_away_and_sync_sends_once(capsys, pg_database, tmp_path, monkeypatch):
-    import app.cli_measure as cli_measure
+    import app.cli.devices as cli_devices
     from instruments.audio.simulated import SimulatedAudio
-    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+    monkeypatch.setattr(cli_devices, "open_devices", lambda args, stack: (
         SimulatedAudio(realtime=False, seed=1), None, {"name": "paper (simulated)", "sd_m2": 0.0133}))
     proxy = TcpProxy(pg_database.server.port)
     try:

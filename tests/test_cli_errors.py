@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-import app.cli_commands
+import app.cli.effects
 from analysis.errors import LinparError, is_user_error, user_message
 from app.cli import main
 
@@ -31,7 +31,7 @@ def test_a_bug_exits_70_with_one_line_and_a_crash_report(capsys, monkeypatch, tm
 
     def broken(args):
         raise ValueError("a bug, not bad input")       # a bare ValueError is a bug, not the user's error
-    monkeypatch.setattr(app.cli_commands, "cmd_effects", broken)
+    monkeypatch.setattr(app.cli.effects, "run", broken)
     code, out, err = run(capsys, "effects", "--json")
     assert code == 70 and out == ""
     assert len(err.splitlines()) == 1 and "Traceback" not in err
@@ -46,7 +46,7 @@ def test_a_bug_exits_70_with_one_line_and_a_crash_report(capsys, monkeypatch, tm
 
 def test_two_crashes_in_one_second_keep_two_reports(capsys, monkeypatch, tmp_path):
     monkeypatch.setenv("LINPAR_CACHE", str(tmp_path))
-    monkeypatch.setattr(app.cli_commands, "cmd_effects", lambda args: 1 / 0)
+    monkeypatch.setattr(app.cli.effects, "run", lambda args: 1 / 0)
     for _ in range(2):
         assert run(capsys, "effects")[0] == 70
     assert len(list(tmp_path.glob("crash-*.txt"))) == 2
@@ -56,7 +56,7 @@ def test_a_crash_report_that_cannot_be_written_still_gives_one_line(capsys, monk
     blocker = tmp_path / "a-file"
     blocker.write_text("not a folder")
     monkeypatch.setenv("LINPAR_CACHE", str(blocker / "cache"))
-    monkeypatch.setattr(app.cli_commands, "cmd_effects", lambda args: 1 / 0)
+    monkeypatch.setattr(app.cli.effects, "run", lambda args: 1 / 0)
     code, _, err = run(capsys, "effects")
     assert code == 70 and len(err.splitlines()) == 1 and "no crash report" in err
 
@@ -89,8 +89,8 @@ def every_error_class():
             module = ".".join(path.relative_to(REPO).with_suffix("").parts)
             if module.endswith("__init__"):
                 module = module[: -len(".__init__")]
-            if module in ("app.main", "instruments.rig.server"):
-                continue        # Qt's start-up and a server script: no error classes, side effects on import
+            if module in ("app.main", "instruments.rig.server") or module.endswith(".__main__"):
+                continue        # Qt's start-up, a server script, `python -m`: no error classes, side effects on import
             try:
                 mod = importlib.import_module(module)
             except ImportError:

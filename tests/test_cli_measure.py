@@ -87,9 +87,9 @@ def test_mistakes_are_one_line_errors_before_anything_starts(tmp_path, capsys, a
 @pytest.fixture
 def simulated_card(monkeypatch):
     """`linpar measure` on the in-process simulated sound card (no JACK), analog laser on its input."""
-    import app.cli_measure as cli_measure
+    import app.cli.devices as cli_devices
     from instruments.audio.simulated import SimulatedAudio
-    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+    monkeypatch.setattr(cli_devices, "open_devices", lambda args, stack: (
         SimulatedAudio(realtime=False, seed=1), None, {"name": "paper (simulated)", "sd_m2": 0.0133}))
 
 
@@ -99,7 +99,7 @@ MEASURED = datetime(2024, 5, 1, 12, 0, 0, tzinfo=timezone.utc)
 @pytest.fixture
 def measured_on_may_1st(monkeypatch):
     """`linpar measure`'s clock (only its own: the archive's stays true) says 2024-05-01 12:00 UTC."""
-    import app.cli_measure as cli_measure
+    import app.cli.measure as cli_measure
 
     class Clock(datetime):
         @classmethod
@@ -167,10 +167,10 @@ def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, me
 
 def test_a_measurement_with_the_voltage_lead_off_is_judged_kept_and_not_stored(monkeypatch, tmp_path, capsys):
     """It used to end in a ZeroDivisionError traceback after writing the recording."""
-    import app.cli_measure as cli_measure
+    import app.cli.devices as cli_devices
     from instruments.audio.simulated import SimulatedAudio
     from instruments.rig.engine import RigFaults
-    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+    monkeypatch.setattr(cli_devices, "open_devices", lambda args, stack: (
         SimulatedAudio(realtime=False, seed=1, faults=RigFaults(disconnected={"voltage"})), None,
         {"name": "paper (simulated)", "sd_m2": 0.0133}))
     code, printed, err = measure(capsys, tmp_path, "--archive-root", str(tmp_path / "archive"))

@@ -14,7 +14,7 @@ import sys
 
 import pytest
 
-import app.cli_measure as cli_measure
+import app.cli.devices as cli_devices
 from analysis.recording import read_recording
 from app.cli import main
 from instruments.audio.simulated import SimulatedAudio
@@ -31,12 +31,12 @@ def run(capsys, *argv):
 
 @pytest.fixture
 def simulated_card(monkeypatch):
-    monkeypatch.setattr(cli_measure, "_devices", lambda args, stack: (
+    monkeypatch.setattr(cli_devices, "open_devices", lambda args, stack: (
         SimulatedAudio(realtime=False, seed=1), None, {"name": "paper (simulated)", "sd_m2": 0.0133}))
 
 
 def test_ctrl_c_during_measure_writes_the_periods_so_far(simulated_card, monkeypatch, tmp_path, capsys):
-    class CtrlCAfterThreePeriods(cli_measure._Progress):
+    class CtrlCAfterThreePeriods(cli_devices.Progress):
         pressed = False
 
         def __call__(self, p):
@@ -44,7 +44,7 @@ def test_ctrl_c_during_measure_writes_the_periods_so_far(simulated_card, monkeyp
             if p.stage == "averaging" and p.periods_kept == 3 and not self.pressed:
                 self.pressed = True
                 os.kill(os.getpid(), signal.SIGINT)       # as the terminal does
-    monkeypatch.setattr(cli_measure, "_Progress", CtrlCAfterThreePeriods)
+    monkeypatch.setattr(cli_devices, "Progress", CtrlCAfterThreePeriods)
     before = signal.getsignal(signal.SIGINT)      # SIG_IGN, not Python's handler, under a shell's `cmd &`
     code, out, err = run(capsys, "measure", "--out", tmp_path, "--name", "m", *SHORT)
     assert code == 130 and out == ""
@@ -58,7 +58,7 @@ def test_ctrl_c_during_measure_writes_the_periods_so_far(simulated_card, monkeyp
 
 def test_a_second_ctrl_c_stops_at_once_and_recover_makes_the_journal_a_recording(simulated_card, monkeypatch,
                                                                                  tmp_path, capsys):
-    class CtrlCTwice(cli_measure._Progress):
+    class CtrlCTwice(cli_devices.Progress):
         presses = 0
 
         def __call__(self, p):
@@ -66,7 +66,7 @@ def test_a_second_ctrl_c_stops_at_once_and_recover_makes_the_journal_a_recording
             if p.stage == "averaging" and p.periods_kept >= 3 and self.presses < 2:
                 self.presses += 1
                 os.kill(os.getpid(), signal.SIGINT)
-    monkeypatch.setattr(cli_measure, "_Progress", CtrlCTwice)
+    monkeypatch.setattr(cli_devices, "Progress", CtrlCTwice)
     code, _, err = run(capsys, "measure", "--out", tmp_path, "--name", "m", *SHORT)
     assert code == 130 and f"'linpar recover {tmp_path}' makes it a recording" in err
     assert not (tmp_path / "m.wav").exists() and (tmp_path / "m.unfinished").is_dir()

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from app import cli_rig
+from app.cli import rig as cli_rig
 from app.cli import build_parser, main
 
 REPO = Path(__file__).resolve().parents[1]

@@ -9,6 +9,7 @@ from typing import Mapping
 
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.effects import breakup, channels, creep, enclosure, forcefactor, inductance, mechanical
+from analysis.default_model import DEFAULT_EFFECTS
 from analysis.errors import LinparError
 
 # Grouped by category; within a category the effects are alternatives (one per model).
@@ -40,7 +41,6 @@ _ALL: tuple[Effect, ...] = (
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}
-DEFAULT_EFFECTS = ("lr2", "creep-log")
 
 
 def categories() -> dict[str, list[Effect]]:

@@ -14,6 +14,7 @@ import json
 
 import numpy as np
 
+from analysis.json_finite import dumps
 from analysis.large_signal.curves import compliance_of
 from analysis.large_signal.result import LargeSignalResult
 
@@ -50,14 +51,4 @@ def curves_csv(result: LargeSignalResult) -> str:
 
 def curves_json(result: LargeSignalResult) -> str:
     """The JSON of `linpar large-signal --json` (NaN and infinities as null)."""
-    return json.dumps(_finite(result.as_json()), allow_nan=False, indent=1) + "\n"
-
-
-def _finite(x):
-    if isinstance(x, dict):
-        return {k: _finite(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite(v) for v in x]
-    if isinstance(x, float) and not np.isfinite(x):
-        return None
-    return x
+    return dumps(result.as_json(), indent=1, ensure_ascii=True) + "\n"

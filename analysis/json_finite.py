@@ -1,7 +1,7 @@
-"""What `linpar ... --json` prints: always valid JSON, never NaN or Infinity.
+"""JSON that is always valid: never NaN or Infinity (what `linpar ... --json` prints, the JSON exports).
 
 JSON has no NaN and no infinities (Python's json writes them, other readers
-refuse them). Every document printed goes through `dumps`: a non-finite
+refuse them). Every document printed or exported goes through `dumps`: a non-finite
 number becomes null, and when it is the "value" of an object (a parameter,
 a finding) the object says why in "reason", as a parameter that could not be
 measured does. numpy scalars and arrays become plain numbers and lists.

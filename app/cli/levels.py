@@ -17,6 +17,9 @@ from __future__ import annotations
 import argparse
 import sys
 
+from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects
+from app.cli.output import print_json
+
 
 def _levels(text: str) -> tuple[float, ...]:
     from analysis.bounds import LEVEL_V_RMS, BoundsError
@@ -29,9 +32,7 @@ def _levels(text: str) -> tuple[float, ...]:
     return levels
 
 
-def add_commands(sub) -> None:
-    from analysis.bounds import SD
-    from app.cli_options import number
+def register(sub) -> None:
     levels = sub.add_parser("levels", help="level series: the parameters against peak excursion (Table II)")
     levels.add_argument("paths", nargs="*", metavar="FILE",
                         help="recordings at rising levels (NAME, NAME.wav or NAME.json)")
@@ -40,15 +41,14 @@ def add_commands(sub) -> None:
     levels.add_argument("--levels", type=_levels, metavar="V1,V2,...",
                         help="with --simulate: drive levels in V RMS (default 0.3,1,3,6,10,14: ~0.15-8.5 mm)")
     levels.add_argument("--out", metavar="DIR", help="with --simulate: write the recordings to DIR (kept)")
-    levels.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
-    levels.add_argument("--model", metavar="EFFECTS", help="effect ids (default lr2,creep-log)")
-    levels.add_argument("--json", action="store_true", help="print one JSON object (with the Fig. 14 data)")
+    add_sd_option(levels)
+    add_model_option(levels)
+    add_json_option(levels, "print one JSON object (with the Fig. 14 data)")
+    levels.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from analysis.level_series import format_series, level_series
-    from app.cli import CliError
-    from app.cli_import import _effects, _print_json
     if args.simulate and args.paths:
         raise CliError("give either recordings (FILE...) or --simulate, not both")
     if not args.simulate:
@@ -57,11 +57,11 @@ def run(args: argparse.Namespace) -> int:
         used = [name for name, value in (("--levels", args.levels), ("--out", args.out)) if value]
         if used:
             raise CliError(f"{', '.join(used)}: only with --simulate")
-    effects = _effects(args.model) if args.model else None     # a bad --model fails before the simulation
+    effects = model_effects(args.model) if args.model else None     # a bad --model fails before the simulation
     items = _simulate(args) if args.simulate else list(args.paths)
     series = level_series(items, args.sd, effects)
     if args.json:
-        _print_json(series.as_json())
+        print_json(series.as_json())
     else:
         print(format_series(series))
     return 0
@@ -69,7 +69,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _simulate(args: argparse.Namespace) -> list:
     """The simulated series at args.levels: .wav paths with --out, else Recordings in memory."""
-    from app.cli import CliError
     from instruments.simulation import level_series as sim
     levels = args.levels or sim.DEFAULT_LEVELS_V
     try:

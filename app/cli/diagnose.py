@@ -1,28 +1,42 @@
-"""`linpar diagnose`: rank the effects the model may lack, follow the greedy path, say what is missing and where."""
+"""`linpar diagnose`: rank the effects the model may lack, follow the greedy path, say what is missing and where.
+
+The analysis is imported when the command runs: building the parser (`linpar --help`) stays light.
+"""
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-from analysis import acceptance
-from analysis.derived import parameter_table
-from analysis.diagnosis import Candidate, Diagnosis, Step, diagnose, explain
-from analysis.diagnosis_words import (VERDICT_TITLES, chi2_words, drift_from_validity, residual_json, sites_json,
-                                      tied_sites, verdict_text)
-from analysis.fit import FitData, FitResult
-from analysis.model import Model
-from analysis.parallel import fit_executor
-from analysis.pipeline import judged_fit_data, resolve_sd
-from analysis.recording import read_recording
-from app.cli_json import dumps
+from app.cli import curves, effects
+from app.cli.options import add_json_option, add_sd_option, model_effects
+from app.cli.output import print_json
+
+if TYPE_CHECKING:
+    from analysis.diagnosis import Candidate, Diagnosis, Step
+    from analysis.fit import FitData, FitResult
+
+
+def register(sub) -> None:
+    diagnose = sub.add_parser("diagnose", help="find which physical effect the model lacks")
+    diagnose.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
+    diagnose.add_argument("--from", dest="start", metavar="EFFECTS", default="none",
+                          help="the starting model's effect ids (default: the textbook model)")
+    add_sd_option(diagnose)
+    add_json_option(diagnose)
+    curves.add_curve_options(diagnose)
+    effects.add_effects_file_option(diagnose)
+    diagnose.set_defaults(run=run)
 
 
 def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
     """The lines to diagnose (from a recording, or from imported curves), Sd, and the recording's drift finding."""
-    from app import cli_import
-    if cli_import.wants_curves(args):
+    from analysis.diagnosis_words import drift_from_validity
+    from analysis.pipeline import judged_fit_data, resolve_sd
+    from analysis.recording import read_recording
+    if curves.wants_curves(args):
         from analysis.curve_fit import curve_data
-        z, hx, notes = cli_import.load_curves(args)
-        data, _ = curve_data(z, hx, cli_import.fit_range(args, args.hx_fmax), notes)
+        z, hx, notes = curves.load_curves(args)
+        data, _ = curve_data(z, hx, curves.fit_range(args, args.hx_fmax), notes)
         return data, args.sd, None
     recording = read_recording(args.path)
     data, validity = judged_fit_data(recording, "be diagnosed")
@@ -30,10 +44,12 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
 
 
 def run_diagnosis(args: argparse.Namespace):
-    from app.cli_commands import _effects
-    effects = _effects(args.start, "--from")     # a bad --from fails before the data are read
+    from analysis.diagnosis import diagnose
+    from analysis.model import Model
+    from analysis.parallel import fit_executor
+    start = model_effects(args.start, "--from")     # a bad --from fails before the data are read
     data, sd, drift = _data(args)
-    model = Model(effects, with_displacement=data.displacement is not None)
+    model = Model(start, with_displacement=data.displacement is not None)
     with fit_executor() as executor:
         result = diagnose(data, model, executor=executor)
     return result, sd, drift
@@ -44,6 +60,8 @@ def _fit_summary(fit: FitResult) -> dict:
 
 
 def _candidate_json(current: FitResult, c: Candidate) -> dict:
+    from analysis import acceptance
+    from analysis.diagnosis import explain
     return {
         "action": c.action,
         "effect": c.effect.id,
@@ -60,11 +78,15 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
 
 
 def _step_json(step: Step) -> dict:
+    from analysis import acceptance
     return {**_fit_summary(step.fit), "chosen": step.chosen.effect.id if step.chosen else None,
             "flags": acceptance.flags_json(step.flags)}
 
 
 def diagnosis_json(result: Diagnosis, sd_m2: float | None, drift: str | None = None) -> dict:
+    from analysis import acceptance
+    from analysis.derived import parameter_table
+    from analysis.diagnosis_words import residual_json, sites_json, verdict_text
     final = result.final
     return {
         "verdict": result.verdict,
@@ -87,6 +109,8 @@ def _flags_text(flags) -> str:
 
 
 def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
+    from analysis.diagnosis import explain
+    from analysis.diagnosis_words import VERDICT_TITLES, chi2_words, tied_sites, verdict_text
     lines = [f"verdict: {VERDICT_TITLES[result.verdict]}", "  " + verdict_text(result, drift), "",
              f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", "",
              f"{'rank':<5}{'move':<34}{'delta BIC':>12}  {'taken?':<12} reduced chi^2"]
@@ -120,10 +144,10 @@ def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
     return "\n".join(lines)
 
 
-def cmd_diagnose(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     result, sd, drift = run_diagnosis(args)
     if args.json:
-        print(dumps(diagnosis_json(result, sd, drift)))
+        print_json(diagnosis_json(result, sd, drift))
     else:
         print(format_diagnosis(result, drift))
     return 0

@@ -7,10 +7,11 @@ with --effects-file, before it does anything else: a bad file stops it at once w
 from __future__ import annotations
 
 import argparse
-import json
 from typing import TYPE_CHECKING
 
 from analysis.config_folder import EFFECTS_FOLDER_ENV, config_folder
+from app.cli.options import add_json_option
+from app.cli.output import print_json
 
 if TYPE_CHECKING:       # the catalogue (and scipy) is loaded by the commands that use it, not by every start
     from analysis.effects import Effect
@@ -19,7 +20,14 @@ if TYPE_CHECKING:       # the catalogue (and scipy) is loaded by the commands th
 COMMANDS = ("analyze", "diagnose", "effects", "report", "export", "archive", "addedmass", "stats", "levels")
 
 
-def add_option(parser: argparse.ArgumentParser) -> None:
+def register(sub) -> None:
+    effects = sub.add_parser("effects", help="list the effects catalogue and your own effects")
+    add_json_option(effects, None)
+    add_effects_file_option(effects)
+    effects.set_defaults(run=run)
+
+
+def add_effects_file_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--effects-file", dest="effects_files", action="append", default=[], metavar="FILE",
                         help="an effect of your own (TOML; repeatable), beside the catalogue and the user folder "
                              f"(${EFFECTS_FOLDER_ENV} or {config_folder() / 'effects'})")
@@ -38,11 +46,11 @@ def _parameters_text(effect: Effect) -> str:
                      for p in effect.params)
 
 
-def cmd_effects(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int:
     from analysis.effects import CATALOGUE, categories, registry
     users = registry.user_effects()
     if args.json:
-        print(json.dumps([e.describe() for e in (*CATALOGUE.values(), *users)], indent=1))
+        print_json([e.describe() for e in (*CATALOGUE.values(), *users)], indent=1)
         return 0
     for category, effects in categories().items():
         print(f"[{category}]")

@@ -13,11 +13,11 @@ status: 0 running, 1 not running; 2 on an error (one line on stderr).
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from analysis.bounds import XRUN_S
-from app.cli_options import number
+from app.cli.options import CliError, number
+from app.cli.output import print_json
 
 EXIT_OK, EXIT_NOT_RUNNING = 0, 1
 # The rig server's --model choices (instruments/rig/server.py), spelled here so that the parser loads no rig code.
@@ -29,8 +29,9 @@ def _manager():
     return manager
 
 
-def add_commands(sub) -> None:
+def register(sub) -> None:
     rig = sub.add_parser("rig", help="the virtual rig: a simulated amplifier, driver and sensors on JACK")
+    rig.set_defaults(run=run)
     actions = rig.add_subparsers(dest="rig_action", required=True, parser_class=type(rig))
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("--name", default="linpar", help="rig name = its JACK server's name (default %(default)s)")
@@ -81,7 +82,6 @@ def run(args: argparse.Namespace) -> int:
 def _start(args) -> int:
     if args.model != "linear" and args.effects:
         # The nonlinear driver takes its small-signal model from the driver file's values.
-        from app.cli import CliError
         raise CliError(f"--effects applies to the linear model only, not to --model {args.model}")
     # A driver file or a spec that cannot be used is one line here, not a rig process that dies starting.
     from analysis.drivers import load_driver
@@ -108,7 +108,7 @@ def _start(args) -> int:
 def _status(args) -> int:
     status = _manager().rig_status(args.name, args.runtime_dir)
     if args.json:
-        print(json.dumps({"running": status is not None, **(status or {})}, indent=1))
+        print_json({"running": status is not None, **(status or {})}, indent=1)
     else:
         print(format_status(status) if status else f"rig {args.name!r} is not running")
     return EXIT_OK if status else EXIT_NOT_RUNNING

@@ -17,8 +17,13 @@ import argparse
 import sys
 from pathlib import Path
 
+from app.cli import output
+from app.cli.options import CliError, add_json_option
+from app.cli.output import print_json
+from app.cli.result_text import format_result
 
-def add_commands(sub) -> None:
+
+def register(sub) -> None:
     recover = sub.add_parser("recover", help="measurements cut short by a crash: list, keep, analyse or discard")
     recover.add_argument("dir", nargs="?", default=".", metavar="DIR",
                          help="the folder the measurement was written to (measure --out; default: .)")
@@ -27,11 +32,11 @@ def add_commands(sub) -> None:
     what.add_argument("--analyse", "--analyze", nargs="*", metavar="NAME",
                       help="write them as recordings and analyse them (all without NAME)")
     what.add_argument("--discard", nargs="+", metavar="NAME", help="remove their journals: the data are lost")
-    recover.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_option(recover)
+    recover.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from app.cli import CliError
     from instruments.measurement.recovery import discard, find_unfinished, recover
     folder = Path(args.dir)
     if not folder.is_dir():
@@ -66,18 +71,16 @@ def run(args: argparse.Namespace) -> int:
             failed.append({"name": unfinished.name, "error": user_message(exc)})
             print(f"linpar: error: {user_message(exc)}", file=sys.stderr)
     if args.json:
-        from app.cli_json import dumps
-        print(dumps({"folder": str(folder), "done": done, "failed": failed}))
+        print_json({"folder": str(folder), "done": done, "failed": failed})
     return 2 if failed else 0
 
 
 def _list(found: dict, folder: Path, as_json: bool) -> int:
     if as_json:
-        from app.cli_json import dumps
-        print(dumps({"folder": str(folder), "unfinished": [
+        print_json({"folder": str(folder), "unfinished": [
             {"name": u.name, "journal": str(u.journal), "started_at": u.started_at, "periods": u.periods,
              "seconds": u.seconds, "serial_laser": u.serial_laser, "driver": u.driver,
-             "recoverable": not u.problem, "problem": u.problem or None} for u in found.values()]}))
+             "recoverable": not u.problem, "problem": u.problem or None} for u in found.values()]})
         return 0
     if not found:
         print(f"no unfinished measurement in {folder}")
@@ -91,7 +94,6 @@ def _list(found: dict, folder: Path, as_json: bool) -> int:
 
 def _analysis(wav: Path, as_json: bool):
     from analysis.pipeline import analyze_path, result_json
-    from app.cli_commands import format_result
     result = analyze_path(wav)
     if as_json:
         return result_json(result)
@@ -101,4 +103,4 @@ def _analysis(wav: Path, as_json: bool):
 
 
 def _say(text: str) -> None:
-    print(f"linpar recover: {text}", file=sys.stderr, flush=True)
+    output.say("recover", text)

@@ -5,7 +5,7 @@
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
                    [--on-xrun end|restart] [--serial TEXT] [--operator TEXT] [--station TEXT]
                    [--archive URL|DIR | --archive-root DIR | --no-archive] [--json]
-                   [--plan single|large-signal [the plan's limits: app/cli_large_signal.py]]
+                   [--plan single|large-signal [the plan's limits: app/cli/large_signal.py]]
 
 With ``--rig virtual`` (the default) the virtual rig named ``--rig-name`` is
 used, started first if it is not running and stopped at the end if this
@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import shlex
 import signal
 import sys
@@ -50,18 +49,19 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Iterator
 
-from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS, SAMPLE_RATE, SD
+from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS
 from analysis.errors import is_user_error, user_message
-from app.cli_json import dumps
-from app.cli_options import number
-from instruments.measurement.errors import MeasurementError
+from app.cli import devices, large_signal
+from app.cli.devices import LASER_ANALOG, say
+from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects, number
+from app.cli.output import print_json
+from app.cli.result_text import format_result
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
-LASER_ANALOG, LASER_NONE = "analog", "none"
 EXIT_NOT_STORED, EXIT_INTERRUPTED = 3, 130
 
 
-def add_commands(sub) -> None:
+def register(sub) -> None:
     m = sub.add_parser("measure", help="measure a driver: play, record, write the recording, analyse it")
     m.add_argument("--out", required=True, type=Path, metavar="DIR", help="folder for the recording")
     m.add_argument("--name", help="file name of the recording (default: measurement-DATE-TIME)")
@@ -80,12 +80,11 @@ def add_commands(sub) -> None:
                    help="excitation level, V RMS at the terminals")
     m.add_argument("--periods", type=number(PERIODS), metavar="N", help="periods averaged")
     m.add_argument("--period", type=number(PERIOD_SAMPLES), metavar="SAMPLES", help="period length, a power of two")
-    m.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
+    add_sd_option(m)
     m.add_argument("--on-xrun", choices=("end", "restart"),
                    help="an xrun while periods are kept: end the measurement, keeping them (the default with the "
                         "serial laser), or average again")
-    m.add_argument("--model", metavar="EFFECTS",
-                   help="effect ids (default lr2,creep-log; with the serial laser also delay-x)")
+    add_model_option(m, why="; with the serial laser also delay-x")
     for field in ("serial", "operator", "station"):
         m.add_argument(f"--{field}", default="", metavar="TEXT", help=f"the {field} kept with it in the archive")
     where = m.add_mutually_exclusive_group()
@@ -96,34 +95,34 @@ def add_commands(sub) -> None:
                        help="archive to store the measurement in (default: $LINPAR_ARCHIVE or "
                             "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
     where.add_argument("--no-archive", action="store_true", help="do not store the measurement in the archive")
-    m.add_argument("--json", action="store_true", help="print one JSON object")
-    from app import cli_large_signal
-    cli_large_signal.add_plan_options(m)
+    add_json_option(m)
+    large_signal.add_plan_options(m)
+    m.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from app.cli_commands import _effects, format_result
+    """One measurement (the single plan), or the large-signal plan's steps (app.cli.large_signal)."""
+    if args.plan == "large-signal":
+        return large_signal.run_plan(args)
     from analysis.pipeline import result_json
     from instruments.measurement.recovery import find_unfinished, run_journaled
     from instruments.measurement.runner import MeasurementCancelled
 
-    from app.cli_large_signal import plan_options_checked
-    plan_options_checked(args)          # a large-signal limit given to this single measurement is refused
-    effects = _effects(args.model) if args.model else None
+    large_signal.plan_options_checked(args)     # a large-signal limit given to this single measurement is refused
+    effects = model_effects(args.model) if args.model else None
     if not args.no_archive:     # a mistyped archive is said now, not after the measurement (nothing connects yet)
         from analysis.archive.backends import archive_spec, check_spec
-        from app.cli import CliError
         if args.archive is not None and not args.archive.strip():
             raise CliError("--archive: empty: give a folder or postgresql://USER@HOST[:PORT]/DATABASE")
         check_spec(archive_spec(args.archive or (str(args.archive_root) if args.archive_root else None)))
     for unfinished in find_unfinished(args.out):
-        _say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
+        say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
              f"('linpar recover {args.out}' keeps, analyses or discards it)")
     # The plan first: a plan that cannot work must not start a rig.
     plan = MeasurementPlan.from_template(args.template or "woofer", level_v_rms=args.level, n_periods=args.periods,
                                          period_samples=args.period, on_xrun=args.on_xrun)
     with ExitStack() as stack:
-        audio, laser, driver = _devices(args, stack)
+        audio, laser, driver = devices.open_devices(args, stack)
         if args.sd is not None:
             driver = {**driver, "sd_m2": args.sd}
         if args.serial:
@@ -133,13 +132,13 @@ def run(args: argparse.Namespace) -> int:
         plan = dataclasses.replace(plan, driver={k: v for k, v in driver.items() if v is not None},
                                    session=new_session(args.operator or "", args.station or "", plan.template))
         cancel = _Cancel()
-        _say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
+        say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
              f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"
              f" of sound) on {audio.describe()}" + (f", laser {laser!r}" if laser is not None else ""))
         try:
             with _ctrl_c_cancels(cancel):
-                outcome = run_journaled(plan, audio, _laser_sensor(laser), args.out, name=args.name,
-                                        cancel=cancel, progress=_Progress(), effects=effects)
+                outcome = run_journaled(plan, audio, devices.laser_sensor(laser), args.out, name=args.name,
+                                        cancel=cancel, progress=devices.Progress(), effects=effects)
             # The recording carries no date, and a store later would be dated then (--measured-at).
             measured_at = datetime.now(timezone.utc).isoformat(timespec="seconds")
         except MeasurementCancelled as exc:
@@ -150,19 +149,19 @@ def run(args: argparse.Namespace) -> int:
             return EXIT_INTERRUPTED
         except KeyboardInterrupt:       # a second Ctrl-C: the journal keeps what was measured
             cancel.set()
-            _say(f"interrupted twice: what was measured is in the journal in {args.out}; 'linpar recover "
+            say(f"interrupted twice: what was measured is in the journal in {args.out}; 'linpar recover "
                  f"{args.out}' makes it a recording")
             raise
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
-            _say(f"wrote {path}")
+            say(f"wrote {path}")
     archived = None if args.no_archive else _store(args, outcome, plan, measured_at)
     result = outcome.result
     if args.json:
         doc = result_json(result)
         if archived is not None:
             doc = {**doc, "archive": archived}
-        print(dumps(doc))
+        print_json(doc)
     else:
         print(format_result(result))
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
@@ -187,7 +186,7 @@ def _ctrl_c_cancels(cancel: _Cancel) -> Iterator[None]:
             raise KeyboardInterrupt
         cancel.interrupted = True
         cancel.set()
-        _say("Ctrl-C: stopping; the periods measured so far are written (Ctrl-C again to stop at once)")
+        say("Ctrl-C: stopping; the periods measured so far are written (Ctrl-C again to stop at once)")
     previous = signal.signal(signal.SIGINT, on_sigint)
     try:
         yield
@@ -202,7 +201,7 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     root = shown(spec)
     if outcome.result.fit is None:        # a broken measurement: judged (printed), but nothing to keep in the archive
         why = f"nothing could be fitted ({outcome.result.not_fitted})"
-        _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in {outcome.recording_path}")
+        say(f"warning: not stored in the archive {root}: {why}. The recording is kept in {outcome.recording_path}")
         return {"error": why, "root": str(root)}
     meta = {"serial": args.serial, "operator": args.operator, "station": args.station, "measured_at": measured_at,
             "settings": {"template": plan.template, "rig": args.rig,
@@ -219,18 +218,18 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
             from app.crash_report import internal_error_line
             why = internal_error_line(exc, "storing the measurement in the archive")
         if getattr(exc, "queued_id", None):     # refused by the server, kept in the station's queue: not twice
-            _say(f"warning: not stored in the archive {root}: {why}")
+            say(f"warning: not stored in the archive {root}: {why}")
             return {"error": why, "root": str(root), "queued": exc.queued_id}
-        _say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
+        say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
              f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
         return {"error": why, "root": str(root)}
     finally:
         for note in archive.notes if archive is not None else ():
-            _say(f"note: {note}")
+            say(f"note: {note}")
     if archive.pending:
-        _say(f"measured as {mid}; it waits in this station's queue until the server {root} can be reached")
+        say(f"measured as {mid}; it waits in this station's queue until the server {root} can be reached")
         return {"id": mid, "root": str(root), "queued": True}
-    _say(f"stored in the archive {root} as {mid}")
+    say(f"stored in the archive {root} as {mid}")
     return {"id": mid, "root": str(root)}
 
 
@@ -244,91 +243,3 @@ def _store_later(args: argparse.Namespace, outcome, root: str, measured_at: str)
         command += [f"--{key}", getattr(args, key)] if getattr(args, key) else []
     where = "--archive" if "://" in root else "--root"
     return shlex.join(command + ["--measured-at", measured_at, where, str(root)])
-
-
-def _devices(args: argparse.Namespace, stack: ExitStack):
-    """(audio, laser port or None, driver info); what is started here is stopped by ``stack``."""
-    if args.rig == "soundcard":
-        return _sound_card(args), _laser_choice(args.laser, None), {}
-    from instruments.audio import portaudio
-    from instruments.rig import manager
-    from instruments.rig.workstation import rig_audio
-
-    handle = manager.find_rig(args.rig_name, args.runtime_dir)
-    if handle is None:
-        _say(f"starting the virtual rig {args.rig_name!r}")
-        handle = manager.start_rig(args.rig_name, runtime_dir=args.runtime_dir)
-        stack.callback(lambda: (_say(f"stopping the virtual rig {args.rig_name!r}"),
-                                manager.stop_rig(args.rig_name, args.runtime_dir)))
-    audio = rig_audio(handle)
-    stack.callback(portaudio.release)      # PortAudio lets go of the rig's JACK server before it may stop
-    laser = _laser_choice(args.laser, handle.state.laser_pty)
-    if args.laser is None and laser is None:
-        raise MeasurementError(f"the rig {args.rig_name!r} has no serial laser (started with --no-laser): "
-                               f"use --laser analog or --laser none")
-    if laser is not None or args.laser == LASER_NONE:
-        audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
-    state = handle.state
-    return audio, laser, {"name": state.extra.get("driver_name", state.driver), "sd_m2": state.extra.get("sd_m2")}
-
-
-def _laser_choice(option: str | None, rig_pty: str | None) -> str | None:
-    if option in (LASER_ANALOG, LASER_NONE):
-        return None
-    return option or rig_pty
-
-
-def _laser_sensor(port: str | None):
-    if port is None:
-        return None
-    from instruments.laser import ILD1420
-    return ILD1420(port)
-
-
-def _sound_card(args: argparse.Namespace):
-    from instruments.audio import Calibration, ChannelMap, SoundDeviceAudio, list_devices
-    if args.calibration is None:
-        raise MeasurementError("--rig soundcard needs --calibration FILE (the sound card's calibration and "
-                               "channel map)")
-    from analysis.files import read_text
-    what = 'a JSON file {"calibration": {...}, "channel_map": {...}}'
-    text = read_text(args.calibration, "config", what, MeasurementError)
-    try:
-        doc = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as exc:
-        raise MeasurementError(f"{args.calibration}: not JSON ({exc}): expected {what}") from None
-    if not isinstance(doc, dict):
-        raise MeasurementError(f"{args.calibration}: expected {what}")
-    calibration = Calibration.from_dict(doc.get("calibration", {}))
-    channel_map = ChannelMap.from_dict(doc.get("channel_map", {}))
-    if args.laser != LASER_ANALOG:
-        channel_map = dataclasses.replace(channel_map, laser_analog=None)
-    elif channel_map.laser_analog is None:
-        raise MeasurementError(f"--laser analog: the channel map in {args.calibration} has no laser_analog input")
-    devices = [d for d in list_devices() if d.full_duplex and (args.device is None or d.name == args.device)]
-    if len(devices) != 1:
-        names = ", ".join(str(d.choice) for d in list_devices() if d.full_duplex) or "none"
-        what = f"no full-duplex sound card named {args.device!r}" if not devices else \
-            f"{len(devices)} sound cards match; name one with --device"
-        raise MeasurementError(f"{what}; full-duplex cards: {names}")
-    rate = SAMPLE_RATE.check(doc.get("sample_rate", 48000), f"{args.calibration}: sample_rate", MeasurementError)
-    return SoundDeviceAudio(devices[0].choice, calibration, rate, channel_map)
-
-
-class _Progress:
-    """One stderr line per stage and per kept period."""
-
-    def __init__(self):
-        self._last = None
-
-    def __call__(self, p: MeasurementProgress) -> None:
-        key = (p.stage, p.periods_kept)
-        if key == self._last:
-            return
-        self._last = key
-        periods = f" {p.periods_kept}/{p.periods_wanted} periods" if p.stage in ("averaging", "settling") else ""
-        _say(f"[{p.elapsed_s:5.1f} s] {p.stage}{periods}{': ' + p.message if p.message else ''}")
-
-
-def _say(text: str) -> None:
-    print(f"linpar measure: {text}", file=sys.stderr, flush=True)

@@ -14,9 +14,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from analysis.bounds import SD
-from app.cli_archive import add_root_option
-from app.cli_options import number
+from app.cli import effects
+from app.cli.archive_server import add_archive_options, open_from_args
+from app.cli.options import CliError, add_model_option, add_sd_option, model_effects
 
 EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
                   ("zma", "measured impedance (.zma)"), ("zma_model", "modelled impedance (.zma)"),
@@ -26,26 +26,26 @@ EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
 
 def _source_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", metavar="ID|PATH", help="archived measurement id, or a recording to analyse")
-    add_root_option(parser)
-    parser.add_argument("--sd", type=number(SD), metavar="M2",
-                        help="effective radiating area in m^2 (recordings only)")
-    parser.add_argument("--model", metavar="EFFECTS", help="effect ids for a recording (default lr2,creep-log)")
-    from app.cli_effects import add_option
-    add_option(parser)
+    add_archive_options(parser)
+    add_sd_option(parser, " (recordings only)")
+    add_model_option(parser, why="; recordings only")
+    effects.add_effects_file_option(parser)
 
 
-def add_commands(sub) -> None:
+def register(sub) -> None:
     report = sub.add_parser("report", help="PDF and HTML report of one measurement")
     _source_arguments(report)
     report.add_argument("--pdf", metavar="FILE")
     report.add_argument("--html", metavar="FILE")
     report.add_argument("--limits", metavar="FILE",
                         help="QA limits (JSON, linpar-limits/1): the report shows pass/fail per parameter and overall")
+    report.set_defaults(run=run_report)
 
     export = sub.add_parser("export", help="parameters, curves and a driver file of one measurement")
     _source_arguments(export)
     for kind, what in EXPORT_OPTIONS:
         export.add_argument(f"--{kind.replace('_', '-')}", dest=kind, metavar="FILE", help=what)
+    export.set_defaults(run=run_export)
 
 
 def _is_recording(text: str) -> bool:
@@ -56,17 +56,13 @@ def _is_recording(text: str) -> bool:
 
 def load_source(args):
     """(StoredResult, header, settings, calibration) of the ID or PATH."""
-    from app.cli import CliError
     if _is_recording(args.source):
         from analysis.archive.results import stored_from_recording
-        from app.cli_commands import _effects
-        effects = _effects(args.model)
-        stored, header, calibration = stored_from_recording(args.source, args.sd, effects)
+        stored, header, calibration = stored_from_recording(args.source, args.sd, model_effects(args.model))
         return stored, header, None, calibration
     if args.sd is not None or args.model is not None:
         raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "
                        "its own")
-    from app.cli_archive_server import open_from_args
     m = open_from_args(args).get(args.source)
     record = m.record
     header = {k: record.get(k) for k in ("driver", "serial", "measured_at", "operator", "station", "id")}
@@ -81,30 +77,35 @@ def _outputs_spare_the_inputs(args, outputs) -> None:
     check_outputs_spare_inputs(outputs, inputs)
 
 
-def run(args: argparse.Namespace) -> int:
-    from app.cli import CliError
-    if args.command == "report":
-        if not args.pdf and not args.html:
-            raise CliError("report: give --pdf FILE and/or --html FILE")
-        _outputs_spare_the_inputs(args, [(o, p) for o, p in (("--pdf", args.pdf), ("--html", args.html)) if p])
-        from analysis.limits import load_limits
-        from analysis.report import build_report, write_report
-        limits = load_limits(args.limits) if args.limits else None    # a bad file fails before the analysis
-        stored, header, settings, calibration = load_source(args)
-        content = build_report(stored, header, settings, calibration, limits)
-        written = write_report(content, args.pdf, args.html)
-        if content.qa is not None:
-            print(f"QA: {content.qa.headline}: {content.qa.why} (limits {content.qa.file})")
-    else:
-        targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
-        if not targets:
-            raise CliError("export: give at least one of " + ", ".join(
-                f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
-        _outputs_spare_the_inputs(args, [(f"--{k.replace('_', '-')}", p) for k, p in targets.items()])
-        from analysis.export import write_exports
-        stored, header, _, _ = load_source(args)
-        written = write_exports(stored, targets, header)
-    for path in written:
-        print(f"written: {path}")
+def run_report(args: argparse.Namespace) -> int:
+    if not args.pdf and not args.html:
+        raise CliError("report: give --pdf FILE and/or --html FILE")
+    _outputs_spare_the_inputs(args, [(o, p) for o, p in (("--pdf", args.pdf), ("--html", args.html)) if p])
+    from analysis.limits import load_limits
+    from analysis.report import build_report, write_report
+    limits = load_limits(args.limits) if args.limits else None    # a bad file fails before the analysis
+    stored, header, settings, calibration = load_source(args)
+    content = build_report(stored, header, settings, calibration, limits)
+    written = write_report(content, args.pdf, args.html)
+    if content.qa is not None:
+        print(f"QA: {content.qa.headline}: {content.qa.why} (limits {content.qa.file})")
+    _say_written(written)
     return 0
+
+
+def run_export(args: argparse.Namespace) -> int:
+    targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
+    if not targets:
+        raise CliError("export: give at least one of " + ", ".join(
+            f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
+    _outputs_spare_the_inputs(args, [(f"--{k.replace('_', '-')}", p) for k, p in targets.items()])
+    from analysis.export import write_exports
+    stored, header, _, _ = load_source(args)
+    _say_written(write_exports(stored, targets, header))
+    return 0
+
+
+def _say_written(paths) -> None:
+    for path in paths:
+        print(f"written: {path}")
 

@@ -9,8 +9,8 @@
     linpar qa golden [--add ID...] [--remove ID...]         the golden units
     linpar qa export [filters] [--csv FILE] [--json FILE] [--dfq FILE]
 
-Each takes --archive URL|DIR or --root DIR (app.cli_archive_server). The
-statistics' text is in app.cli_qa_text; the numbers in analysis.production.
+Each takes --archive URL|DIR or --root DIR (app.cli.archive_server). The
+statistics' text is in app.cli.qa_text; the numbers in analysis.production.
 """
 from __future__ import annotations
 
@@ -20,9 +20,9 @@ import sys
 from pathlib import Path
 
 from analysis.bounds import BASELINE, COVERAGE_K, LIMITS_VERSION
-from app.cli_archive_server import add_archive_options, open_from_args, say_notes
-from app.cli_json import dumps
-from app.cli_options import number
+from app.cli.archive_server import add_archive_options, open_from_args, say_notes
+from app.cli.options import CliError, add_json_option, number
+from app.cli.output import print_json
 
 
 def _selection_options(parser: argparse.ArgumentParser) -> None:
@@ -38,6 +38,7 @@ def _selection_options(parser: argparse.ArgumentParser) -> None:
 
 def register(sub) -> None:
     qa = sub.add_parser("qa", help="production QA: statistics over units, limits versions, golden units, export")
+    qa.set_defaults(run=run)
     verbs = qa.add_subparsers(dest="qa_command", required=True, parser_class=type(qa))
 
     stats = verbs.add_parser("stats", help="per parameter: n, mean, sigma, Cp/Cpk, Pp/Ppk, yield, control-chart "
@@ -45,7 +46,7 @@ def register(sub) -> None:
     _selection_options(stats)
     stats.add_argument("--baseline", type=number(BASELINE), default=50, metavar="N",
                        help="the control chart's limits come from the first N units (default %(default)s)")
-    stats.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_option(stats)
 
     limits = verbs.add_parser("limits", help="the archive's limits versions; propose limits from golden units; "
                                              "store a new version")
@@ -59,13 +60,13 @@ def register(sub) -> None:
     limits.add_argument("--out", metavar="FILE", help="write the proposal there (default: print it)")
     limits.add_argument("--name", metavar="TEXT", help="the proposal's name")
     limits.add_argument("--note", metavar="TEXT", default="", help="why this version (kept with it)")
-    limits.add_argument("--json", action="store_true", help="print JSON")
+    add_json_option(limits, "print JSON")
 
     golden = verbs.add_parser("golden", help="list, add or remove golden units (adding and removing: an engineer's "
                                              "right)")
     golden.add_argument("--add", nargs="+", default=[], metavar="ID")
     golden.add_argument("--remove", nargs="+", default=[], metavar="ID")
-    golden.add_argument("--json", action="store_true", help="print JSON")
+    add_json_option(golden, "print JSON")
 
     export = verbs.add_parser("export", help="the selected population as CSV (long), JSON or Q-DAS AQDEF (.dfq)")
     _selection_options(export)
@@ -107,9 +108,9 @@ def run(args: argparse.Namespace) -> int:
 def _run_stats(archive, args) -> int:
     _population, stats = _stats(archive, args, with_stds=False)     # the statistics need no standard deviations
     if args.json:
-        print(dumps({"archive": archive.location, **stats.as_json()}))
+        print_json({"archive": archive.location, **stats.as_json()})
     else:
-        from app.cli_qa_text import stats_text
+        from app.cli.qa_text import stats_text
         print(stats_text(stats, archive.location))
     return 0
 
@@ -120,9 +121,9 @@ def _write(path: str, payload: bytes | str) -> Path:
 
 
 def _run_limits(archive, args) -> int:
-    from app.cli_qa_text import proposal_text, versions_text
+    from app.cli.qa_text import proposal_text, versions_text
     if args.show:
-        print(dumps(archive.limits(args.show).document, indent=1))
+        print_json(archive.limits(args.show).document, indent=1)
         return 0
     if args.store:
         from analysis.files import read_text
@@ -130,15 +131,16 @@ def _run_limits(archive, args) -> int:
         load_limits(args.store)                               # every check of a limits file, with its lines
         doc = json.loads(read_text(args.store, "config", "a JSON limits file", LimitsError))
         version = archive.store_limits(doc, args.note)
-        print(dumps(version.as_json()) if args.json else
-              f"stored {args.store} as limits version {version.version} ({version.name}) in {archive.location}")
+        if args.json:
+            print_json(version.as_json())
+        else:
+            print(f"stored {args.store} as limits version {version.version} ({version.name}) in {archive.location}")
         return 0
     if args.from_golden is not None:
         from analysis.archive.population import Selection
         from analysis.production import propose_limits
         ids = [archive.resolve(i)[0] for i in args.from_golden] or archive.golden()
         if not ids:
-            from app.cli import CliError
             raise CliError("qa limits --from-golden: name the golden units' ids, or mark them first with "
                            "'linpar qa golden --add ID...'")
         population = archive.population(Selection(ids=tuple(ids)).checked())
@@ -147,13 +149,16 @@ def _run_limits(archive, args) -> int:
         if args.out:
             _write(args.out, text)
         if args.json:
-            print(dumps({"limits": document, "proposed": [p.as_json() for p in proposed], "notes": notes,
-                         "written": args.out}))
+            print_json({"limits": document, "proposed": [p.as_json() for p in proposed], "notes": notes,
+                        "written": args.out})
         else:
             print(proposal_text(proposed, notes, args.k, args.out, text))
         return 0
     versions = archive.limits_versions()
-    print(dumps([v.as_json() for v in versions]) if args.json else versions_text(versions, archive.location))
+    if args.json:
+        print_json([v.as_json() for v in versions])
+    else:
+        print(versions_text(versions, archive.location))
     return 0
 
 
@@ -164,14 +169,13 @@ def _run_golden(archive, args) -> int:
     if args.remove:
         ids = archive.set_golden(args.remove, golden=False)
     if args.json:
-        print(dumps({"archive": archive.location, "golden": ids}))
+        print_json({"archive": archive.location, "golden": ids})
     else:
         print(f"{len(ids)} golden unit(s) in {archive.location}" + "".join(f"\n  {i}" for i in ids))
     return 0
 
 
 def _run_export(archive, args) -> int:
-    from app.cli import CliError
     targets = [(o, p) for o, p in (("--csv", args.csv), ("--json", args.json), ("--dfq", args.dfq)) if p]
     if not targets:
         raise CliError("qa export: give --csv FILE, --json FILE and/or --dfq FILE")

@@ -36,7 +36,10 @@ from pathlib import Path
 
 from analysis.bounds import (AUDIO_FREQUENCY, DISTORTION_DB, EXCURSION_MM, LEVEL_STEP, LEVEL_V_RMS, LIMIT_PERCENT,
                              POLYNOMIAL_ORDER, TEMPERATURE_RISE_K)
-from app.cli_options import number
+from app.cli import devices
+from app.cli.devices import say
+from app.cli.options import CliError, add_json_option, number
+from app.cli.output import print_json
 
 PLANS = ("single", "large-signal")
 OUTPUTS = (("pdf", "write the report as PDF"), ("html", "write the report as HTML (self-contained)"),
@@ -55,7 +58,7 @@ def _two_tones(text: str) -> tuple[float, float]:
     return f1, f2
 
 
-def add_commands(sub) -> None:
+def register(sub) -> None:
     c = sub.add_parser("large-signal", help="Bl(x), Kms(x), Le(x), the coil's rest offset and the excursion limits")
     c.add_argument("paths", nargs="+", metavar="REC",
                    help="recordings of one driver at large signal (NAME, NAME.wav or NAME.json), or a plan's "
@@ -74,9 +77,10 @@ def add_commands(sub) -> None:
                    help="with --predict: H2 and H3 of current and displacement for a sine at HZ")
     c.add_argument("--two-tones", type=_two_tones, metavar="F1,F2",
                    help="with --predict: IMD2 and IMD3 for two tones F1 + F2 (amplitudes 4:1)")
-    c.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_option(c)
     for option, what in OUTPUTS:
         c.add_argument(f"--{option}", type=Path, metavar="FILE", help=what)
+    c.set_defaults(run=run)
 
 
 # The large-signal plan's limits: (option, bound, default, help). Their defaults are filled in by run_plan, so
@@ -105,7 +109,6 @@ def add_plan_options(measure: argparse.ArgumentParser) -> None:
 def plan_options_checked(args: argparse.Namespace) -> None:
     """CliError when the single plan is given a large-signal limit; otherwise each limit not given gets its
     default."""
-    from app.cli import CliError
     for option, _, default, _, _ in PLAN_LIMITS:
         attribute = option.replace("-", "_")
         if getattr(args, attribute) is None:
@@ -118,8 +121,6 @@ def plan_options_checked(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from analysis.large_signal import LimitThresholds, Prediction, large_signal
     from analysis.large_signal.words import format_large_signal
-    from app.cli import CliError
-    from app.cli_import import _print_json
     if (args.sine is not None or args.two_tones is not None) and args.predict is None:
         raise CliError("--sine and --two-tones need --predict VOLT (the level to predict at)")
     thresholds = LimitThresholds(args.bl_min / 100.0, args.cms_min / 100.0, args.le_change / 100.0)
@@ -128,7 +129,7 @@ def run(args: argparse.Namespace) -> int:
     outputs = checked_outputs(args, inputs)          # before the identification: a mistake costs nothing
     result = large_signal(inputs, args.order, thresholds, predictions)
     if args.json:
-        _print_json(result.as_json())
+        print_json(result.as_json())
     else:
         print(format_large_signal(result))
     for path in write_outputs(result, outputs):
@@ -186,9 +187,6 @@ def run_plan(args: argparse.Namespace) -> int:
     from analysis.large_signal import LargeSignalError, large_signal
     from analysis.large_signal.stepping import StepLimits
     from analysis.large_signal.words import format_large_signal
-    from app import cli_measure
-    from app.cli import CliError
-    from app.cli_import import _print_json
     from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
     from instruments.measurement.plan import MeasurementPlan
 
@@ -205,20 +203,20 @@ def run_plan(args: argparse.Namespace) -> int:
     plan = LargeSignalPlan(base, args.level or base.level_v_rms, args.step, limits)
     cancel = threading.Event()
     with ExitStack() as stack:
-        audio, laser, driver = cli_measure._devices(args, stack)
+        audio, laser, driver = devices.open_devices(args, stack)
         if args.sd is not None:
             driver = {**driver, "sd_m2": args.sd}
         plan = replace(plan, base=replace(plan.base, driver={k: v for k, v in driver.items() if v is not None}))
-        _say(f"large-signal plan from {plan.start_level_v:g} V, x{plan.step:g} per step, until "
+        say(f"large-signal plan from {plan.start_level_v:g} V, x{plan.step:g} per step, until "
              f"{args.max_excursion:g} mm, {args.max_voltage:g} V, {args.max_distortion:g} dB current distortion "
              f"or +{args.max_temperature_rise:g} K on {audio.describe()}")
         try:
-            outcome = run_large_signal(plan, audio, cli_measure._laser_sensor(laser), args.out, name=args.name,
-                                       cancel=cancel, progress=cli_measure._Progress(), on_step=_said_step)
+            outcome = run_large_signal(plan, audio, devices.laser_sensor(laser), args.out, name=args.name,
+                                       cancel=cancel, progress=devices.Progress(), on_step=_said_step)
         except KeyboardInterrupt:
             cancel.set()
             raise
-    _say(f"stopped: {outcome.message}; summary in {outcome.summary_path}")
+    say(f"stopped: {outcome.message}; summary in {outcome.summary_path}")
     doc: dict = {"plan": {"summary": str(outcome.summary_path), "stopped_by": outcome.stopped_by,
                           "message": outcome.message, "recordings": [str(p) for p in outcome.recordings]}}
     text = None
@@ -231,7 +229,7 @@ def run_plan(args: argparse.Namespace) -> int:
             doc["large_signal"], doc["error"] = None, str(exc)
             text = f"the steps could not be identified: {exc}"
     if args.json:
-        _print_json(doc)
+        print_json(doc)
     elif text:
         print(text)
     if outcome.stopped_by in ("fault", "cancelled"):
@@ -242,9 +240,5 @@ def run_plan(args: argparse.Namespace) -> int:
 def _said_step(step) -> None:
     m = step.measures
     peak = "no displacement" if m.peak_m is None else f"peak {m.peak_m * 1e3:.2f} mm"
-    _say(f"step {step.index} at {step.level_v:.3g} V: {peak}, current distortion {m.current_distortion_db:.1f} dB, "
+    say(f"step {step.index} at {step.level_v:.3g} V: {peak}, current distortion {m.current_distortion_db:.1f} dB, "
          f"RE {m.re_ohm:.3f} ohm -> {step.recording_path}")
-
-
-def _say(text: str) -> None:
-    print(f"linpar measure: {text}", file=sys.stderr, flush=True)

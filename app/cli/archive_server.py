@@ -14,6 +14,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from app.cli.options import CliError, add_json_option
+from app.cli.output import print_json
+
 SERVER_VERBS = ("setup", "sync")
 
 
@@ -28,7 +31,6 @@ def add_archive_options(parser: argparse.ArgumentParser) -> None:
 def spec_of(args) -> str:
     """The archive the options name; the environment's when they name none."""
     from analysis.archive.backends import archive_spec
-    from app.cli import CliError
     for option in ("archive", "root"):
         if getattr(args, option, None) is not None and not getattr(args, option).strip():
             raise CliError(f"--{option}: empty: give a folder" + (" or postgresql://USER@HOST[:PORT]/DATABASE"
@@ -56,13 +58,11 @@ def register_verbs(verbs) -> None:
     sync = verbs.add_parser("sync", help="send this station's queued measurements to the archive's server")
     for parser in (setup, sync):
         add_archive_options(parser)
-        parser.add_argument("--json", action="store_true", help="print JSON")
+        add_json_option(parser, "print JSON")
 
 
 def run_verb(args) -> int:
     from analysis.archive.backends import is_url
-    from app.cli import CliError
-    from app.cli_json import dumps
     spec = spec_of(args)
     if args.archive_command == "setup":
         if not is_url(spec):
@@ -75,9 +75,11 @@ def run_verb(args) -> int:
             users[name.strip()] = role.strip()
         from analysis.archive.pg import setup
         report = setup(spec, users)
-        print(dumps({"archive": report.location, "schema_from": report.schema_from, "schema_to": report.schema_to,
-                     "roles_created": report.roles_created, "users": report.users}) if args.json
-              else report.describe())
+        if args.json:
+            print_json({"archive": report.location, "schema_from": report.schema_from,
+                        "schema_to": report.schema_to, "roles_created": report.roles_created, "users": report.users})
+        else:
+            print(report.describe())
         return 0
     from analysis.archive.backends import open_archive
     archive = open_archive(spec)
@@ -90,7 +92,7 @@ def run_verb(args) -> int:
         raise ArchiveError(f"{why}: {sent}{report.waiting} measurement(s) wait in the local queue "
                            f"{getattr(getattr(archive, 'outbox', None), 'root', '')}; nothing is lost")
     if args.json:
-        print(dumps({"archive": archive.location, "sent": report.sent, "already": report.already}))
+        print_json({"archive": archive.location, "sent": report.sent, "already": report.already})
     else:
         print(f"{archive.location}: {report.describe()}" if report.sent or report.already
               else f"{archive.location}: nothing waits in this station's queue")

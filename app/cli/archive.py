@@ -8,22 +8,19 @@ from __future__ import annotations
 import argparse
 import sys
 
-from analysis.bounds import LIST_LIMIT, SD
-from app import cli_archive_server
-from app.cli_json import dumps
-from app.cli_options import number
+from analysis.bounds import LIST_LIMIT
+from app.cli import archive_server, effects
+from app.cli.archive_server import add_archive_options, say_notes
+from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects, number
+from app.cli.output import print_json
 
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
 
 
-def add_root_option(parser: argparse.ArgumentParser) -> None:
-    """--archive URL|DIR or --root DIR (app.cli_archive_server)."""
-    cli_archive_server.add_archive_options(parser)
-
-
-def add_commands(sub) -> None:
+def register(sub) -> None:
     archive = sub.add_parser("archive", help="the measurement archive: list, show, export, rebuild, store, compare; "
                                              "setup and sync for a PostgreSQL server")
+    archive.set_defaults(run=run)
     verbs = archive.add_subparsers(dest="archive_command", required=True, parser_class=type(archive))
 
     ls = verbs.add_parser("list", help="list stored measurements, newest first")
@@ -49,25 +46,17 @@ def add_commands(sub) -> None:
         store.add_argument(f"--{name}", metavar="TEXT", default="")
     store.add_argument("--measured-at", metavar="DATE", help="when it was measured (ISO 8601; default: now)")
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
-    store.add_argument("--sd", type=number(SD), metavar="M2", help="effective radiating area in m^2")
-    store.add_argument("--model", metavar="EFFECTS", help="effect ids separated by commas (default lr2,creep-log)")
-    from app.cli_effects import add_option
-    add_option(store)
+    add_sd_option(store)
+    add_model_option(store)
+    effects.add_effects_file_option(store)
 
     compare = verbs.add_parser("compare", help="up to 8 measurements' parameters side by side")
     compare.add_argument("ids", nargs="+", metavar="ID")
 
     for parser in (ls, show, export, store, compare, verbs.choices["rebuild"]):
-        add_root_option(parser)
-        parser.add_argument("--json", action="store_true", help="print JSON")
-    cli_archive_server.register_verbs(verbs)
-
-
-def _archive(args):
-    return cli_archive_server.open_from_args(args)
-
-
-_notes = cli_archive_server.say_notes
+        add_archive_options(parser)
+        add_json_option(parser, "print JSON")
+    archive_server.register_verbs(verbs)
 
 
 def _param(entry, name: str, scale: float) -> str:
@@ -78,16 +67,16 @@ def _param(entry, name: str, scale: float) -> str:
 
 def run(args: argparse.Namespace) -> int:
     verb = args.archive_command
-    if verb in cli_archive_server.SERVER_VERBS:
-        return cli_archive_server.run_verb(args)
-    archive = _archive(args)
+    if verb in archive_server.SERVER_VERBS:
+        return archive_server.run_verb(args)
+    archive = archive_server.open_from_args(args)
     if verb == "list":
         from analysis.archive import Filter
         entries = archive.list(Filter(args.driver, args.serial, args.operator, args.station, args.validity,
                                       args.since, args.until, args.limit))
-        _notes(archive)
+        say_notes(archive)
         if args.json:
-            print(dumps([e.as_json() for e in entries]))
+            print_json([e.as_json() for e in entries])
             return 0
         cols = "  ".join(f"{n + (' [' + u + ']' if u else ''):>10}" for n, u, _ in LIST_PARAMETERS)
         lines = [f"{'id':<22}  {'date (UTC)':<20}  {'driver':<20}  {'serial':<12}  {'validity':<8}  {cols}"]
@@ -100,9 +89,9 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if verb == "show":
         m = archive.get(args.id)
-        _notes(archive)
+        say_notes(archive)
         if args.json:
-            print(dumps({**m.record, "path": str(m.folder)}, indent=1))
+            print_json({**m.record, "path": str(m.folder)}, indent=1)
             return 0
         r = m.record
         for key in ("id", "measured_at", "stored_at", "driver", "serial", "operator", "station", "validity",
@@ -121,13 +110,16 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if verb == "export":
         target = archive.export(args.id, args.dir)
-        _notes(archive)
-        print(dumps({"exported": str(target)}) if args.json else f"exported to {target}")
+        say_notes(archive)
+        if args.json:
+            print_json({"exported": str(target)})
+        else:
+            print(f"exported to {target}")
         return 0
     if verb == "rebuild":
         report = archive.rebuild()
         if args.json:
-            print(dumps({"indexed": report.indexed, "skipped": report.skipped}))
+            print_json({"indexed": report.indexed, "skipped": report.skipped})
         else:
             print(report.describe())
         return 0
@@ -140,16 +132,14 @@ def run(args: argparse.Namespace) -> int:
 
 def _store(archive, args) -> int:
     from analysis.pipeline import analyze_path
-    from app.cli_commands import _effects
-    effects = _effects(args.model)
-    result = analyze_path(args.path, args.sd, effects)
+    result = analyze_path(args.path, args.sd, model_effects(args.model))
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)
-    _notes(archive)
+    say_notes(archive)
     queued = archive.pending > 0
     if args.json:
-        print(dumps({"id": mid, "validity": result.validity.get("overall"), **({"queued": True} if queued else {})}))
+        print_json({"id": mid, "validity": result.validity.get("overall"), **({"queued": True} if queued else {})})
     else:
         print(f"{'queued' if queued else 'stored'} {mid} (validity {result.validity.get('overall')})"
               + (": it waits in this station's queue until the server can be reached" if queued else ""))
@@ -160,9 +150,9 @@ def _compare(archive, args) -> int:
     from analysis.archive import compare
     from analysis.report.numbers import format_number, pretty_unit
     c = compare(archive, args.ids)
-    _notes(archive)
+    say_notes(archive)
     if args.json:
-        print(dumps(c.as_json()))
+        print_json(c.as_json())
         return 0
     width = 14
     print(f"{'parameter':<14}{'unit':<8}" + "".join(f"{label[:width - 1]:>{width}}" for label in c.labels)

@@ -1,0 +1,53 @@
+"""`linpar analyze`: fit the parameters of a recording (or, with --impedance/--uiv, of imported curves)."""
+from __future__ import annotations
+
+import argparse
+
+from app.cli import curves, effects
+from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects
+from app.cli.output import print_json
+from app.cli.result_text import format_result
+
+EXIT_QA_FAIL = 1
+
+
+def register(sub) -> None:
+    analyze = sub.add_parser("analyze", help="fit the parameters of a recording")
+    analyze.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
+    add_sd_option(analyze)
+    add_model_option(analyze)
+    add_json_option(analyze)
+    analyze.add_argument("--limits", metavar="FILE",
+                         help="QA limits (JSON): print pass/fail; exit 0 pass, 1 fail, 2 error")
+    curves.add_curve_options(analyze)
+    effects.add_effects_file_option(analyze)
+    analyze.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if curves.wants_curves(args):
+        if args.limits:
+            from analysis.limits import LimitsError
+            raise LimitsError("--limits applies to recordings, not to imported curves")
+        return curves.analyze_curves(args)
+    return analyze_recording(args)
+
+
+def analyze_recording(args: argparse.Namespace) -> int:
+    from analysis import limits as qa
+    from analysis.pipeline import analyze_path, result_json
+    limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
+    result = analyze_path(args.path, args.sd, model_effects(args.model))
+    doc = result_json(result)
+    if limits is not None:
+        doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)
+    if args.json:
+        print_json(doc)
+    else:
+        print(format_result(result))
+        if limits is not None:
+            print("\n" + qa.format_verdicts(limits, result.parameters, result.validity))
+    if limits is None:
+        return 0
+    # 0 pass, 1 fail, 2 (an error: the measurement must be repeated, or its model found) when not judged.
+    return {"pass": 0, "fail": EXIT_QA_FAIL}.get(doc["limits"]["verdict"], 2)

@@ -1,0 +1,56 @@
+"""`linpar`'s parser and its one error boundary: parse, then run the command's `run(args)`."""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Sequence
+
+from analysis.bounds import SIZE_KINDS, size_limits_set
+from analysis.errors import is_user_error, user_message
+from app.cli import (added_mass, analyze, archive, diagnose, effects, gui, large_signal, levels, measure, qa,
+                     recover, report, rig, stats)
+from app.cli.options import Parser, size_limit
+
+# 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
+EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 2, 70, 130
+
+# In the order `linpar --help` lists them.
+COMMAND_GROUPS = (analyze, diagnose, added_mass, stats, rig, measure, recover, archive, report, levels, large_signal,
+                  qa, effects, gui)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = Parser(prog="linpar", description="Loudspeaker linear parameters from voltage, current and "
+                                               "laser displacement.")
+    parser.add_argument("--size-limit", action="append", type=size_limit, metavar="KIND=SIZE", default=[],
+                        help="read larger files than the defaults, which fit any real measurement: KIND is "
+                             f"{', '.join(SIZE_KINDS)}; SIZE like 500M or 4G (before the command; repeatable)")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for group in COMMAND_GROUPS:
+        group.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command; the CLI's only error boundary (analysis.errors): exit 2 for the user's errors,
+    70 for a bug (one line, the details in a crash report), 130 for Ctrl-C."""
+    try:
+        args = build_parser().parse_args(argv)
+        with size_limits_set(**dict(args.size_limit)):
+            if args.command in effects.COMMANDS:
+                effects.load(args)      # a bad effect file stops every command that builds models: one line
+            return args.run(args)
+    except KeyboardInterrupt:
+        print("linpar: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - the boundary: a user error is one line, anything else a bug
+        if is_user_error(exc):
+            print(f"linpar: error: {user_message(exc)}", file=sys.stderr)
+            return EXIT_ERROR
+        from app.crash_report import internal_error_line
+        print(f"linpar: {internal_error_line(exc, argv=argv)}", file=sys.stderr)
+        return EXIT_INTERNAL
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

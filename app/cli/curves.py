@@ -1,0 +1,95 @@
+"""Other tools' curves on the command line: `linpar analyze --impedance/--hx/--uiv` (and diagnose's).
+
+The analysis modules are imported inside the commands: building the parser
+(`linpar --help`) stays light.
+"""
+from __future__ import annotations
+
+import argparse
+
+from analysis.bounds import FREQUENCY
+from app.cli.options import CliError, model_effects, number
+from app.cli.output import print_json
+from app.cli.result_text import format_result
+
+CURVE_OPTIONS = ("impedance", "uiv")
+# Options that mean something for imported curves only: with a recording they are refused, not ignored.
+CURVE_ONLY = ("hx", "mm_per_volt", "hx_fmax", "phase", "fmin", "fmax", "all_lines")
+
+
+def add_range_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--phase", choices=("deg", "rad"),
+                        help="phase unit of the files (default: what the file's header says, else degrees)")
+    parser.add_argument("--fmin", type=number(FREQUENCY), metavar="HZ", help="fit only lines at or above HZ")
+    parser.add_argument("--fmax", type=number(FREQUENCY), metavar="HZ", help="fit only lines at or below HZ")
+    parser.add_argument("--all-lines", action="store_true",
+                        help="keep every line of linearly spaced files (default: thinned to 100 lines per decade)")
+
+
+def add_curve_options(analyze: argparse.ArgumentParser) -> None:
+    """Options of `linpar analyze` (and diagnose) for imported curves (PATH then becomes optional)."""
+    group = analyze.add_argument_group("imported curves (instead of a recording)")
+    group.add_argument("--impedance", metavar="FILE", help="impedance curve: .zma, .frd, REW export or text table")
+    group.add_argument("--hx", metavar="FILE", help="displacement transfer function X/U (m/V; see --mm-per-volt)")
+    group.add_argument("--uiv", metavar="FILE", help="CSV of complex U, I and laser velocity (or displacement) spectra")
+    group.add_argument("--mm-per-volt", action="store_true", help="the --hx magnitude is in mm/V")
+    group.add_argument("--hx-fmax", type=number(FREQUENCY), metavar="HZ",
+                       help="fit Hx only up to HZ (default: 4 x fs, where the cone is still a piston)")
+    add_range_options(group)
+
+
+def wants_curves(args: argparse.Namespace) -> bool:
+    """True when `linpar analyze` is about imported curves (or has nothing to analyse: said here)."""
+    return (any(getattr(args, name, None) for name in CURVE_OPTIONS + CURVE_ONLY)
+            or not getattr(args, "path", None))
+
+
+def fit_range(args, hx_f_max=None):
+    from analysis.curve_fit import LINES_PER_DECADE, FitRange
+    return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
+
+
+def load_curves(args: argparse.Namespace):
+    """(Z, Hx or None, notes) from --impedance/--hx or --uiv, checked for conflicting options."""
+    from analysis.importers import read_curve, read_uiv
+    if args.path and not (args.impedance or args.uiv or args.hx):
+        used = [f"--{n.replace('_', '-')}" for n in CURVE_ONLY if getattr(args, n)]
+        raise CliError(f"{', '.join(used)}: for imported curves only (--impedance/--uiv), not for a recording")
+    if not (args.impedance or args.uiv or args.hx):
+        raise CliError("analyze needs a recording path (NAME, NAME.wav or NAME.json) or curves: "
+                       "--impedance FILE [--hx FILE] or --uiv FILE")
+    if args.path:
+        raise CliError("give either a recording PATH or imported curves (--impedance/--uiv), not both")
+    if args.uiv and (args.impedance or args.hx):
+        raise CliError("--uiv carries both Z and Hx: do not add --impedance or --hx")
+    if args.hx and not args.impedance:
+        raise CliError("--hx needs --impedance: Hx alone cannot be fitted")
+    if args.uiv:
+        uiv = read_uiv(args.uiv)
+        z, hx, notes = uiv.impedance, uiv.displacement, [uiv.describe()]
+    else:
+        z_curve = read_curve(args.impedance, "impedance", args.phase)
+        notes = [z_curve.describe()]
+        z, hx = z_curve.transfer, None
+        if args.hx:
+            hx_curve = read_curve(args.hx, "displacement", args.phase, "mm/V" if args.mm_per_volt else None)
+            hx = hx_curve.transfer
+            notes.append(hx_curve.describe())
+    return z, hx, notes
+
+
+def analyze_curves(args: argparse.Namespace) -> int:
+    from analysis.curve_fit import curve_json, fit_curves
+    z, hx, notes = load_curves(args)
+    result = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes)
+    if args.json:
+        print_json(curve_json(result))
+        return 0
+    print(format_result(result))
+    ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
+    rms = ", ".join(f"{k} {100 * v:.2g} %" for k, v in result.validity["rms_relative_residual"].items())
+    print(f"fitted: {ranges}; rms relative misfit: {rms}")
+    print(f"note: {result.validity['note']}; {result.validity['uncertainties']}")
+    for note in result.notes:
+        print(f"  {note}")
+    return 0

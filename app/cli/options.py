@@ -1,0 +1,69 @@
+"""The options several `linpar` commands share, and the checks of what enters through them.
+
+`number(bound)` is an argparse type: the text becomes a finite number in
+the bound's range, or argparse's one-line error ("argument --sd: found
+1e+160, expected an effective radiating area Sd: a number from 0.0001 to 1
+m^2"). The bound says what the number is; no command repeats a range.
+
+Only the bounds and the default model are imported here: building the parser
+(`linpar --help`) loads no analysis.
+"""
+from __future__ import annotations
+
+import argparse
+from typing import Callable, Sequence
+
+from analysis.bounds import SD, Bound, BoundsError, parse_size_limit
+from analysis.default_model import DEFAULT_EFFECTS
+from analysis.errors import LinparError
+
+
+class CliError(LinparError):
+    """A command line that cannot be run as given: printed as one line, exit code 2."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, no usage dump: scripts read stderr
+        raise CliError(f"{message} (see '{self.prog} --help')")
+
+
+def number(bound: Bound) -> Callable[[str], float | int]:
+    def parse(text: str):
+        try:
+            return bound.parse(text, "")
+        except BoundsError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    parse.__name__ = bound.what          # argparse names the type in a few of its own messages
+    return parse
+
+
+def size_limit(text: str) -> tuple[str, int]:
+    try:
+        return parse_size_limit(text)
+    except BoundsError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--size-limit: ")) from None
+
+
+def add_model_option(parser, default: Sequence[str] = DEFAULT_EFFECTS, why: str = "") -> None:
+    """--model EFFECTS; `default` is what the command fits without it (said in the help, never typed twice)."""
+    parser.add_argument("--model", metavar="EFFECTS",
+                        help=f"effect ids separated by commas (default {','.join(default)}{why}; "
+                             "'none' for the textbook model)")
+
+
+def add_sd_option(parser, note: str = "") -> None:
+    parser.add_argument("--sd", type=number(SD), metavar="M2", help=f"effective radiating area in m^2{note}")
+
+
+def add_json_option(parser, what: str = "print one JSON object") -> None:
+    parser.add_argument("--json", action="store_true", help=what)
+
+
+def model_effects(text: str | None, option: str = "--model"):
+    """The effects an option names (the default model for None); ModelError that names the option."""
+    from analysis.effects import UnknownEffectError, parse_effects
+    from analysis.model import ModelError
+    try:
+        return parse_effects(text)
+    except UnknownEffectError as exc:
+        raise ModelError(f"{option}: {exc}") from None

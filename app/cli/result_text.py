@@ -1,0 +1,49 @@
+"""The text `linpar analyze` (and measure, recover) prints for a fitted recording or imported curves."""
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:        # the analysis loads when a command runs, not for `linpar --help`
+    from analysis.derived import ParameterValue
+
+
+def format_value(p: ParameterValue) -> tuple[str, str]:
+    if p.value is None:
+        return "n/a", ""
+    v = p.value * p.display_scale
+    s = None if p.std is None else p.std * abs(p.display_scale)
+    digits = 4
+    if s and s > 0:
+        digits = max(2, min(8, int(-math.floor(math.log10(s))) + 1))
+        return f"{v:.{digits}f}" if abs(v) < 1e6 else f"{v:.6g}", f"{s:.2g}"
+    return f"{v:.6g}", "-"
+
+
+def format_result(result) -> str:
+    """The parameter table, the fit's statistics, what is not reported and why, and the validity."""
+    lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"]
+    missing: dict[str, list[str]] = {}      # reason -> the parameters it keeps out
+    for p in result.parameters.values():
+        value, std = format_value(p)
+        lines.append(f"{p.name:<14}{value:>14}  {std:>10}  {p.display_unit}")
+        if p.value is None:
+            missing.setdefault(str(p.reason), []).append(p.name)
+    notes = [f"  {', '.join(names)}: {reason}" for reason, names in missing.items()]
+    fit = result.fit
+    if fit is None:
+        lines += ["", f"not fitted: {getattr(result, 'not_fitted', None)}"]
+        notes = []          # every parameter has that one reason
+    else:
+        chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
+        lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
+                      f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
+        if not fit.success:
+            lines.append(f"warning: the fit did not converge: {fit.message}")
+    if notes:
+        lines += ["", "not reported:"] + notes
+    lines.append(f"validity: {result.validity.get('overall', 'unknown')}")
+    for channel in (result.validity.get("channels") or {}).values():
+        for f in channel.get("findings") or ():
+            lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
+    return "\n".join(lines)
