@@ -31,7 +31,7 @@ from analysis.bounds import CHANNEL_SCALE, PERIOD_SAMPLES, SAMPLE_RATE, SD
 from analysis.files import check_output, mapped, regular_file
 from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
                                         RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
-                                        show, sidecar_of, unit_wanted)
+                                        show, unit_wanted)
 from analysis.recording_wav import WavFormatError, decode_wav, encode_float32_wav
 
 __all__ = ["FORMAT", "IN_MEMORY", "MIN_PERIODS", "REQUIRED_SIGNALS", "UNITS", "Channel", "Recording",
@@ -179,6 +179,22 @@ def make_recording(sample_rate: int, signals: Mapping[str, np.ndarray], period_s
     return Recording(sample_rate=sample_rate, channels=channels, data=data, period_samples=period_samples,
                      settle_periods=settle_periods, excited_bins=excited_bins,
                      driver={} if driver is None else driver, extra={} if extra is None else extra)
+
+
+def sidecar_of(rec: Recording) -> dict[str, Any]:
+    """The sidecar document of `rec`: the format's keys first, then what it kept of other keys."""
+    excitation: dict[str, Any] = {"period_samples": rec.period_samples, "settle_periods": rec.settle_periods}
+    if rec.excited_bins is not None:
+        excitation["excited_bins"] = list(rec.excited_bins)
+    doc: dict[str, Any] = {
+        "format": FORMAT,
+        "channels": [{"signal": c.signal, "unit": c.unit, "scale": c.scale, **c.extra} for c in rec.channels],
+        "excitation": {**excitation, **rec.excitation_extra},
+    }
+    if rec.driver:
+        doc["driver"] = dict(rec.driver)
+    doc.update(rec.extra)
+    return doc
 
 
 def recording_paths(path: str | Path) -> tuple[Path, Path]:

@@ -14,15 +14,12 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
 import numpy as np
 
 from analysis.errors import LinparError
 from analysis.files import read_bytes
-
-if TYPE_CHECKING:
-    from analysis.recording import Recording
 
 FORMAT = "linpar-recording/1"
 # The signals the analysis knows, with the only unit each may be in.
@@ -139,22 +136,6 @@ def _required(doc: dict, key: str, kind: type, label: str, where: str, expected:
 
 
 # --- writing -----------------------------------------------------------------
-
-def sidecar_of(rec: Recording) -> dict[str, Any]:
-    """The sidecar document of `rec`: the format's keys first, then what it kept of other keys."""
-    excitation: dict[str, Any] = {"period_samples": rec.period_samples, "settle_periods": rec.settle_periods}
-    if rec.excited_bins is not None:
-        excitation["excited_bins"] = list(rec.excited_bins)
-    doc: dict[str, Any] = {
-        "format": FORMAT,
-        "channels": [{"signal": c.signal, "unit": c.unit, "scale": c.scale, **c.extra} for c in rec.channels],
-        "excitation": {**excitation, **rec.excitation_extra},
-    }
-    if rec.driver:
-        doc["driver"] = dict(rec.driver)
-    doc.update(rec.extra)
-    return doc
-
 
 def format_sidecar(doc: dict[str, Any]) -> str:
     """The layout of the spec's example: one line per top-level key and per channel."""

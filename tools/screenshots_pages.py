@@ -14,10 +14,11 @@ from pathlib import Path
 
 from PySide6.QtWidgets import QApplication
 
+from tools.screenshot_kit import (ANALYSIS_TIMEOUT_S, grab_small_and_large, settle, synthetic_recording, wait_for,
+                                  wait_for_click)
+
 
 def every_page_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
-    from tools.screenshots import (ANALYSIS_TIMEOUT_S, grab_small_and_large, settle, synthetic_recording,
-                                   wait_for, wait_for_click)
     written: list[Path] = []
 
     def shoot(stem: str) -> None:

@@ -17,34 +17,14 @@ runs one suite against each.
 from __future__ import annotations
 
 import os
-import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Protocol
 
-from analysis.archive.names import ArchiveError
+from analysis.archive.names import ArchiveError, shown  # noqa: F401 - shown: re-exported, callers show specifications
+from analysis.archive.sync_report import SyncReport
 
 URL_ENV = "LINPAR_ARCHIVE_URL"
 FOLDER_ENV = "LINPAR_ARCHIVE"
-
-
-@dataclass
-class SyncReport:
-    """What sending the local queue to the server did."""
-
-    sent: list[str] = field(default_factory=list)          # ids now on the server
-    already: list[str] = field(default_factory=list)       # ids the server had already (sent before a break)
-    waiting: int = 0                                       # still in the local queue
-    problem: str = ""                                      # why they wait ("" when none do)
-    refused: bool = False                                  # the server said no (not: could not be reached)
-    stuck: list[str] = field(default_factory=list)         # "id: why" of those the server refuses one by one
-
-    def describe(self) -> str:
-        text = f"{len(self.sent)} sent" + (f", {len(self.already)} already on the server" if self.already else "")
-        if self.waiting:
-            why = "; ".join(x for x in (self.problem, *self.stuck[:3]) if x)
-            text += f"; {self.waiting} wait in the local queue ({why})"
-        return text
 
 
 class ArchiveBackend(Protocol):
@@ -102,11 +82,6 @@ def archive_spec(explicit: str | Path | None = None) -> str:
 
 def is_url(spec: str) -> bool:
     return "://" in str(spec)
-
-
-def shown(spec: str) -> str:
-    """A specification as messages may show it: a URL's password masked."""
-    return re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", str(spec))
 
 
 def _factory(spec: str) -> Callable[[str], ArchiveBackend]:

@@ -177,7 +177,7 @@ class FolderQA:
 
     def sync(self):
         """A folder archive has no server to send to: nothing waits."""
-        from analysis.archive.backends import SyncReport
+        from analysis.archive.sync_report import SyncReport
         return SyncReport()
 
     @property

@@ -83,3 +83,8 @@ def safe_suffix(name: str, default: str = ".bin") -> str:
     """A file's extension reduced to '.' + up to 8 [a-z0-9], for files copied in under our own names."""
     suffix = slug(Path(str(name).replace("\x00", "")).suffix.lstrip("."))[:8].replace("-", "")
     return f".{suffix}" if suffix else default
+
+
+def shown(spec: str) -> str:
+    """A specification as messages may show it: a URL's password masked."""
+    return re.sub(r"(://[^:/@]*):[^@/]*@", r"\1:***@", str(spec))

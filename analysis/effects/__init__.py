@@ -7,40 +7,10 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.effects import breakup, channels, creep, enclosure, forcefactor, inductance, mechanical
 from analysis.default_model import DEFAULT_EFFECTS
+from analysis.effects.base import Effect, ParamSpec, Site
+from analysis.effects.catalogue import CATALOGUE
 from analysis.errors import LinparError
-
-# Grouped by category; within a category the effects are alternatives (one per model).
-_ALL: tuple[Effect, ...] = (
-    inductance.lr2,
-    inductance.lr3,
-    inductance.leach,
-    inductance.wright,
-    creep.creep_log,
-    creep.creep_log_causal,
-    creep.creep_3p,
-    creep.creep_fractional,
-    creep.creep_rs,
-    creep.creep_kv,
-    creep.creep_zener,
-    channels.delay_current,
-    channels.lowpass_current,
-    channels.delay_x,
-    channels.lowpass_x,
-    channels.lowpass2_x,
-    breakup.breakup,
-    breakup.breakup_spot,
-    breakup.breakup_coil,
-    forcefactor.bl_eddy,
-    mechanical.air_load,
-    mechanical.damping_power,
-    enclosure.closed_box,
-    enclosure.vented_box,
-)
-
-CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}
 
 
 def categories() -> dict[str, list[Effect]]:

@@ -15,126 +15,15 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import asdict, dataclass
-from typing import Any, Callable, Mapping
+from typing import Callable
 
 import numpy as np
 
+from instruments.audio.captured import CLIP_LEVEL, CapturedSignals, CaptureStats
 from instruments.audio.errors import AudioError, CaptureCancelled
 from instruments.audio.interface import AudioInterface
 from instruments.audio.periods import PeriodCollector
 from instruments.audio.stream_core import LoopedExcitation, StreamCounters
-
-CLIP_LEVEL = 0.999   # |sample| at or above this (FS) counts as clipped
-
-
-@dataclass(frozen=True, slots=True)
-class CaptureStats:
-    """How a capture went. Counts are samples unless named otherwise."""
-
-    sample_rate: int
-    period_samples: int
-    periods_kept: int
-    fade_samples: int             # fade-in length; the fade is part of the discarded settle
-    settle_samples: int           # asked-for settle after the fade (and after the first signal)
-    discarded_samples: int        # input samples before the first kept one (fade + settle + latency)
-    samples_received: int
-    samples_lost: int             # gaps in the sample counter (blocks dropped on a full queue)
-    gaps: int
-    queue_overflows: int          # blocks the callback dropped
-    input_overflows: int          # PortAudio status flags, counted per callback
-    input_underflows: int
-    output_underflows: int
-    output_overflows: int
-    restarts: int                 # times the kept periods were discarded after an xrun
-    output_clipped_samples: int   # samples of one period above output full scale (clipped)
-    output_peak_fs: float         # the requested output peak, FS
-    clipped_inputs: tuple[tuple[str, int], ...]   # (signal, samples at >= CLIP_LEVEL FS) in kept periods
-    full_scale_fraction: tuple[tuple[str, float], ...]   # (signal, peak |sample| / FS) in kept periods
-    silent_channels: tuple[str, ...]              # signals exactly zero in every kept sample
-    device: str = ""
-    ended_by: str = "complete"
-
-    @property
-    def xruns(self) -> int:
-        return self.input_overflows + self.input_underflows + self.output_underflows + self.output_overflows
-
-    @property
-    def dropouts(self) -> int:
-        return self.xruns + self.gaps
-
-    def problems(self) -> list[str]:
-        """One line per thing the user should know, empty when the capture was clean."""
-        out = []
-        if self.output_clipped_samples:
-            out.append(f"output clipped: the excitation asks for {self.output_peak_fs:.2f} FS, "
-                       f"{self.output_clipped_samples} samples per period above full scale (lower the level)")
-        for signal, count in self.clipped_inputs:
-            if count:
-                out.append(f"input {signal} clipped on {count} samples (lower the level or the input gain)")
-        for signal in self.silent_channels:
-            out.append(f"input {signal} is silent (exact zeros): nothing connected?")
-        if self.xruns:
-            out.append(f"{self.xruns} xrun(s) reported by the audio driver; {self.restarts} restart(s) of the "
-                       f"averaging")
-        if self.samples_lost:
-            out.append(f"{self.samples_lost} input samples lost in {self.gaps} gap(s) (the measurement thread "
-                       f"fell behind)")
-        return out
-
-    def as_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["clipped_inputs"] = dict(self.clipped_inputs)
-        d["full_scale_fraction"] = dict(self.full_scale_fraction)
-        d["silent_channels"] = list(self.silent_channels)
-        return d
-
-    def capture_info(self) -> dict[str, Any]:
-        """The recording sidecar's "capture" object (analysis.validity_capture.CaptureInfo).
-
-        Dropouts and xruns are those inside the kept periods: always none,
-        since a period with a gap is dropped and an xrun discards every period
-        kept before it (instruments.audio.periods). How often that happened is
-        in the "audio_capture" object (``as_dict``).
-        """
-        return {"full_scale_fraction": dict(self.full_scale_fraction),
-                "clipped_samples": dict(self.clipped_inputs),
-                "dropouts": {signal: 0 for signal, _ in self.clipped_inputs}, "xruns": 0}
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class CapturedSignals:
-    """Whole periods in SI units: voltage (V), current (A), displacement (m) or None. Read-only."""
-
-    sample_rate: int
-    period_samples: int
-    voltage: np.ndarray
-    current: np.ndarray
-    displacement: np.ndarray | None
-    stats: CaptureStats
-
-    @property
-    def n_periods(self) -> int:
-        return self.voltage.size // self.period_samples
-
-    def signals(self) -> dict[str, np.ndarray]:
-        """Name -> samples, as analysis.recording.make_recording takes them."""
-        out = {"voltage": self.voltage, "current": self.current}
-        if self.displacement is not None:
-            out["displacement"] = self.displacement
-        return out
-
-    def to_recording(self, excited_bins=None, driver: Mapping | None = None):
-        """An analysis Recording of these periods (no settle left in them).
-
-        The sidecar gets "capture" (what analysis.validity reads) and
-        "audio_capture" (every count of CaptureStats, for the report).
-        """
-        from analysis.recording import make_recording
-        return make_recording(self.sample_rate, self.signals(), self.period_samples, settle_periods=0,
-                              excited_bins=None if excited_bins is None else tuple(int(b) for b in excited_bins),
-                              driver=dict(driver or {}),
-                              extra={"capture": self.stats.capture_info(), "audio_capture": self.stats.as_dict()})
 
 
 def capture(audio: AudioInterface, excitation_waveform: np.ndarray, n_periods: int, settle_periods: int, *,

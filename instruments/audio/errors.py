@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 from analysis.errors import LinparError
 
 if TYPE_CHECKING:
-    from instruments.audio.capture import CapturedSignals
+    from instruments.audio.captured import CapturedSignals
 
 
 class AudioError(LinparError, RuntimeError):

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from analysis.recording import make_recording, write_recording
+from instruments.audio.captured import CLIP_LEVEL
 from instruments.audio.config import Calibration, ChannelMap
 from instruments.audio.periods import PeriodCollector
 from instruments.audio.stream_core import XRUN_FLAGS, InputBlock
@@ -26,8 +27,6 @@ from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import MeasurementPlan
 from instruments.measurement.recovery_journal import (FADE_S, FORMAT, INDEX_RECORD, LASER_COLUMNS, LASER_HEAD,
                                                       SUFFIX, in_use, now_utc, recording_written)
-
-CLIP_LEVEL = 0.999           # as instruments.audio.capture
 
 
 class RecoveryError(MeasurementError):

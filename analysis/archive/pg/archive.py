@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
 from analysis.archive.archive import Measurement, export_folder
-from analysis.archive.backends import SyncReport
 from analysis.archive.index import Filter, _entry_of_row
 from analysis.archive.limits_store import LimitsVersion, checked_document, checked_note, version_of_json
 from analysis.archive.names import ArchiveError, check_id, check_id_prefix, inside
@@ -28,6 +27,7 @@ from analysis.archive.pg.files import fetch_file
 from analysis.archive.pg.outbox import Outbox, queue_folder
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, connect, parse_url, server_errors
 from analysis.archive.record import RECORD_FILE, checked_parameter, entry_of, one_line_text, read_record
+from analysis.archive.sync_report import SyncReport
 
 LIST_COLUMNS = ("id, folder, measured_at, stored_at, driver, serial, operator, station, validity, effects, "
                 "verdict, limits_version")

@@ -34,11 +34,11 @@ from typing import Iterator
 
 from analysis.archive.archive import Archive
 from analysis.archive.atomic import FILE_MODE, write_atomic
-from analysis.archive.backends import SyncReport
 from analysis.archive.limits_store import LimitsVersion, version_json, version_of_json
 from analysis.archive.names import ArchiveError, folder_name
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, server_errors
 from analysis.archive.pg.upload import IdTaken, record_sha256, send_measurement
+from analysis.archive.sync_report import SyncReport
 
 LIMITS_CACHE = "limits.json"
 LOCK_FILE = ".send.lock"

@@ -181,23 +181,6 @@ def version_of(conn) -> int:
     return int(rows[0][0])
 
 
-def check_version(conn, server) -> None:
-    """ServerRefused unless the server's schema is the version this program speaks."""
-    from analysis.archive.pg.server import ServerRefused
-    version = version_of(conn)
-    if version == CURRENT_VERSION:
-        return
-    if version == 0:
-        raise ServerRefused(f"{server.display}: this database holds no linpar archive: its owner creates it with "
-                            f"'linpar archive setup --archive postgresql://OWNER@{server.host}:{server.port}/"
-                            f"{server.dbname}'")
-    if version < CURRENT_VERSION:
-        raise ServerRefused(f"{server.display}: the archive's schema is version {version}, this program needs "
-                            f"{CURRENT_VERSION}: the database's owner migrates it with 'linpar archive setup'")
-    raise ServerRefused(f"{server.display}: the archive's schema is version {version}, newer than this program's "
-                        f"{CURRENT_VERSION}: update linpar on this station")
-
-
 def migrate(conn) -> tuple[int, int]:
     """Bring the schema to CURRENT_VERSION (as the database's owner); (version before, version after)."""
     from analysis.archive.names import ArchiveError

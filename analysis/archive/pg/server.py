@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Iterator
 
 from analysis.archive.names import ArchiveError
+from analysis.archive.names import shown as masked
 from analysis.errors import one_line
 
 CONNECT_TIMEOUT_S = 5
@@ -81,7 +82,6 @@ def parse_url(url: str) -> ServerURL:
     """The checked URL; ArchiveError (one line, the password never shown) when it cannot be one."""
     from psycopg import conninfo
     text = str(url).strip()
-    from analysis.archive.backends import shown as masked
     shown = masked(text)[:120]
     if not re.match(r"^postgres(ql)?://", text, re.IGNORECASE):
         raise ArchiveError(f"{shown}: expected postgresql://USER@HOST[:PORT]/DATABASE")
@@ -164,14 +164,30 @@ def connect(server: ServerURL, doing: str):
     session half in one.
     """
     import psycopg
-    from analysis.archive.pg.schema import check_version
     with server_errors(server, doing):
         conn = psycopg.connect(**server.params, autocommit=True)
     try:
         with server_errors(server, doing):
             conn.execute(f"SET search_path TO {SCHEMA}, pg_catalog")
-            check_version(conn, server)
+            _check_version(conn, server)
     except BaseException:
         conn.close()
         raise
     return conn
+
+
+def _check_version(conn, server: ServerURL) -> None:
+    """ServerRefused unless the server's schema is the version this program speaks."""
+    from analysis.archive.pg.schema import CURRENT_VERSION, version_of
+    version = version_of(conn)
+    if version == CURRENT_VERSION:
+        return
+    if version == 0:
+        raise ServerRefused(f"{server.display}: this database holds no linpar archive: its owner creates it with "
+                            f"'linpar archive setup --archive postgresql://OWNER@{server.host}:{server.port}/"
+                            f"{server.dbname}'")
+    if version < CURRENT_VERSION:
+        raise ServerRefused(f"{server.display}: the archive's schema is version {version}, this program needs "
+                            f"{CURRENT_VERSION}: the database's owner migrates it with 'linpar archive setup'")
+    raise ServerRefused(f"{server.display}: the archive's schema is version {version}, newer than this program's "
+                        f"{CURRENT_VERSION}: update linpar on this station")
