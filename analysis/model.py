@@ -21,11 +21,8 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
-from analysis.errors import LinparError
-# Imported before the effects: effects that need fs import it from here while
-# this module is still loading (analysis.lumped is the cycle-free home).
-from analysis.lumped import resonance_frequency  # noqa: F401  (re-exported)
 from analysis.effects.base import Effect, ParamSpec, Site
+from analysis.errors import LinparError
 
 # The textbook model without extra effects: the lumped elements of physics.md.
 BASE_PARAMS: tuple[ParamSpec, ...] = (

@@ -17,8 +17,6 @@ from __future__ import annotations
 import json
 import math
 import numbers
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
@@ -28,7 +26,7 @@ import numpy as np
 
 # The sidecar's vocabulary (FORMAT, UNITS, Channel, RecordingError) is defined there and importable from here.
 from analysis.bounds import CHANNEL_SCALE, PERIOD_SAMPLES, SAMPLE_RATE, SD
-from analysis.files import check_output, mapped, regular_file
+from analysis.files import mapped, regular_file, write_atomic
 from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
                                         RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
                                         show, unit_wanted)
@@ -143,8 +141,8 @@ def write_recording(path: str | Path, recording: Recording) -> tuple[Path, Path]
     except UnicodeEncodeError as err:
         raise RecordingError(f"{json_path}: a string holds {err.object[err.start:err.end]!r}, half of a UTF-16 "
                              f"surrogate pair, expected Unicode text") from None
-    _write_atomic(wav_path, wav_bytes)
-    _write_atomic(json_path, json_bytes)
+    write_atomic(wav_path, wav_bytes)
+    write_atomic(json_path, json_bytes)
     return wav_path, json_path
 
 
@@ -359,21 +357,6 @@ def _checked_mapping(mapping, reserved, label: str, prefix: str, whole_key: str 
 
 
 # --- files and small helpers -------------------------------------------------
-
-def _write_atomic(path: Path, payload: bytes) -> None:
-    """Write to a temporary file in the same folder, then rename over `path` (never over a FIFO or device)."""
-    check_output(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(payload)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
 
 def _bounded(value, bound, label: str, key: str) -> int:
     """An integer field within its bound (analysis.bounds); a non-integer is refused as such, not rounded."""

@@ -6,9 +6,9 @@ for why (PySide6 decodes "@Variant(...)" values through pickle).
 from __future__ import annotations
 
 import codecs
-import os
-import tempfile
 from pathlib import Path
+
+from analysis.files import write_atomic
 
 # What Qt's QSettingsPrivate::stringToVariant may make of a value starting with "@"
 # without a QDataStream: bytes, a string, geometry, nothing. "@@" is an escaped "@".
@@ -18,17 +18,7 @@ _STREAMED_TAGS = ("@Variant(", "@DateTime(")
 
 
 def replace_bytes(path: Path, data: bytes) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())        # on disk before the rename: a crash leaves the old file or the new
-        os.chmod(tmp, path.stat().st_mode & 0o7777)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomic(path, data)        # a crash leaves the old file or the new, with the old one's mode
 
 
 # -- reading an INI file the way Qt 6 does (qsettings.cpp), to look before Qt does --------------

@@ -169,7 +169,7 @@ def measure_resistor(config, r_ohm: float, level_v: float, cancel: threading.Eve
     """Measure the reference resistor on `config` (on the simulator: a simulated one) and check it."""
     from analysis.multitone import design_multitone
     from app.wizard.hardware import SIMULATOR, open_audio
-    from instruments.audio.capture import capture
+    from instruments.audio import capture
 
     if config.kind == SIMULATOR:
         config = replace(config, simulated_driver=resistor_driver(r_ohm, config.sample_rate))

@@ -125,7 +125,7 @@ def list_sound_cards() -> list:
 def test_audio(config: HardwareConfig, cancel: threading.Event | None = None, progress=None) -> str:
     """A short, quiet capture: what the inputs carry, in words (AudioError when the card does not work)."""
     from analysis.multitone import design_multitone
-    from instruments.audio.capture import capture
+    from instruments.audio import capture
 
     mt = design_multitone(config.sample_rate, TEST_PERIOD, 50.0, 5000.0, rms=TEST_LEVEL_V, crest_iterations=0)
     audio = open_audio(config)

@@ -3,7 +3,7 @@
 Both go through instruments.measurement's run_measurement when it is
 installed (the level check's probes too, with analyse=False, written to a
 temporary folder: so a serial laser is read during the level check as well).
-Without it the fallback here measures: instruments.audio.capture, with its
+Without it the fallback here measures: instruments.audio.capture_loop, with its
 input blocks teed to a second PeriodCollector so that each kept period also
 goes to an analysis.live.LiveAccumulator (the live panels), then
 write_recording, then analyze_recording. The tee sees the same blocks in the
@@ -29,7 +29,7 @@ from app.wizard.calibration import Corrections
 from app.wizard.corrected_audio import corrected_audio
 from app.wizard.hardware import SERIAL_LASER, HardwareConfig, open_audio
 from app.wizard.plans import DriverInfo, Template, find_runner, multitone_for
-from instruments.audio.capture import CapturedSignals, capture
+from instruments.audio import CapturedSignals, capture
 from instruments.audio.periods import PeriodCollector
 
 FADE_S = 0.1

@@ -13,7 +13,7 @@ engine itself imports instruments.audio.config.
 from importlib import import_module
 
 _EXPORTS = {
-    "capture": "capture", "CaptureStats": "capture", "CapturedSignals": "capture",
+    "capture": "capture_loop", "CaptureStats": "captured", "CapturedSignals": "captured",
     "AudioConfigError": "config", "AudioDeviceChoice": "config", "Calibration": "config", "ChannelMap": "config",
     "JACK_HOSTAPI": "config",
     "AudioError": "errors", "AudioUnavailable": "errors", "CaptureCancelled": "errors",
@@ -23,13 +23,6 @@ _EXPORTS = {
     "InputBlock": "stream_core", "LoopedExcitation": "stream_core", "StreamCounters": "stream_core",
 }
 __all__ = sorted(_EXPORTS)
-
-
-# NB: `capture` is both a submodule and the function the package exports. Bound
-# here, eagerly: otherwise the first `import instruments.audio.capture` anywhere
-# rebinds the package's attribute to the module for everyone. (capture.py itself
-# loads only numpy and this package's light modules, not PortAudio.)
-from instruments.audio.capture import CapturedSignals, CaptureStats, capture  # noqa: E402
 
 
 def __getattr__(name: str):

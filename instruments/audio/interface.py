@@ -6,7 +6,7 @@ continuous full-duplex stream. ``start`` opens and starts the stream;
 samples with their sample counter); ``fade_out`` asks for the end of the
 output; ``stop`` closes the stream and never hangs. Conversion to SI units
 (calibration and channel map) happens on the consumer side, in
-instruments.audio.capture, identically for every implementation.
+instruments.audio.capture_loop, identically for every implementation.
 """
 from __future__ import annotations
 

@@ -116,6 +116,10 @@ class DuplexCore:
         self.blocks: queue.Queue[InputBlock] = queue.Queue(maxsize=queue_blocks)
         self._period = excitation.period
         self._fade = max(int(excitation.fade_samples), 0)
+        # Raised-cosine fade windows, computed once: the callback allocates no array of its own.
+        ramp = np.pi * np.arange(self._fade, dtype=np.float64) / max(self._fade, 1)
+        self._fade_in = 0.5 - 0.5 * np.cos(ramp)
+        self._fade_out = 0.5 + 0.5 * np.cos(ramp)
         # NB: written by the callback thread only; read by the consumer.
         self._callbacks = 0
         self._in_index = 0
@@ -169,6 +173,7 @@ class DuplexCore:
                 self._queue_overflows += 1
 
     def _fill_output(self, outdata: np.ndarray) -> None:
+        """The looped period into the output channel, faded in and out, in place (no array allocated)."""
         frames = outdata.shape[0]
         start = self._out_index
         self._out_index += frames
@@ -177,16 +182,23 @@ class DuplexCore:
             return
         if self._fade_out_requested and self._fade_out_start is None:
             self._fade_out_start = start
-        samples = np.take(self._period, np.arange(start, start + frames), mode="wrap")
-        n = np.arange(start, start + frames, dtype=np.float64)
+        into = None if self._fade_out_start is None else start - self._fade_out_start   # samples into the fade-out
+        if into is not None and (self._fade == 0 or into >= self._fade):
+            self.output_finished = True
+            return
+        column = outdata[:, self.output_channel]
+        period = self._period
+        done, position = 0, start % period.size
+        while done < frames:
+            n = min(frames - done, period.size - position)
+            column[done:done + n] = period[position:position + n]
+            done, position = done + n, 0
         if start < self._fade:
-            samples *= np.where(n < self._fade, 0.5 - 0.5 * np.cos(np.pi * n / self._fade), 1.0)
-        if self._fade_out_start is not None:
-            into = n - self._fade_out_start
-            if self._fade == 0 or into[0] >= self._fade:
+            k = min(frames, self._fade - start)
+            column[:k] *= self._fade_in[start:start + k]
+        if into is not None:
+            k = min(frames, self._fade - into)
+            column[:k] *= self._fade_out[into:into + k]
+            column[k:] = 0.0
+            if into + frames >= self._fade:
                 self.output_finished = True
-                return
-            samples *= np.where(into < self._fade, 0.5 + 0.5 * np.cos(np.pi * into / self._fade), 0.0)
-            if into[-1] + 1 >= self._fade:
-                self.output_finished = True
-        outdata[:, self.output_channel] = samples

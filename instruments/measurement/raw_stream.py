@@ -28,14 +28,14 @@ Written atomically (a temporary file in the same folder, then renamed).
 """
 from __future__ import annotations
 
+import io
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from analysis.files import write_atomic
 from instruments.laser.sensor import LaserBlock
 
 FORMAT = "linpar-raw-capture/1"
@@ -70,18 +70,9 @@ def write_raw_capture(path: Path, blocks: Sequence[LaserBlock], audio_arrivals: 
     }
     for name, value in (extra_arrays or {}).items():
         arrays[name] = np.asarray(value, dtype=np.float64)
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            np.savez(f, **arrays)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    encoded = io.BytesIO()
+    np.savez(encoded, **arrays)
+    return write_atomic(Path(path), encoded.getvalue())
 
 
 def read_raw_capture(path: Path) -> tuple[dict[str, np.ndarray], dict[str, Any]]:

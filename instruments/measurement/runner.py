@@ -47,8 +47,7 @@ import numpy as np
 from analysis.pipeline import AnalysisResult
 from analysis.recording import Recording, make_recording, read_recording, write_recording
 from analysis.session import SESSION_KEY, new_session
-from instruments.audio import capture as _capture_name      # first: see the NB at `capture` below
-from instruments.audio import CapturedSignals
+from instruments.audio import CapturedSignals, capture
 from instruments.audio.errors import AudioError, CaptureCancelled
 from instruments.audio.interface import AudioInterface
 from instruments.laser.sensor import DisplacementSensor, LaserError
@@ -63,10 +62,6 @@ from instruments.measurement.resample import HALF_TAPS
 from instruments.measurement.timed_audio import TimedAudio
 from instruments.measurement.errors import MeasurementError  # noqa: F401  (re-exported)
 
-# NB: "capture" is both a submodule of instruments.audio and the function the package exports lazily.
-# Importing the submodule by its path binds the package's name to the module, for every later importer;
-# so the name is taken through the package, and whichever of the two it is, the function comes out.
-capture = getattr(_capture_name, "capture", _capture_name)
 _CAPTURE_KEPT = re.compile(r"; kept \d+ of \d+ periods$")
 GIL_SWITCH_S = 0.001
 SILENT_SHARE = 0.01      # a period with this share of exact zeros on every input is not the driver's

@@ -21,12 +21,13 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any, Sequence
 
+from analysis.files import write_atomic
 from instruments.rig.control import ControlServer
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP, RigEngine, RigFaults, RigNoise, default_driver
 from instruments.rig.jack_rig import DEFAULT_CLIENT_PATTERN, PLAYED_CHANNEL, JackRig
 from instruments.rig.jackd import RIG_PERIOD, JackServer
 from instruments.rig.laser_feed import DisplacementFeed, RigLaser
-from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, write_atomic
+from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState
 
 EXIT_OK, EXIT_FAILED, EXIT_SERVER_DIED = 0, 1, 3
 

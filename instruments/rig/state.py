@@ -122,17 +122,6 @@ class RigState:
                                 f"it again") from None
 
 
-def write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def read_state(paths: RigPaths) -> RigState | None:
     """The state of the rig, None when it has not written one (not started, not ready, or gone)."""
     try:

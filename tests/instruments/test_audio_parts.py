@@ -70,6 +70,34 @@ def test_output_loops_the_period_between_raised_cosine_fades():
     assert not tail.any()
 
 
+def test_the_output_is_the_same_in_blocks_of_any_size_fades_included():
+    """The callback fills blocks of whatever size the device asks, a fade-in shorter than a block or longer than
+    a period, a fade-out asked in the middle of the fade-in: sample for sample the looped period times the
+    raised-cosine envelopes, as one long block would be."""
+    rng = np.random.default_rng(7)
+    period = rng.uniform(-1.0, 1.0, 37)
+    exc = LoopedExcitation.from_volts(period * 10.0, CAL, fade_samples=90)
+    core = DuplexCore(exc, n_inputs=1, n_outputs=3, output_channel=2)
+    blocks, written, fade_from = [], 0, None
+    while not core.output_finished:
+        out = np.full((int(rng.integers(1, 60)), 3), 7.0, dtype=np.float32)
+        if fade_from is None and written >= 70:         # during the fade-in (90 samples)
+            core.request_fade_out()
+            fade_from = written
+        core.process(None, out, 0)
+        assert np.all(out[:, :2] == 0)
+        blocks.append(out[:, 2].copy())
+        written += len(out)
+    got = np.concatenate(blocks)
+    n = np.arange(got.size)
+    envelope = np.where(n < 90, 0.5 - 0.5 * np.cos(np.pi * n / 90), 1.0)
+    into = n - fade_from
+    envelope *= np.where(into < 0, 1.0, np.where(into < 90, 0.5 + 0.5 * np.cos(np.pi * into / 90), 0.0))
+    expected = period.astype(np.float32)[n % 37] * envelope          # CAL: 10 V -> 1 FS
+    assert np.allclose(got, expected, atol=1e-6)
+    assert got.size >= fade_from + 90 and not got[fade_from + 90:].any()
+
+
 def test_output_above_full_scale_is_clipped_and_counted():
     exc = LoopedExcitation.from_volts(np.array([0.0, 15.0, -12.0, 3.0]), CAL, fade_samples=0)
     assert exc.clipped_per_period == 2
