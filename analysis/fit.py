@@ -145,6 +145,12 @@ class FitResult:
         with np.errstate(divide="ignore", invalid="ignore"):
             return self.covar / np.outer(d, d)
 
+    def report(self, min_correl: float | None = None) -> str:
+        """The fit report, as lmfit's fit_report: statistics, parameters with sigma, correlations with
+        |r| >= min_correl (default analysis.fit_report.MIN_CORREL), parameters on a bound."""
+        from analysis.fit_report import MIN_CORREL, fit_report_json, fit_report_text
+        return fit_report_text(fit_report_json(self, MIN_CORREL if min_correl is None else min_correl))
+
 
 # Curves without a noise estimate (imported ones get one from their local
 # scatter, analysis.curve_noise; the added-mass fits do without) are weighted

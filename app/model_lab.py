@@ -213,9 +213,7 @@ class ModelLab(QWidget):
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
                 f"<span style='color:#555'>({html.escape(version.how)})</span><br>{html.escape(fit_headline(fit))}")
-        self.model_label.setToolTip(f"Effects: {', '.join(fit.model.effect_ids) or 'none'}\n"
-                                    f"Reduced χ²: {chi2_text(fit.chi2_red_by_channel())}; BIC {fit.bic:.1f}; "
-                                    f"{fit.n_varying} parameters")
+        self.model_label.setToolTip(f"<pre>{html.escape(fit.report())}</pre>")     # the numbers one look away
         if not fit.success:
             text += (f"<br><span style='color:#8e1b1b'><b>The fit did not converge</b>: "
                      f"{html.escape(fit.message)}</span>")

@@ -1,5 +1,6 @@
 """The `linpar` command line: output, JSON shape, exit codes, one-line errors."""
 import json
+import re
 import subprocess
 import sys
 
@@ -54,6 +55,9 @@ def test_analyze_table_shows_customary_units(capsys, rec_path):
     mms_line = next(line for line in out.splitlines() if line.startswith("Mms"))
     assert mms_line.split()[-1] == "g" and float(mms_line.split()[1]) == pytest.approx(11.84, abs=0.05)
     assert "reduced chi^2" in out
+    # the fit's own report below (FitResult.report): statistics, sigmas, the strong correlations
+    assert "[[Fit statistics]]" in out and "[[Correlations]] (unreported correlations are below 0.5" in out
+    assert re.search(r"C\(\w+, \w+\) = [+-]0\.\d{3}", out)
 
 
 def test_without_displacement_mechanical_parameters_are_null_with_a_reason(capsys, z_only_path):

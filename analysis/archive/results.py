@@ -22,6 +22,8 @@ import numpy as np
 from analysis.bounds import FREQUENCY, SD
 from analysis.derived import ParameterValue
 from analysis.errors import LinparError
+from analysis.fit_report import fit_report_json
+from analysis.json_finite import finite
 from analysis.session import session_of
 
 FORMAT = "linpar-results/1"
@@ -107,7 +109,7 @@ def _model_json(fit) -> dict:
             "chi2_red": {k: _num(v) for k, v in fit.chi2_red_by_channel().items()},
             "aic": _num(fit.aic), "bic": _num(fit.bic), "n_data": fit.n_data,
             "n_parameters": fit.n_varying, "converged": bool(fit.success), "message": fit.message,
-            "noise_known": fit.noise_known}
+            "noise_known": fit.noise_known, "report": finite(fit_report_json(fit))}
 
 
 def _curves_json(fit) -> dict:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
+from analysis.fit_report import fit_report_rows
 from analysis.report.numbers import format_number, parameter_cells, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 
@@ -122,6 +123,8 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
                                      f"{info.get('n_parameters', 'n/a')} fitted parameters"))
     converged = info.get("converged")
     rows.append(("Converged", "yes" if converged else f"NO: {info.get('message', '')}"))
+    if isinstance(info.get("report"), Mapping):       # results stored before the fit kept its report have none
+        rows += fit_report_rows(info["report"])
     return tuple(rows)
 
 

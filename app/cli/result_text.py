@@ -21,7 +21,8 @@ def format_value(p: ParameterValue) -> tuple[str, str]:
 
 
 def format_result(result) -> str:
-    """The parameter table, the fit's statistics, what is not reported and why, and the validity."""
+    """The parameter table, the fit's summary, what is not reported and why, the validity, then the fit's report
+    (FitResult.report: statistics, fitted parameters with sigma, correlations, parameters on a bound)."""
     lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"]
     missing: dict[str, list[str]] = {}      # reason -> the parameters it keeps out
     for p in result.parameters.values():
@@ -40,10 +41,13 @@ def format_result(result) -> str:
                       f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
         if not fit.success:
             lines.append(f"warning: the fit did not converge: {fit.message}")
+        report = fit.report()
     if notes:
         lines += ["", "not reported:"] + notes
     lines.append(f"validity: {result.validity.get('overall', 'unknown')}")
     for channel in (result.validity.get("channels") or {}).values():
         for f in channel.get("findings") or ():
             lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
+    if fit is not None:
+        lines += ["", report]           # the fit's own report (analysis.fit_report): correlations, bounds
     return "\n".join(lines)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import contextlib
+import html
 import threading
 
 import numpy as np
@@ -104,6 +105,8 @@ def test_the_catalogue_groups_every_effect_by_category_and_explains_it(qtbot, la
     assert sorted(sum(listed.values(), [])) == sorted(CATALOGUE)
     assert sorted(map(sorted, listed.values())) == sorted(sorted(e.id for e in es) for es in grouped.values())
     assert lab.catalogue.checked() == ("lr2",)          # the model the lab started from
+    fit = lab.versions[-1].fitted.fit          # the model's numbers: the fit's own report (FitResult.report)
+    assert lab.model_label.toolTip() == f"<pre>{html.escape(fit.report())}</pre>" and "[[Correlations]]" in fit.report()
 
     creep = get_effect("creep-log")
     qtbot.mouseMove(tree.viewport(), tree.visualItemRect(lab.catalogue.item("creep-log")).center())
