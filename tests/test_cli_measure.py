@@ -165,17 +165,24 @@ def test_a_failed_store_keeps_the_recording_warns_and_exits_3(simulated_card, me
     assert entry.measured_at == "2024-05-01T12:00:00Z" != entry.stored_at
 
 
-def test_a_measurement_with_the_voltage_lead_off_is_judged_kept_and_not_stored(monkeypatch, tmp_path, capsys):
-    """It used to end in a ZeroDivisionError traceback after writing the recording."""
+def test_a_measurement_with_the_voltage_lead_off_is_judged_kept_and_stored_red(monkeypatch, tmp_path, capsys):
+    """It used to end in a ZeroDivisionError traceback after writing the recording; then it was judged but not
+    archived. A broken measurement is stored, judged red with its remedy, as the GUI stores it."""
     import app.cli.devices as cli_devices
+    from analysis.archive import Archive
     from instruments.audio.simulated import SimulatedAudio
     from instruments.rig.engine import RigFaults
     monkeypatch.setattr(cli_devices, "open_devices", lambda args, stack: (
         SimulatedAudio(realtime=False, seed=1, faults=RigFaults(disconnected={"voltage"})), None,
         {"name": "paper (simulated)", "sd_m2": 0.0133}))
-    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(tmp_path / "archive"))
-    assert code == 3 and "Traceback" not in err
+    root = tmp_path / "archive"
+    code, printed, err = measure(capsys, tmp_path, "--archive-root", str(root), "--serial", "SN-9")
+    assert code == 0 and "Traceback" not in err, err
     assert printed["validity"]["channels"]["voltage"]["findings"][0]["code"] == "no-signal"
-    assert printed["parameters"]["RE"]["value"] is None and printed["archive"]["error"].startswith("nothing")
-    assert "warning: not stored in the archive" in err and "The recording is kept in" in err
-    assert (tmp_path / "out" / "m.wav").is_file() and not (tmp_path / "archive").exists()
+    assert printed["parameters"]["RE"]["value"] is None and set(printed["archive"]) == {"id", "root"}
+    assert f"as {printed['archive']['id']} (judged red: nothing could be fitted)" in err
+    assert (tmp_path / "out" / "m.wav").is_file()
+    (entry,) = Archive(root).list()
+    assert entry.id == printed["archive"]["id"] and entry.validity == "red" and entry.serial == "SN-9"
+    stored = Archive(root).get(entry.id).result()
+    assert stored.not_fitted and stored.validity["channels"]["voltage"]["findings"][0]["remedy"]

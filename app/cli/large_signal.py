@@ -208,7 +208,7 @@ def run_plan(args: argparse.Namespace) -> int:
             driver = {**driver, "sd_m2": args.sd}
         plan = replace(plan, base=replace(plan.base, driver={k: v for k, v in driver.items() if v is not None}))
         say(f"large-signal plan from {plan.start_level_v:g} V, x{plan.step:g} per step, until "
-             f"{args.max_excursion:g} mm, {args.max_voltage:g} V, {args.max_distortion:g} dB current distortion "
+            f"{args.max_excursion:g} mm, {args.max_voltage:g} V, {args.max_distortion:g} dB current distortion "
              f"or +{args.max_temperature_rise:g} K on {audio.describe()}")
         try:
             outcome = run_large_signal(plan, audio, devices.laser_sensor(laser), args.out, name=args.name,
@@ -241,4 +241,4 @@ def _said_step(step) -> None:
     m = step.measures
     peak = "no displacement" if m.peak_m is None else f"peak {m.peak_m * 1e3:.2f} mm"
     say(f"step {step.index} at {step.level_v:.3g} V: {peak}, current distortion {m.current_distortion_db:.1f} dB, "
-         f"RE {m.re_ohm:.3f} ohm -> {step.recording_path}")
+        f"RE {m.re_ohm:.3f} ohm -> {step.recording_path}")

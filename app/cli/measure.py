@@ -22,7 +22,8 @@ the files written go to stderr. A measurement that a device ends (or Ctrl-C)
 keeps what was recorded and exits with 2 and a message that says what
 happened and where the data are.
 
-A complete measurement is then stored in the measurement archive
+The measurement is then stored in the measurement archive, a broken one too
+(judged red with its remedies, as the GUI stores it)
 (analysis.archive: ``--archive`` a postgresql:// URL or a folder, or
 ``--archive-root`` a folder; default $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE,
 else ~/.local/share/linpar/archive; ``--no-archive``: not stored) and stderr says
@@ -117,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         check_spec(archive_spec(args.archive or (str(args.archive_root) if args.archive_root else None)))
     for unfinished in find_unfinished(args.out):
         say(f"note: a measurement was cut short: {unfinished.describe()}; its data are in {unfinished.journal} "
-             f"('linpar recover {args.out}' keeps, analyses or discards it)")
+            f"('linpar recover {args.out}' keeps, analyses or discards it)")
     # The plan first: a plan that cannot work must not start a rig.
     plan = MeasurementPlan.from_template(args.template or "woofer", level_v_rms=args.level, n_periods=args.periods,
                                          period_samples=args.period, on_xrun=args.on_xrun)
@@ -133,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
                                    session=new_session(args.operator or "", args.station or "", plan.template))
         cancel = _Cancel()
         say(f"measuring: {plan.template}, {plan.level_v_rms:g} V RMS, {plan.n_periods} periods of "
-             f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"
+            f"{plan.period_samples} samples after {plan.settle} to settle (~{plan.duration_s(audio.sample_rate):.0f} s"
              f" of sound) on {audio.describe()}" + (f", laser {laser!r}" if laser is not None else ""))
         try:
             with _ctrl_c_cancels(cancel):
@@ -150,7 +151,7 @@ def run(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:       # a second Ctrl-C: the journal keeps what was measured
             cancel.set()
             say(f"interrupted twice: what was measured is in the journal in {args.out}; 'linpar recover "
-                 f"{args.out}' makes it a recording")
+                f"{args.out}' makes it a recording")
             raise
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
@@ -199,10 +200,7 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     from analysis.archive.backends import archive_spec, open_archive, shown
     spec = archive_spec(args.archive or (str(Path(args.archive_root).expanduser()) if args.archive_root else None))
     root = shown(spec)
-    if outcome.result.fit is None:        # a broken measurement: judged (printed), but nothing to keep in the archive
-        why = f"nothing could be fitted ({outcome.result.not_fitted})"
-        say(f"warning: not stored in the archive {root}: {why}. The recording is kept in {outcome.recording_path}")
-        return {"error": why, "root": str(root)}
+    # A broken measurement (nothing fitted) is stored too, judged red with its remedies, as the GUI stores it.
     meta = {"serial": args.serial, "operator": args.operator, "station": args.station, "measured_at": measured_at,
             "settings": {"template": plan.template, "rig": args.rig,
                          "laser": "serial" if outcome.raw_path is not None else (args.laser or LASER_ANALOG)}}
@@ -221,7 +219,7 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
             say(f"warning: not stored in the archive {root}: {why}")
             return {"error": why, "root": str(root), "queued": exc.queued_id}
         say(f"warning: not stored in the archive {root}: {why}. The recording is kept in "
-             f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
+            f"{outcome.recording_path}; store it later with: {_store_later(args, outcome, root, measured_at)}")
         return {"error": why, "root": str(root)}
     finally:
         for note in archive.notes if archive is not None else ():
@@ -229,13 +227,16 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     if archive.pending:
         say(f"measured as {mid}; it waits in this station's queue until the server {root} can be reached")
         return {"id": mid, "root": str(root), "queued": True}
-    say(f"stored in the archive {root} as {mid}")
+    judged = "" if outcome.result.fit is not None else f" (judged {outcome.result.validity.get('overall')}: nothing " \
+                                                       "could be fitted)"
+    say(f"stored in the archive {root} as {mid}{judged}")
     return {"id": mid, "root": str(root)}
 
 
 def _store_later(args: argparse.Namespace, outcome, root: str, measured_at: str) -> str:
     """The `linpar archive store` command that stores this measurement as this command would have (shell-quoted)."""
-    effects = ",".join(outcome.result.fit.model.effect_ids) or "none"
+    fit = outcome.result.fit
+    effects = ",".join(fit.model.effect_ids if fit is not None else ()) or "none"
     command = ["linpar", "archive", "store", str(outcome.recording_path.with_suffix("")), "--model", effects]
     if outcome.raw_path is not None:
         command += ["--laser-stream", str(outcome.raw_path)]
