@@ -15,7 +15,6 @@ folder (its permissions). Roles are the PostgreSQL back end's.
 """
 from __future__ import annotations
 
-import contextlib
 import getpass
 import json
 import os
@@ -23,8 +22,9 @@ import re
 import tempfile
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Iterable, Iterator
+from typing import Iterable
 
+from analysis import file_lock
 from analysis.archive.atomic import FILE_MODE, fsync_dir, write_atomic
 from analysis.archive.limits_store import (LimitsVersion, checked_document, checked_note, version_json,
                                            version_of_json)
@@ -45,7 +45,7 @@ def _user() -> str:
     try:
         return getpass.getuser()
     except (KeyError, OSError):       # no name for this uid (a container)
-        return f"uid {os.getuid()}"
+        return f"uid {os.getuid()}" if hasattr(os, "getuid") else "unknown user"   # Windows has no uid
 
 
 class FolderQA:
@@ -148,15 +148,8 @@ class FolderQA:
             write_atomic(self.root / GOLDEN_FILE, json.dumps(doc, indent=1) + "\n")
         return current
 
-    @contextlib.contextmanager
-    def _golden_lock(self) -> Iterator[None]:
-        import fcntl
-        fd = os.open(self.root / ".golden.lock", os.O_RDWR | os.O_CREAT, FILE_MODE)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX)
-            yield
-        finally:
-            os.close(fd)
+    def _golden_lock(self):
+        return file_lock.exclusive(self.root / ".golden.lock")
 
     # --- statistics ---------------------------------------------------------------------
 

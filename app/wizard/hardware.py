@@ -8,6 +8,7 @@ and closes its own, so no stream outlives the job that needed it.
 """
 from __future__ import annotations
 
+import sys
 import threading
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -78,8 +79,19 @@ class HardwareConfig:
         return replace(self.channel_map, laser_analog=None)
 
 
+def virtual_rig_unavailable(platform: str | None = None) -> str | None:
+    """Why the JACK virtual rig cannot run on this system (``sys.platform`` unless given), or None where it can."""
+    if (platform or sys.platform).startswith("linux"):
+        return None
+    return ("the virtual rig runs on Linux only: it needs a JACK server of its own and pseudo-terminals for its "
+            "laser. The in-process simulator stands in for it here, with the same simulated driver and laser")
+
+
 def find_virtual_rig(name: str = DEFAULT_NAME, runtime_dir: str | None = None):
-    """The running rig of that name, or None. Reads a few small files: fine on the GUI thread."""
+    """The running rig of that name, or None (always None where the rig cannot run). Reads a few small files:
+    fine on the GUI thread."""
+    if virtual_rig_unavailable() is not None:
+        return None         # and no look for a rig's process: os.kill(pid, 0) would end it on Windows
     from instruments.rig.manager import find_rig
     try:
         return find_rig(name, Path(runtime_dir) if runtime_dir else None)

@@ -9,7 +9,7 @@ from PySide6.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, 
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
 from app.wizard.hardware import (
     ANALOG_LASER, NO_LASER, RIG, SERIAL_LASER, SERIAL_LASER_MISSING, SIMULATOR, SOUNDCARD, HardwareConfig,
-    find_virtual_rig)
+    find_virtual_rig, virtual_rig_unavailable)
 from app.wizard.hardware_form import CalibrationForm, ChannelMapForm
 from app.wizard.plans import find_runner
 from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
@@ -270,7 +270,11 @@ class HardwarePage(WizardPage):
 
     def on_look_for_rig(self) -> None:
         self.rig = find_virtual_rig(self.rig_name, self.rig_runtime_dir)
-        if self.rig is None:
+        if (why_not := virtual_rig_unavailable()) is not None:
+            self.rig_radio.setEnabled(False)
+            self.rig_refresh.setEnabled(False)
+            self.rig_status.setText("Not on this system: " + why_not + ".")
+        elif self.rig is None:
             self.rig_status.setText(coloured("not running: start it with 'linpar rig start'", ERROR_COLOUR))
         else:
             s = self.rig.state

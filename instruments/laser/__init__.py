@@ -3,7 +3,6 @@ its emulator on a pseudo-terminal, an in-process simulation, and the scale
 for its analog output. See shared/spec/laser-ild1420.md."""
 
 from instruments.laser.analog import AnalogLaserScale
-from instruments.laser.emulator import LaserEmulator
 from instruments.laser.ild1420 import DEFAULT_BAUDRATE, ILD1420
 from instruments.laser.sensor import (
     DEFAULT_OUTPUTS, NO_COUNTER, DisplacementSensor, LaserBlock, LaserError, LaserStats,
@@ -17,3 +16,11 @@ __all__ = [
     "ILD1420", "LaserBlock", "LaserEmulator", "LaserError", "LaserErrorCode", "LaserStats",
     "NO_COUNTER", "SensorInfo", "SimulatedLaser", "concatenate_blocks", "describe_error",
 ]
+
+
+def __getattr__(name: str):
+    # The pty emulator needs termios and fcntl, which Windows lacks: it is loaded when asked for, not with the package.
+    if name == "LaserEmulator":
+        from instruments.laser.emulator import LaserEmulator
+        return LaserEmulator
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

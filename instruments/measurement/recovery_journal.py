@@ -6,7 +6,6 @@ instruments.measurement.recovery_replay reads journals back.
 """
 from __future__ import annotations
 
-import fcntl
 import json
 import os
 import queue
@@ -19,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from analysis import file_lock
 from analysis.archive.atomic import write_atomic
 from instruments.audio.stream_core import InputBlock
 from instruments.laser.sensor import LaserBlock
@@ -49,7 +49,7 @@ class Journal:
         self.dropped = 0                     # NB: blocks the queue had no room for (counted by device threads)
         self._queue: queue.Queue = queue.Queue(maxsize=QUEUE_ITEMS)
         self._files: dict[str, int] = {}
-        self._lock_fd: int | None = None
+        self._lock = None                    # held while the measurement runs (analysis.file_lock)
         self._thread: threading.Thread | None = None
 
     @classmethod
@@ -58,8 +58,9 @@ class Journal:
         path.mkdir()                         # FileExistsError: a journal of that name is still there
         journal = cls(path)
         try:
-            journal._lock_fd = os.open(path / "lock", os.O_CREAT | os.O_RDWR, 0o644)
-            fcntl.flock(journal._lock_fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            journal._lock = file_lock.take(path / "lock", wait_s=0)
+            if journal._lock is None:
+                raise FileExistsError(f"{path}: another measurement holds this journal")
             meta = {"format": FORMAT, "name": name, "started_at": now_utc(), "host": socket.gethostname(),
                     "pid": os.getpid(), "plan": plan.as_json(), "sample_rate": int(audio.sample_rate),
                     "channel_map": audio.channel_map.to_dict(), "calibration": audio.calibration.to_dict(),
@@ -98,9 +99,9 @@ class Journal:
                 pass
             os.close(fd)
         self._files.clear()
-        if self._lock_fd is not None:
-            os.close(self._lock_fd)          # frees the lock: from now on find_unfinished sees the journal
-            self._lock_fd = None
+        if self._lock is not None:
+            self._lock.release()             # from now on find_unfinished sees the journal
+            self._lock = None
         if not keep:
             shutil.rmtree(self.path, ignore_errors=True)
         return keep
@@ -161,17 +162,7 @@ class _Tee:
 
 def in_use(journal: Path) -> bool:
     """True while the measuring process holds the journal's lock."""
-    try:
-        fd = os.open(journal / "lock", os.O_RDWR)
-    except OSError:
-        return False
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        return True
-    finally:
-        os.close(fd)
-    return False
+    return file_lock.held(journal / "lock")
 
 
 def recording_written(stem: Path) -> bool:

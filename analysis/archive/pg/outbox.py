@@ -25,14 +25,13 @@ with it, and the verdict names that version.
 """
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import os
 from pathlib import Path
-from typing import Iterator
 
 from analysis.archive.archive import Archive
+from analysis import file_lock
 from analysis.archive.atomic import FILE_MODE, write_atomic
 from analysis.archive.limits_store import LimitsVersion, version_json, version_of_json
 from analysis.archive.names import ArchiveError, folder_name
@@ -81,20 +80,10 @@ class Outbox:
 
     # --- sending ------------------------------------------------------------------------------------
 
-    @contextlib.contextmanager
-    def _sending(self) -> Iterator[bool]:
-        import fcntl
+    def _sending(self):
+        """The station's sending lock: yields False when another program at this station is sending."""
         self.root.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.root / LOCK_FILE, os.O_RDWR | os.O_CREAT, FILE_MODE)
-        try:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                yield False
-                return
-            yield True
-        finally:
-            os.close(fd)
+        return file_lock.exclusive(self.root / LOCK_FILE, wait=False)
 
     def send(self, conn, server) -> SyncReport:
         """Send every queued measurement, oldest first; stop at the first that the server cannot take."""
