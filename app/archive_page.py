@@ -41,7 +41,7 @@ COLOURS = {"error": style.VALIDITY_COLOURS["red"][1], "note": style.VALIDITY_COL
 
 def archive_source(qsettings) -> str:
     """$LINPAR_ARCHIVE_URL, else the folder chosen on the page, else analysis.archive's default
-    ($LINPAR_ARCHIVE or ~/.local/share/...)."""
+    ($LINPAR_ARCHIVE, else the archive in the platform's data folder)."""
     url = os.environ.get(URL_ENV, "").strip()
     if url:
         return url

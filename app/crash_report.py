@@ -6,7 +6,8 @@ bug. The CLI and the GUI report it the same way: one line,
     internal error: ZeroDivisionError: float division by zero (details in /home/u/.cache/linpar/crash-....txt)
 
 and a text file with the traceback, the command line, the version of linpar,
-Python and the platform. Crash reports go to the platform's cache folder:
+Python and the platform. Crash reports go to the platform's cache folder
+(analysis.config_folder.cache_folder):
 
     $LINPAR_CACHE                         when set (tests, or a shared folder at a station)
     Linux and others  $XDG_CACHE_HOME/linpar, else ~/.cache/linpar
@@ -25,25 +26,15 @@ from datetime import datetime
 from pathlib import Path
 from typing import Sequence
 
+from analysis.config_folder import cache_folder
 from analysis.errors import one_line
 
-CACHE_ENV = "LINPAR_CACHE"
 PREFIX = "crash-"
 
 
 def cache_dir() -> Path:
     """The folder crash reports go to (module doc); not created here."""
-    override = os.environ.get(CACHE_ENV)
-    if override:
-        return Path(override).expanduser()
-    home = Path.home()
-    if sys.platform == "darwin":
-        return home / "Library" / "Caches" / "linpar"
-    if sys.platform.startswith("win"):
-        base = os.environ.get("LOCALAPPDATA")
-        return (Path(base) if base else home / "AppData" / "Local") / "linpar" / "Cache"
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg and Path(xdg).is_absolute() else home / ".cache") / "linpar"
+    return cache_folder()
 
 
 def version() -> str:

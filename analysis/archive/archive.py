@@ -39,6 +39,7 @@ from analysis.archive.names import (ArchiveError, check_id, check_id_prefix, cle
 from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Entry, entry_of, read_record
 from analysis.archive.schema import KEY_PARAMETERS
 from analysis.bounds import YEAR
+from analysis.config_folder import data_folder, overridden
 from analysis.session import recording_header
 from analysis.files import read_text, regular_file
 
@@ -49,8 +50,8 @@ OWN_LIMITS = object()       # store(judge_with=...): judge with the archive's ne
 
 
 def default_root() -> Path:
-    env = os.environ.get("LINPAR_ARCHIVE")
-    return Path(env).expanduser() if env else Path.home() / ".local" / "share" / "linpar" / "archive"
+    """$LINPAR_ARCHIVE, else the archive folder in linpar's data folder (analysis.config_folder)."""
+    return overridden("LINPAR_ARCHIVE") or data_folder() / "archive"
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from analysis.config_folder import data_folder
 from app.cli.options import CliError, add_json_option
 from app.cli.output import print_json
 
@@ -24,7 +25,7 @@ def add_archive_options(parser: argparse.ArgumentParser) -> None:
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--archive", metavar="URL|DIR",
                        help="the archive: postgresql://USER@HOST[:PORT]/DB (the line's server) or a folder "
-                            "(default: $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE, else ~/.local/share/linpar/archive)")
+                            f"(default: $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE, else {data_folder() / 'archive'})")
     where.add_argument("--root", metavar="DIR", help="a folder archive (as --archive DIR)")
 
 

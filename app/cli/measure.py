@@ -26,7 +26,7 @@ The measurement is then stored in the measurement archive, a broken one too
 (judged red with its remedies, as the GUI stores it)
 (analysis.archive: ``--archive`` a postgresql:// URL or a folder, or
 ``--archive-root`` a folder; default $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE,
-else ~/.local/share/linpar/archive; ``--no-archive``: not stored) and stderr says
+else the archive folder in the platform's data folder; ``--no-archive``: not stored) and stderr says
 its id; with --json the printed object gets "archive": {"id", "root"} ("root":
 the folder or the server's URL without its password; "queued": true when the
 server could not be reached and the measurement waits in the station's local
@@ -50,6 +50,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Iterator
 
+from analysis.config_folder import data_folder
 from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS
 from analysis.errors import is_user_error, user_message
 from app.cli import devices, large_signal
@@ -91,10 +92,10 @@ def register(sub) -> None:
     where = m.add_mutually_exclusive_group()
     where.add_argument("--archive", metavar="URL|DIR",
                        help="archive to store in: postgresql://USER@HOST[:PORT]/DB (the line's server) or a folder "
-                            "(default: $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE, else ~/.local/share/linpar/archive)")
+                            f"(default: $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE, else {data_folder() / 'archive'})")
     where.add_argument("--archive-root", type=Path, metavar="DIR",
-                       help="archive to store the measurement in (default: $LINPAR_ARCHIVE or "
-                            "~/.local/share/linpar/archive); exit 3 when it cannot be stored")
+                       help=f"archive to store the measurement in (default: $LINPAR_ARCHIVE or "
+                            f"{data_folder() / 'archive'}); exit 3 when it cannot be stored")
     where.add_argument("--no-archive", action="store_true", help="do not store the measurement in the archive")
     add_json_option(m)
     large_signal.add_plan_options(m)

@@ -19,6 +19,7 @@ from analysis.errors import LinparError
 from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
+from instruments.serial_ports import port_example
 
 SIMULATOR, RIG, SOUNDCARD = "simulator", "rig", "soundcard"
 NO_LASER, ANALOG_LASER, SERIAL_LASER = "none", "analog", "serial"
@@ -161,7 +162,7 @@ def test_laser(config: HardwareConfig) -> str:
     if config.laser != SERIAL_LASER:
         return "no serial laser chosen"
     if not config.laser_port:
-        raise LaserError("give the laser's serial port (a device such as /dev/ttyUSB0, or a pty)")
+        raise LaserError(f"give the laser's serial port (a device such as {port_example()})")
     laser = ILD1420(config.laser_port)
     try:
         info = laser.open()

@@ -15,6 +15,7 @@ from app.wizard.plans import find_runner
 from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
+from instruments.serial_ports import port_example
 
 SETTINGS_KEY = "measure/hardware"
 LASER_RATES = (4000.0, 2000.0, 1000.0, 500.0, 250.0)
@@ -63,7 +64,7 @@ class HardwarePage(WizardPage):
         for button in (self.laser_analog, self.laser_none, self.laser_serial):
             self.laser_group.addButton(button)
         self.laser_port = QLineEdit()
-        self.laser_port.setPlaceholderText("/dev/ttyUSB0")
+        self.laser_port.setPlaceholderText(port_example())
         self.laser_rate = QComboBox()
         for rate in LASER_RATES:
             self.laser_rate.addItem(f"{rate:g} Hz", rate)
@@ -187,7 +188,7 @@ class HardwarePage(WizardPage):
             if find_runner() is None:
                 return "The serial laser cannot be used yet: " + SERIAL_LASER_MISSING + "."
             if not config.laser_port:
-                return "Give the laser's serial port (a device such as /dev/ttyUSB0), or choose another laser."
+                return f"Give the laser's serial port (a device such as {port_example()}), or choose another laser."
         return None
 
     @property

@@ -6,7 +6,7 @@ It offers what the folder archive does (analysis.archive.backends.ArchiveBackend
 Storing goes through the station's local queue (analysis.archive.pg.outbox),
 so a station that loses the server keeps storing and the queue is sent when
 the server is back. Reading asks the server; a stored file is fetched on first
-use into a local cache ($LINPAR_CACHE or ~/.cache/linpar, archive/<server>/),
+use into a local cache ($LINPAR_CACHE or the platform's cache folder, archive/<server>/),
 checked against its SHA-256, so that reports, exports and the GUI open it as a
 file, as they do a folder archive's.
 """
@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
@@ -26,6 +25,7 @@ from analysis.archive.names import ArchiveError, check_id, check_id_prefix, insi
 from analysis.archive.pg.files import fetch_file
 from analysis.archive.pg.outbox import Outbox, queue_folder
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, connect, parse_url, server_errors
+from analysis import config_folder
 from analysis.archive.record import RECORD_FILE, checked_parameter, entry_of, one_line_text, read_record
 from analysis.archive.sync_report import SyncReport
 
@@ -34,13 +34,7 @@ LIST_COLUMNS = ("id, folder, measured_at, stored_at, driver, serial, operator, s
 
 
 def cache_folder(slug: str) -> Path:
-    base = os.environ.get("LINPAR_CACHE", "").strip()
-    if base:
-        root = Path(base).expanduser()
-    else:
-        xdg = os.environ.get("XDG_CACHE_HOME", "")
-        root = (Path(xdg) if xdg and Path(xdg).is_absolute() else Path.home() / ".cache") / "linpar"
-    return root / "archive" / slug
+    return config_folder.cache_folder() / "archive" / slug
 
 
 @dataclass(frozen=True)

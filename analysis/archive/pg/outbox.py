@@ -2,7 +2,7 @@
 
 The queue is a folder archive of its own (analysis.archive.Archive: a
 complete folder renamed into place, or nothing), kept per server and user in
-$LINPAR_QUEUE or ~/.local/share/linpar/queue. Sending one measurement is one
+$LINPAR_QUEUE or queue/ in the platform's data folder (analysis.config_folder). Sending one measurement is one
 transaction on the server (its row, parameters and files), keyed by the
 measurement's id, which the station chose when it queued it:
 
@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 
 from analysis.archive.archive import Archive
@@ -36,6 +35,7 @@ from analysis.archive.atomic import FILE_MODE, write_atomic
 from analysis.archive.limits_store import LimitsVersion, version_json, version_of_json
 from analysis.archive.names import ArchiveError, folder_name
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, server_errors
+from analysis.config_folder import data_folder, overridden
 from analysis.archive.pg.upload import IdTaken, record_sha256, send_measurement
 from analysis.archive.sync_report import SyncReport
 
@@ -44,9 +44,7 @@ LOCK_FILE = ".send.lock"
 
 
 def queue_folder(slug: str) -> Path:
-    base = os.environ.get("LINPAR_QUEUE", "").strip()
-    root = Path(base).expanduser() if base else Path.home() / ".local" / "share" / "linpar" / "queue"
-    return root / slug
+    return (overridden("LINPAR_QUEUE") or data_folder() / "queue") / slug
 
 
 class Outbox:
