@@ -28,6 +28,8 @@ over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
 station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
+--only hardware: the Hardware page's sound-card and serial-port lists at both sizes, this machine's and a
+Windows PC's as an example (tools/screenshots_hardware.py).
 qa-current-zeroed-1280x720.png and -1920x1080.png: the QA page judging a recording
 whose current lead is broken against limits; help-guide.png and help-about.png:
 Help's user guide and About (--only qa: just these).
@@ -426,6 +428,11 @@ def open_in_lab(app: QApplication, window, wav: Path, what: str) -> bool:
     return True
 
 
+def hardware_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_hardware import hardware_screenshots as shots
+    return shots(app, window, folder, out)
+
+
 def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_pages import every_page_screenshots
     return every_page_screenshots(app, window, folder, out)
@@ -471,7 +478,7 @@ def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) ->
 
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
-        "pages": pages_screenshots, "qa": qa_broken_screenshots}
+        "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots}
 
 
 def main(argv: list[str]) -> int:

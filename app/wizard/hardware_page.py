@@ -10,16 +10,28 @@ from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, co
 from app.wizard.hardware import (
     ANALOG_LASER, NO_LASER, RIG, SERIAL_LASER, SERIAL_LASER_MISSING, SIMULATOR, SOUNDCARD, HardwareConfig,
     find_virtual_rig, virtual_rig_unavailable)
+from app.wizard.device_lists import SerialPortList, SoundCardList
 from app.wizard.hardware_form import CalibrationForm, ChannelMapForm
 from app.wizard.plans import find_runner
 from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
-from instruments.serial_ports import port_example
+from instruments.serial_ports import list_serial_ports, port_example
 
 SETTINGS_KEY = "measure/hardware"
 LASER_RATES = (4000.0, 2000.0, 1000.0, 500.0, 250.0)
 SAMPLE_RATES = (48000, 44100, 96000)
+FORGOTTEN_INDEX = ("The sound card chosen last time was remembered by its number in PortAudio's list, which changes "
+                   "when a device is plugged in: choose it again (from now on it is remembered by name and host API).")
+
+
+def remembered_device(saved) -> tuple[AudioDeviceChoice | None, str]:
+    """The device the settings remember, and a note for the user when it was stored the old way (by index)."""
+    if not saved:
+        return None, ""
+    if isinstance(saved, dict) and isinstance(saved.get("name"), str) and isinstance(saved.get("hostapi"), str):
+        return AudioDeviceChoice(saved["name"], saved["hostapi"]), ""      # other keys (an old index) dropped
+    return None, FORGOTTEN_INDEX
 
 
 class HardwarePage(WizardPage):
@@ -42,9 +54,9 @@ class HardwarePage(WizardPage):
         self.rig_status = rich_label()
         self.rig_refresh = QPushButton("Look again")
         self.soundcard_radio = QRadioButton("Sound card")
-        self.device_combo = QComboBox()
-        self.device_combo.setMinimumContentsLength(24)
+        self.device_list = SoundCardList()
         self.device_refresh = QPushButton("Refresh list")
+        self.device_advice = rich_label()
         self.rate_combo = QComboBox()
         for rate in SAMPLE_RATES:
             self.rate_combo.addItem(f"{rate / 1000:g} kHz", rate)
@@ -65,6 +77,9 @@ class HardwarePage(WizardPage):
             self.laser_group.addButton(button)
         self.laser_port = QLineEdit()
         self.laser_port.setPlaceholderText(port_example())
+        self.port_list = SerialPortList()
+        self.port_refresh = QPushButton("Look for ports")
+        self.port_note = rich_label()
         self.laser_rate = QComboBox()
         for rate in LASER_RATES:
             self.laser_rate.addItem(f"{rate:g} Hz", rate)
@@ -76,12 +91,14 @@ class HardwarePage(WizardPage):
         for button in (self.simulator_radio, self.rig_radio, self.soundcard_radio, self.laser_none,
                        self.laser_analog, self.laser_serial):
             button.toggled.connect(self.on_edited)
-        for signal in (self.realtime_check.toggled, self.device_combo.currentIndexChanged,
+        for signal in (self.realtime_check.toggled, self.device_list.chosen,
                        self.rate_combo.currentIndexChanged, self.channel_form.edited, self.calibration_form.edited,
                        self.laser_port.textChanged, self.laser_rate.currentIndexChanged):
             signal.connect(self.on_edited)
         self.rig_refresh.clicked.connect(self.on_look_for_rig)
         self.device_refresh.clicked.connect(self.on_refresh_devices)
+        self.port_refresh.clicked.connect(self.on_refresh_ports)
+        self.port_list.picked.connect(self.laser_port.setText)
         self.test_audio_button.clicked.connect(self.on_test_audio)
         self.test_laser_button.clicked.connect(self.on_test_laser)
         for jobs in (self.audio_jobs, self.laser_jobs):
@@ -96,18 +113,19 @@ class HardwarePage(WizardPage):
         grid.addWidget(self.rig_radio, 2, 0, 1, 2)
         grid.addWidget(self.rig_refresh, 2, 2)
         grid.addWidget(self.rig_status, 3, 1, 1, 2)
-        grid.addWidget(self.soundcard_radio, 4, 0)
-        grid.addWidget(self.device_combo, 4, 1)
+        grid.addWidget(self.soundcard_radio, 4, 0, 1, 2)
         grid.addWidget(self.device_refresh, 4, 2)
-        grid.addWidget(QLabel("Sample rate"), 5, 0)
-        grid.addWidget(self.rate_combo, 5, 1)
+        grid.addWidget(self.device_list, 5, 0, 1, 3)
+        grid.addWidget(self.device_advice, 6, 0, 1, 3)
+        grid.addWidget(QLabel("Sample rate"), 7, 0)
+        grid.addWidget(self.rate_combo, 7, 1)
         grid.setColumnStretch(1, 1)
         grid.setColumnMinimumWidth(0, 24)
         test_row = QHBoxLayout()
         test_row.addWidget(self.test_audio_button)
         test_row.addWidget(self.audio_jobs, 1)
-        grid.addLayout(test_row, 6, 0, 1, 3)
-        grid.addWidget(self.audio_result, 7, 0, 1, 3)
+        grid.addLayout(test_row, 8, 0, 1, 3)
+        grid.addWidget(self.audio_result, 9, 0, 1, 3)
 
         wiring = QGroupBox("Wiring and calibration constants")
         wiring_layout = QHBoxLayout(wiring)
@@ -123,20 +141,23 @@ class HardwarePage(WizardPage):
         laser.addWidget(QLabel("Port"), 3, 0)
         laser.addWidget(self.laser_port, 3, 1)
         laser.addWidget(self.laser_rate, 3, 2)
+        laser.addWidget(self.port_list, 4, 0, 1, 3)
+        laser.addWidget(self.port_note, 5, 0, 1, 2)
+        laser.addWidget(self.port_refresh, 5, 2)
         laser_test = QHBoxLayout()
         laser_test.addWidget(self.test_laser_button)
         laser_test.addWidget(self.laser_jobs, 1)
-        laser.addLayout(laser_test, 4, 0, 1, 3)
-        laser.addWidget(self.laser_result, 5, 0, 1, 3)
+        laser.addLayout(laser_test, 6, 0, 1, 3)
+        laser.addWidget(self.laser_result, 7, 0, 1, 3)
         laser.setColumnStretch(1, 1)
 
         left = QVBoxLayout()
         left.addWidget(audio_box)
-        left.addWidget(laser_box)
+        left.addWidget(wiring)
+        left.addWidget(self.wiring_note)
         left.addStretch(1)
         right = QVBoxLayout()
-        right.addWidget(wiring)
-        right.addWidget(self.wiring_note)
+        right.addWidget(laser_box)
         right.addStretch(1)
         layout = QHBoxLayout(self)
         layout.addLayout(left, 3)
@@ -166,7 +187,7 @@ class HardwarePage(WizardPage):
             return HardwareConfig(**common, sample_rate=state.sample_rate if state else 48000,
                                   channel_map=state.workstation_channel_map if state else RIG_CHANNEL_MAP,
                                   calibration=state.workstation_calibration if state else RIG_CALIBRATION)
-        return HardwareConfig(**common, device=self.device_combo.currentData(), sample_rate=self.rate_combo.currentData(),
+        return HardwareConfig(**common, device=self.device_list.choice(), sample_rate=self.rate_combo.currentData(),
                               channel_map=self.channel_form.channel_map(), calibration=self.calibration_form.calibration())
 
     def missing(self) -> str | None:
@@ -176,7 +197,7 @@ class HardwarePage(WizardPage):
         if kind == RIG and self.rig is None:
             return (f"The JACK virtual rig '{self.rig_name}' is not running: start it with 'linpar rig start' and "
                     f"press Look again, or choose the in-process simulator.")
-        if kind == SOUNDCARD and self.device_combo.currentData() is None:
+        if kind == SOUNDCARD and self.device_list.choice() is None:
             return "Choose a sound card: " + (self.device_message or "press Refresh list.")
         try:
             config = self.config()
@@ -222,10 +243,11 @@ class HardwarePage(WizardPage):
                                       else ChannelMap(output=0, voltage=0, current=1, laser_analog=2))
             self.calibration_form.set_calibration(Calibration.from_dict(saved["calibration"])
                                                   if "calibration" in saved else RIG_CALIBRATION)
-            if saved.get("device"):
-                self._saved_device = AudioDeviceChoice.from_dict(saved["device"])
         except AudioConfigError:
             pass        # settings of an older version: start from the defaults
+        self._saved_device, note = remembered_device(saved.get("device"))
+        self.audio_result.setText(note)
+        self.on_refresh_ports()
         {NO_LASER: self.laser_none, SERIAL_LASER: self.laser_serial}.get(saved.get("laser"),
                                                                           self.laser_analog).setChecked(True)
         self.on_look_for_rig()
@@ -242,7 +264,8 @@ class HardwarePage(WizardPage):
     def on_edited(self, *_args) -> None:
         kind = self.kind()
         self.realtime_check.setEnabled(kind == SIMULATOR)
-        self.device_combo.setEnabled(kind == SOUNDCARD)
+        self.device_list.setEnabled(kind == SOUNDCARD)
+        self.device_advice.setText((self.device_list.advice() or self.device_message) if kind == SOUNDCARD else "")
         self.device_refresh.setEnabled(kind == SOUNDCARD and not self.busy)
         self.rate_combo.setEnabled(kind == SOUNDCARD)
         self.channel_form.set_editable(kind == SOUNDCARD)
@@ -262,6 +285,7 @@ class HardwarePage(WizardPage):
         serial = self.laser_kind() == SERIAL_LASER
         self.laser_port.setEnabled(serial)
         self.laser_rate.setEnabled(serial)
+        self.port_list.setEnabled(serial)
         self.test_laser_button.setEnabled(serial and not self.busy)
         self.test_audio_button.setEnabled(not self.busy and not (kind == RIG and self.rig is None))
         self.changed.emit()
@@ -290,18 +314,22 @@ class HardwarePage(WizardPage):
 
     def on_devices(self, devices) -> None:
         self.devices = list(devices)
-        self.device_combo.blockSignals(True)
-        self.device_combo.clear()
-        for d in self.devices:
-            self.device_combo.addItem(f"{d.name} ({d.hostapi}; {d.max_input_channels} in, "
-                                      f"{d.max_output_channels} out)", d.choice)
-        wanted = self._saved_device
-        for i, d in enumerate(self.devices):
-            if wanted is not None and d.choice == wanted:
-                self.device_combo.setCurrentIndex(i)
-        self.device_combo.blockSignals(False)
+        self.device_list.set_devices(self.devices, self.device_list.choice() or self._saved_device)
         self.device_message = "" if self.devices else "PortAudio lists no full-duplex sound card."
         self.on_edited()
+
+    def on_refresh_ports(self, ports=None) -> None:
+        """List the serial ports (a fraction of a second on any system: asked on the GUI thread)."""
+        try:
+            ports = list_serial_ports() if ports is None else ports
+        except Exception as exc:  # noqa: BLE001 - a port list the system will not give is a note, not a crash
+            ports, why = [], f"The serial ports could not be listed ({exc}); type the port's name."
+        else:
+            why = "" if ports else (f"No serial port found: plug in the laser's USB adapter and look again, or type "
+                                    f"the port's name (such as {port_example()}).")
+        self.port_list.set_ports(ports)
+        self.port_note.setText(why or f"{len(ports)} port{'s' if len(ports) != 1 else ''} found: click one to use "
+                                      f"it.")
 
     def on_devices_failed(self, message: str) -> None:
         self.device_message = message

@@ -41,6 +41,10 @@ _state: dict[str, object] = {"handler_installed": False, "abandoned": None}
 
 def sounddevice_module() -> ModuleType:
     """python-sounddevice, imported; AudioUnavailable when PortAudio cannot load."""
+    if sys.platform == "win32":
+        # python-sounddevice's Windows wheel loads its PortAudio with ASIO only when asked, before the import:
+        # ASIO is what suits a measurement there (instruments.audio.host_apis).
+        os.environ.setdefault("SD_ENABLE_ASIO", "1")
     try:
         import sounddevice
     except OSError as exc:
