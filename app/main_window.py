@@ -56,6 +56,7 @@ class MainWindow(QMainWindow):
         self.job: AnalysisJob | None = None     # the analysis whose outcome will be shown
         self._started_at = 0.0
         self.setWindowTitle("linpar")
+        self.setWindowIcon(style.app_icon())
         self.setAcceptDrops(True)
 
         self.results = ResultsView()

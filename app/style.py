@@ -5,7 +5,10 @@ dark theme would make them unreadable when printed.
 """
 from __future__ import annotations
 
+from importlib.resources import files
+
 import pyqtgraph as pg
+from PySide6.QtGui import QIcon
 
 MEASURED = "#1f5fbf"        # measured lines: blue points
 MODEL = "#d1495b"           # the fitted model: red line
@@ -47,3 +50,8 @@ def model_pen():
 
 def measured_brush():
     return pg.mkBrush(MEASURED)
+
+
+def app_icon():
+    """linpar's icon (resources/icons/linpar.png, shipped in the wheel) for the window and the task bar."""
+    return QIcon(str(files("resources") / "icons" / "linpar.png"))

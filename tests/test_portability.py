@@ -45,7 +45,7 @@ def test_every_module_outside_the_rig_and_the_pty_emulator_imports(report):
 
 def test_the_main_window_opens(report):
     found = _step(report, "open_main_window")
-    assert found["visible"] and found["title"] == "linpar"
+    assert found["visible"] and found["title"] == "linpar" and found["has_icon"]
 
 
 def test_a_measurement_on_the_in_process_simulator_is_analysed_and_stored(report):
