@@ -101,6 +101,14 @@ def test_the_installed_packages_are_the_wheels_not_the_checkouts(installed):
         assert not Path(line).is_relative_to(ROOT), line
 
 
+def test_linpar_version_is_the_packages(installed):
+    import tomllib
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+    done = _linpar(installed, "--version")
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == f"linpar {declared}"
+
+
 def test_linpar_analyze_runs_from_another_folder(installed):
     path = installed["cwd"].parent / "recordings" / "paper"
     path.parent.mkdir()

@@ -32,7 +32,7 @@ def windows_example():
 
 
 def hardware_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
-    from tools.screenshots import grab_small_and_large, settle
+    from tools.screenshot_kit import grab_small_and_large, settle
     wizard = window.wizard
     window.pages.setCurrentWidget(wizard)
     wizard.driver_page.name_edit.setText("W18-PAPER")

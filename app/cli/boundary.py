@@ -25,6 +25,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--size-limit", action="append", type=size_limit, metavar="KIND=SIZE", default=[],
                         help="read larger files than the defaults, which fit any real measurement: KIND is "
                              f"{', '.join(SIZE_KINDS)}; SIZE like 500M or 4G (before the command; repeatable)")
+    from app.crash_report import version
+    parser.add_argument("--version", action="version", version=f"linpar {version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for group in COMMAND_GROUPS:
         group.register(sub)
