@@ -15,10 +15,13 @@ from pathlib import Path
 
 from PySide6.QtWidgets import QApplication
 
-WINDOWS_CARDS = (("Focusrite USB ASIO", "ASIO", 2, 2), ("Focusrite USB (Focusrite USB Audio)", "Windows WASAPI", 2, 2),
-                 ("Focusrite USB (Focusrite USB Au", "MME", 2, 2),
-                 ("Focusrite USB (Focusrite USB Audio)", "Windows DirectSound", 2, 2),
-                 ("Realtek ASIO", "ASIO", 2, 2), ("Microphone Array (Realtek(R) Au", "MME", 2, 2))
+# A USB interface and the built-in card, as PortAudio lists them on Windows: full duplex under ASIO only,
+# inputs and outputs apart under MME, DirectSound and WASAPI (MME cuts names at 31 characters).
+WINDOWS_CARDS = (("Focusrite USB ASIO", "ASIO", 2, 2), ("Realtek ASIO", "ASIO", 2, 2),
+                 ("Analogue 1 + 2 (Focusrite USB A", "MME", 2, 0), ("Speakers (Focusrite USB Audio)", "MME", 0, 2),
+                 ("Analogue 1 + 2 (Focusrite USB Audio)", "Windows DirectSound", 2, 0),
+                 ("Analogue 1 + 2 (Focusrite USB Audio)", "Windows WASAPI", 2, 0),
+                 ("Speakers (Focusrite USB Audio)", "Windows WASAPI", 0, 2))
 
 
 def windows_example():

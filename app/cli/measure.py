@@ -50,8 +50,8 @@ from datetime import datetime, timezone
 from pathlib import Path
 from typing import Iterator
 
-from analysis.config_folder import data_folder
 from analysis.bounds import LEVEL_V_RMS, PERIOD_SAMPLES, PERIODS
+from analysis.config_folder import data_folder
 from analysis.errors import is_user_error, user_message
 from app.cli import devices, large_signal
 from app.cli.devices import LASER_ANALOG, say

@@ -6,10 +6,10 @@ from PySide6.QtGui import QColor
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTreeWidget, QTreeWidgetItem
 
 from instruments.audio.config import AudioDeviceChoice
-from instruments.audio.host_apis import BEST, GOOD, POOR, suitability
+from instruments.audio.host_apis import BEST, GOOD, POOR, UNUSABLE, suitability
 
-RANK_COLOURS = {BEST: "#1b5e20", POOR: "#8e1b1b"}
-RANK_WORDS = {BEST: "suits it", GOOD: "usable", POOR: "avoid"}
+RANK_COLOURS = {BEST: "#1b5e20", POOR: "#8e1b1b", UNUSABLE: "#8c8c8c"}
+RANK_WORDS = {BEST: "suits it", GOOD: "usable", POOR: "avoid", UNUSABLE: "cannot"}
 VISIBLE_ROWS = 4
 
 
@@ -33,8 +33,8 @@ class _List(QTreeWidget):
 
 
 class SoundCardList(_List):
-    """Full-duplex devices: name, host API, channels, and whether the host API suits a measurement (in a word;
-    ``advice()`` says why, for the chosen one)."""
+    """Sound devices: name, host API, channels, and whether the device suits a measurement (in a word;
+    ``advice()`` says why, for the chosen one). One that only plays or records is listed, greyed, not chosen."""
 
     chosen = Signal()
 
@@ -51,6 +51,9 @@ class SoundCardList(_List):
                                     f"{device.max_input_channels} / {device.max_output_channels}",
                                     RANK_WORDS[judged.rank]])
             item.setData(0, Qt.UserRole, device.choice)
+            if not device.full_duplex:
+                for column in range(4):
+                    item.setForeground(column, QColor(RANK_COLOURS[UNUSABLE]))
             item.setData(3, Qt.UserRole, judged.text)
             item.setToolTip(0, device.name)
             for column in range(1, 4):
@@ -58,13 +61,14 @@ class SoundCardList(_List):
             if judged.rank in RANK_COLOURS:
                 item.setForeground(3, QColor(RANK_COLOURS[judged.rank]))
             self.addTopLevelItem(item)
-            if wanted is not None and device.choice == wanted:
+            if wanted is not None and device.choice == wanted and device.full_duplex:
                 self.setCurrentItem(item)
         self.blockSignals(False)
 
     def choice(self) -> AudioDeviceChoice | None:
+        """The chosen device, if it can both play and record."""
         item = self.currentItem()
-        return None if item is None else item.data(0, Qt.UserRole)
+        return None if item is None or item.text(3) == RANK_WORDS[UNUSABLE] else item.data(0, Qt.UserRole)
 
     def advice(self) -> str:
         """Whether the chosen device's host API suits a measurement, and why ("" when none is chosen)."""

@@ -130,9 +130,11 @@ def open_audio(config: HardwareConfig, calibration: Calibration | None = None):
 
 
 def list_sound_cards() -> list:
-    """Full-duplex devices PortAudio lists (AudioUnavailable when PortAudio is missing)."""
+    """Every device PortAudio lists (AudioUnavailable when PortAudio is missing). Those that only play or only
+    record are listed too, with why they cannot be used: Windows lists a card under WASAPI, MME and DirectSound
+    as an input and an output apart, and its user should see the card and be told to take its ASIO driver."""
     from instruments.audio.sounddevice_audio import list_devices
-    return [d for d in list_devices(refresh=True) if d.full_duplex]
+    return [d for d in list_devices(refresh=True) if d.max_input_channels or d.max_output_channels]
 
 
 def test_audio(config: HardwareConfig, cancel: threading.Event | None = None, progress=None) -> str:

@@ -3,14 +3,15 @@ from __future__ import annotations
 
 import json
 
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel,
                                QLineEdit, QPushButton, QRadioButton, QVBoxLayout)
 
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
+from app.wizard.device_lists import SerialPortList, SoundCardList
 from app.wizard.hardware import (
     ANALOG_LASER, NO_LASER, RIG, SERIAL_LASER, SERIAL_LASER_MISSING, SIMULATOR, SOUNDCARD, HardwareConfig,
     find_virtual_rig, virtual_rig_unavailable)
-from app.wizard.device_lists import SerialPortList, SoundCardList
 from app.wizard.hardware_form import CalibrationForm, ChannelMapForm
 from app.wizard.plans import find_runner
 from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
@@ -56,7 +57,7 @@ class HardwarePage(WizardPage):
         self.soundcard_radio = QRadioButton("Sound card")
         self.device_list = SoundCardList()
         self.device_refresh = QPushButton("Refresh list")
-        self.device_advice = rich_label()
+        self.device_advice = plain_label()
         self.rate_combo = QComboBox()
         for rate in SAMPLE_RATES:
             self.rate_combo.addItem(f"{rate / 1000:g} kHz", rate)
@@ -79,7 +80,7 @@ class HardwarePage(WizardPage):
         self.laser_port.setPlaceholderText(port_example())
         self.port_list = SerialPortList()
         self.port_refresh = QPushButton("Look for ports")
-        self.port_note = rich_label()
+        self.port_note = plain_label()
         self.laser_rate = QComboBox()
         for rate in LASER_RATES:
             self.laser_rate.addItem(f"{rate:g} Hz", rate)
@@ -198,6 +199,8 @@ class HardwarePage(WizardPage):
             return (f"The JACK virtual rig '{self.rig_name}' is not running: start it with 'linpar rig start' and "
                     f"press Look again, or choose the in-process simulator.")
         if kind == SOUNDCARD and self.device_list.choice() is None:
+            if self.device_list.currentItem() is not None:      # one that only plays or only records
+                return "Choose a sound card that both plays and records: " + self.device_list.advice()
             return "Choose a sound card: " + (self.device_message or "press Refresh list.")
         try:
             config = self.config()
@@ -315,14 +318,15 @@ class HardwarePage(WizardPage):
     def on_devices(self, devices) -> None:
         self.devices = list(devices)
         self.device_list.set_devices(self.devices, self.device_list.choice() or self._saved_device)
-        self.device_message = "" if self.devices else "PortAudio lists no full-duplex sound card."
+        self.device_message = ("" if any(d.full_duplex for d in self.devices) else
+                               "PortAudio lists no sound card that both plays and records.")
         self.on_edited()
 
     def on_refresh_ports(self, ports=None) -> None:
         """List the serial ports (a fraction of a second on any system: asked on the GUI thread)."""
         try:
             ports = list_serial_ports() if ports is None else ports
-        except Exception as exc:  # noqa: BLE001 - a port list the system will not give is a note, not a crash
+        except OSError as exc:      # the system would not give its list (permissions, a driver): type the name
             ports, why = [], f"The serial ports could not be listed ({exc}); type the port's name."
         else:
             why = "" if ports else (f"No serial port found: plug in the laser's USB adapter and look again, or type "
@@ -354,3 +358,11 @@ class HardwarePage(WizardPage):
                             lambda text: self.laser_result.setText(coloured("Found: " + text, OK_COLOUR)),
                             lambda message: self.laser_result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
                             lambda: self.laser_result.setText("Test cancelled."))
+
+
+def plain_label() -> QLabel:
+    """A wrapped label for text that names devices (their names may hold '<' or '&', which rich text would eat)."""
+    label = QLabel()
+    label.setTextFormat(Qt.PlainText)
+    label.setWordWrap(True)
+    return label

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from instruments.audio.interface import AudioDeviceInfo
 
-BEST, GOOD, POOR = 0, 1, 2
+BEST, GOOD, POOR, UNUSABLE = 0, 1, 2, 3
 # host API -> (rank, why), lower is better.
 HOST_APIS = {
     "ASIO": (BEST, "the card maker's own driver: bit-exact, no Windows mixer, no resampling, low latency"),
@@ -34,6 +34,8 @@ HOST_APIS = {
 }
 ALSA_SERVER_DEVICE = (POOR, "an ALSA device of a sound server or plug-in (default, pulse, pipewire, dmix, "
                             "plughw): it resamples and mixes; choose the card's hw: device")
+NOT_DUPLEX = (UNUSABLE, "linpar plays and records on one device, with one clock (under WASAPI, MME and "
+                        "DirectSound Windows lists a card's inputs and outputs apart: take its ASIO driver)")
 UNKNOWN = (POOR, "a host API linpar knows nothing about: check that it neither resamples nor mixes")
 _ALSA_HW = re.compile(r"\((hw:\d+,\d+)\)\s*$")
 MME_NAME_LIMIT = 31     # MME cuts device names to 31 characters
@@ -41,12 +43,14 @@ MME_NAME_LIMIT = 31     # MME cuts device names to 31 characters
 
 @dataclass(frozen=True, slots=True)
 class Suitability:
-    rank: int       # BEST, GOOD or POOR
+    rank: int       # BEST, GOOD, POOR or UNUSABLE
     text: str       # in words, for the device list
 
 
 def judge(device: AudioDeviceInfo) -> tuple[int, str]:
-    """How well this device's host API suits a measurement: (rank, why)."""
+    """How well this device suits a measurement: (rank, why). NOT_DUPLEX for one that only plays or records."""
+    if not device.full_duplex:
+        return NOT_DUPLEX[0], f"{'inputs' if device.max_input_channels else 'outputs'} only: " + NOT_DUPLEX[1]
     if device.hostapi == "ALSA" and not _ALSA_HW.search(device.name):
         return ALSA_SERVER_DEVICE
     return HOST_APIS.get(device.hostapi, UNKNOWN)
@@ -67,7 +71,7 @@ def suitability(devices: list[AudioDeviceInfo]) -> list[Suitability]:
     for i, device in enumerate(devices):
         rank, why = judge(device)
         twins = [j for j in by_card[card_key(device.name)] if j != i]
-        if not twins:
+        if not twins or rank == UNUSABLE:
             found.append(Suitability(rank, _word(rank) + why))
             continue
         best = min([i, *twins], key=lambda j: (judge(devices[j])[0], j))
@@ -86,4 +90,4 @@ def suitability(devices: list[AudioDeviceInfo]) -> list[Suitability]:
 
 
 def _word(rank: int) -> str:
-    return {BEST: "suits measurement: ", GOOD: "usable: ", POOR: "avoid: "}[rank]
+    return {BEST: "suits measurement: ", GOOD: "usable: ", POOR: "avoid: ", UNUSABLE: "cannot be used: "}[rank]

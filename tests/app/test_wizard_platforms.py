@@ -104,6 +104,19 @@ def test_a_device_stored_by_index_in_older_settings_is_asked_for_again(qtbot, se
     wizard.shutdown(10_000)
 
 
+def test_a_device_that_only_records_is_listed_but_not_taken(qtbot, settings, tmp_path, monkeypatch):
+    from instruments.audio.interface import AudioDeviceInfo
+    wizard = make_wizard(qtbot, settings, tmp_path, monkeypatch, '{"kind": "soundcard"}')
+    page = wizard.hardware_page
+    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=30_000)
+    page.on_devices([AudioDeviceInfo(0, "Analogue 1 + 2 (Focusrite USB Audio)", "Windows WASAPI", 2, 0, 48000.0)])
+    page.device_list.setCurrentItem(page.device_list.topLevelItem(0))
+    assert page.device_list.choice() is None and not wizard.next_button.isEnabled()
+    assert "both plays and records" in wizard.reason.text() and "ASIO" in wizard.reason.text()
+    assert "inputs only" in page.device_advice.text()
+    wizard.shutdown(10_000)
+
+
 def test_a_device_stored_with_its_old_index_beside_its_name_is_found_by_name(qtbot, settings, tmp_path, monkeypatch):
     saved = '{"kind": "soundcard", "device": {"name": "Focusrite USB ASIO", "hostapi": "ASIO", "index": 14}}'
     wizard = make_wizard(qtbot, settings, tmp_path, monkeypatch, saved)

@@ -1,7 +1,7 @@
 """Issue 22: which host API suits a measurement, and one card listed under several host APIs."""
 from __future__ import annotations
 
-from instruments.audio.host_apis import BEST, GOOD, POOR, card_key, judge, suitability
+from instruments.audio.host_apis import BEST, GOOD, POOR, UNUSABLE, card_key, judge, suitability
 from instruments.audio.interface import AudioDeviceInfo
 from instruments.serial_ports import SerialPort, list_serial_ports, port_example
 
@@ -60,3 +60,13 @@ def test_serial_ports_are_listed_usb_first_with_their_ids(monkeypatch):
     ports = list_serial_ports()
     assert ports == [SerialPort("COM7", "USB Serial Port (COM7)", "0403:6001", "A1"),
                      SerialPort("COM1", "Communications Port (COM1)", "")]
+
+
+def test_a_device_that_only_records_or_only_plays_cannot_be_used_and_says_what_to_take():
+    found = suitability([device("Focusrite USB ASIO", "ASIO"),
+                         device("Analogue 1 + 2 (Focusrite USB Audio)", "Windows WASAPI", 2, 0),
+                         device("Speakers (Focusrite USB Audio)", "Windows WASAPI", 0, 2)])
+    assert found[0].rank == BEST
+    assert found[1].rank == found[2].rank == UNUSABLE
+    assert found[1].text.startswith("cannot be used: inputs only") and "ASIO" in found[1].text
+    assert found[2].text.startswith("cannot be used: outputs only")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
 
+from analysis import config_folder
 from analysis.archive.archive import Measurement, export_folder
 from analysis.archive.index import Filter, _entry_of_row
 from analysis.archive.limits_store import LimitsVersion, checked_document, checked_note, version_of_json
@@ -25,7 +26,6 @@ from analysis.archive.names import ArchiveError, check_id, check_id_prefix, insi
 from analysis.archive.pg.files import fetch_file
 from analysis.archive.pg.outbox import Outbox, queue_folder
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, connect, parse_url, server_errors
-from analysis import config_folder
 from analysis.archive.record import RECORD_FILE, checked_parameter, entry_of, one_line_text, read_record
 from analysis.archive.sync_report import SyncReport
 

@@ -29,15 +29,15 @@ import hashlib
 import json
 from pathlib import Path
 
-from analysis.archive.archive import Archive
 from analysis import file_lock
+from analysis.archive.archive import Archive
 from analysis.archive.atomic import FILE_MODE, write_atomic
 from analysis.archive.limits_store import LimitsVersion, version_json, version_of_json
 from analysis.archive.names import ArchiveError, folder_name
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, server_errors
-from analysis.config_folder import data_folder, overridden
 from analysis.archive.pg.upload import IdTaken, record_sha256, send_measurement
 from analysis.archive.sync_report import SyncReport
+from analysis.config_folder import data_folder, overridden
 
 LIMITS_CACHE = "limits.json"
 LOCK_FILE = ".send.lock"
