@@ -63,3 +63,17 @@ def test_the_journal_lock_excludes_others_and_dies_with_its_holder(report):
     assert found["held_by_me"] and found["second_refused"] and found["free_after_release"]
     assert found["other_said"] == "held" and found["held_by_other"]
     assert found["free_after_kill"]         # a crashed measurement's journal is offered for recovery
+
+
+def test_off_linux_the_rig_commands_say_so_in_one_line(capsys, monkeypatch):
+    from app.cli import main
+    from instruments.rig import manager
+    with pytest.raises(manager.RigError, match="Linux only"):
+        manager.require_linux("win32")
+    manager.require_linux("linux")
+    real = manager.require_linux
+    monkeypatch.setattr(manager, "require_linux", lambda platform=None: real("darwin"))
+    for argv in (["rig", "status"], ["rig", "start"], ["rig", "stop"]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Linux only" in err and "sound card" in err, err

@@ -44,8 +44,18 @@ class RigHandle:
         return send_command(self.paths.control_socket, {"cmd": cmd, **args})
 
 
+def require_linux(platform: str | None = None) -> None:
+    """RigError where the rig cannot run (``sys.platform`` unless given): before any pid is probed, since
+    os.kill(pid, 0) ends a process on Windows, and before a runtime folder named by a uid Windows lacks."""
+    if not (platform or sys.platform).startswith("linux"):
+        raise RigError("the virtual rig runs on Linux only: it needs a JACK server and pseudo-terminals; measure "
+                       "with a sound card (linpar measure --rig soundcard), or with the window's in-process "
+                       "simulator")
+
+
 def find_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None) -> RigHandle | None:
     """The running rig of that name, or None (stale files of a dead one are removed)."""
+    require_linux()
     paths = RigPaths.for_name(name, runtime_dir)
     pid = read_pid(paths)
     if not pid_alive(pid):
@@ -62,6 +72,7 @@ def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | No
               seed: int | None = None, timeout: float = 20.0, extra_args: Sequence[str] = (),
               model: str = "linear") -> RigHandle:
     """The rig `name`, started in the background unless it runs; `model` is the server's --model."""
+    require_linux()
     if model not in MODELS:
         raise RigError(f"unknown rig model {model!r} (expected {' or '.join(MODELS)})")
     paths = RigPaths.for_name(name, runtime_dir)
@@ -111,6 +122,7 @@ def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | No
 
 def stop_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None, timeout: float = 10.0) -> bool:
     """Stop the rig and its jackd; False if it was not running. RigError if it would not die."""
+    require_linux()
     paths = RigPaths.for_name(name, runtime_dir)
     pid = read_pid(paths)
     if not pid_alive(pid):
@@ -130,6 +142,7 @@ def stop_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None, timeout:
 
 def rig_status(name: str = DEFAULT_NAME, runtime_dir: Path | None = None) -> dict | None:
     """The rig's own status report (state, connections, xruns, faults), or None if it is not running."""
+    require_linux()
     handle = find_rig(name, runtime_dir)
     if handle is None:
         return None
@@ -140,6 +153,7 @@ def rig_status(name: str = DEFAULT_NAME, runtime_dir: Path | None = None) -> dic
 
 
 def list_rigs(runtime_dir: Path | None = None) -> list[str]:
+    require_linux()
     from instruments.rig.state import runtime_root
     root = Path(runtime_dir or runtime_root())
     if not root.is_dir():
