@@ -43,7 +43,7 @@ def _plan_on_the_rig(workdir: Path) -> list[Row]:
     if shutil.which("jackd") is None:
         return [Row("large signal: plan skipped, jackd is not installed (Debian package jackd2)", 0.0, "", "", None)]
     from instruments.audio import portaudio
-    from instruments.laser import ILD1420
+    from instruments.laser import LaserSpec, open_laser
     from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
     from instruments.measurement.plan import MeasurementPlan
     from instruments.rig.manager import start_rig, stop_rig
@@ -57,7 +57,7 @@ def _plan_on_the_rig(workdir: Path) -> list[Row]:
             audio = rig_audio(handle)
             plan = LargeSignalPlan(MeasurementPlan.from_template("large-signal"), 0.5)
             t0 = time.monotonic()
-            outcomes.append(run_large_signal(plan, audio, ILD1420(handle.state.laser_pty), workdir / f"plan-{k}",
+            outcomes.append(run_large_signal(plan, audio, open_laser(LaserSpec(port=handle.state.laser_pty)), workdir / f"plan-{k}",
                                              name="ls"))
             times.append(time.monotonic() - t0)
             portaudio.release()

@@ -63,8 +63,8 @@ def test_size_limits_are_raised_for_the_code_inside_only():
 @pytest.mark.parametrize("range_text, accepted", [("10 mm", True), ("0 mm", False), ("99999999 mm", False),
                                                   ("0.00001 mm", False), ("500 mm", True)])
 def test_a_laser_reply_with_a_measuring_range_no_sensor_has_is_a_laser_error(range_text, accepted):
-    from instruments.laser.commands import parse_info
-    from instruments.laser.frames import Reply
+    from instruments.laser.ild1420.commands import parse_info
+    from instruments.laser.ild1420.frames import Reply
     from instruments.laser.sensor import LaserError
     reply = Reply(f"GETINFO\r\nName: ILD1420-10\r\nMeasuring range: {range_text}\r\n->")
     if accepted:

@@ -70,11 +70,11 @@ class VirtualRig:
     def devices(self):
         import dataclasses
 
-        from instruments.laser import ILD1420
+        from instruments.laser import LaserSpec, open_laser
         from instruments.rig.workstation import rig_audio
         audio = rig_audio(self.handle)
         audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
-        return audio, ILD1420(self.handle.command("laser")["laser_pty"])
+        return audio, open_laser(LaserSpec(port=self.handle.command("laser")["laser_pty"]))
 
     def close(self):
         from instruments.audio import portaudio

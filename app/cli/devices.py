@@ -52,8 +52,8 @@ def _laser_choice(option: str | None, rig_pty: str | None) -> str | None:
 def laser_sensor(port: str | None):
     if port is None:
         return None
-    from instruments.laser import ILD1420
-    return ILD1420(port)
+    from instruments.laser import LaserSpec, open_laser
+    return open_laser(LaserSpec(port=port))
 
 
 def _sound_card(args: argparse.Namespace):

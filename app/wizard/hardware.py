@@ -17,6 +17,7 @@ import numpy as np
 
 from analysis.errors import LinparError
 from instruments.audio.config import AudioDeviceChoice, Calibration, ChannelMap
+from instruments.laser.factory import DEFAULT_MODEL, LaserSpec
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
 from instruments.serial_ports import port_example
@@ -43,6 +44,7 @@ class HardwareConfig:
     channel_map: ChannelMap = RIG_CHANNEL_MAP
     calibration: Calibration = RIG_CALIBRATION
     laser: str = ANALOG_LASER
+    laser_model: str = DEFAULT_MODEL
     laser_port: str = ""
     laser_rate_hz: float = 4000.0
     # Simulator only: a driver to simulate instead of the paper's (a resistor for the calibration).
@@ -51,6 +53,10 @@ class HardwareConfig:
     @property
     def has_displacement(self) -> bool:
         return self.laser == ANALOG_LASER and self.channel_map.laser_analog is not None
+
+    def laser_spec(self) -> LaserSpec:
+        """The serial laser chosen, for instruments.laser.open_laser."""
+        return LaserSpec(self.laser_model, self.laser_port)
 
     def key(self) -> str:
         """Who the calibration corrections belong to: the chain, not the driver on it."""
@@ -159,13 +165,13 @@ def test_audio(config: HardwareConfig, cancel: threading.Event | None = None, pr
 
 def test_laser(config: HardwareConfig) -> str:
     """Open the serial laser, set its rate, read a little: what it is and what it reads."""
-    from instruments.laser import ILD1420, LaserError
+    from instruments.laser import open_laser
 
     if config.laser != SERIAL_LASER:
         return "no serial laser chosen"
     if not config.laser_port:
         raise LaserError(f"give the laser's serial port (a device such as {port_example()})")
-    laser = ILD1420(config.laser_port)
+    laser = open_laser(config.laser_spec())
     try:
         info = laser.open()
         laser.configure(config.laser_rate_hz)

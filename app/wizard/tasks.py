@@ -64,8 +64,8 @@ def open_devices(hardware: HardwareConfig, corrections: Corrections):
     audio = corrected_audio(open_audio(hardware, corrections.apply(hardware.calibration)), corrections)
     laser = None
     if hardware.laser == SERIAL_LASER:
-        from instruments.laser import ILD1420
-        laser = ILD1420(hardware.laser_port)
+        from instruments.laser import open_laser
+        laser = open_laser(hardware.laser_spec())
     return audio, laser
 
 

@@ -1,26 +1,21 @@
-"""The laser displacement sensor: the optoNCDT ILD1420 on its serial link,
-its emulator on a pseudo-terminal, an in-process simulation, and the scale
-for its analog output. See shared/spec/laser-ild1420.md."""
+"""The laser displacement sensor, whatever its model: the protocol every
+sensor keeps (sensor.py), the factory that makes one from a LaserSpec
+(factory.py), the in-process simulation (simulated.py) and the scale of an
+analog output read by the sound card (analog.py). Each model lives in a
+subpackage of its own (ild1420/); importing this package loads none of
+their drivers or emulators, so it imports on every system.
+"""
 
 from instruments.laser.analog import AnalogLaserScale
-from instruments.laser.ild1420 import DEFAULT_BAUDRATE, ILD1420
+from instruments.laser.factory import DEFAULT_MODEL, LaserSpec, laser_model, laser_models, open_laser
+from instruments.laser.model import LaserModel
 from instruments.laser.sensor import (
-    DEFAULT_OUTPUTS, NO_COUNTER, DisplacementSensor, LaserBlock, LaserError, LaserStats,
-    SensorInfo, concatenate_blocks)
-from instruments.laser.sensor_model import ErrorPlan
-from instruments.laser.simulated import SimulatedLaser
-from instruments.laser.values import LaserErrorCode, describe_error
+    DEFAULT_OUTPUTS, NO_COUNTER, DisplacementSensor, LaserBlock, LaserError, LaserStats, SensorInfo,
+    concatenate_blocks)
 
 __all__ = [
-    "AnalogLaserScale", "DEFAULT_BAUDRATE", "DEFAULT_OUTPUTS", "DisplacementSensor", "ErrorPlan",
-    "ILD1420", "LaserBlock", "LaserEmulator", "LaserError", "LaserErrorCode", "LaserStats",
-    "NO_COUNTER", "SensorInfo", "SimulatedLaser", "concatenate_blocks", "describe_error",
+    "AnalogLaserScale", "DEFAULT_MODEL", "DEFAULT_OUTPUTS", "DisplacementSensor", "LaserBlock", "LaserError",
+    "LaserModel", "LaserSpec", "LaserStats", "NO_COUNTER", "SensorInfo", "concatenate_blocks", "laser_model",
+    "laser_models", "open_laser",
 ]
 
-
-def __getattr__(name: str):
-    # The pty emulator needs termios and fcntl, which Windows lacks: it is loaded when asked for, not with the package.
-    if name == "LaserEmulator":
-        from instruments.laser.emulator import LaserEmulator
-        return LaserEmulator
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,7 +1,8 @@
 """The displacement-sensor protocol and what crosses threads from a laser.
 
-``DisplacementSensor`` is what the measurement code talks to; ``ILD1420``
-(the serial sensor) and ``SimulatedLaser`` (in-process) implement it.
+``DisplacementSensor`` is what the measurement code talks to; each sensor
+model's driver (``instruments/laser/<model>/``) and ``SimulatedLaser``
+(in-process) implement it. Nothing here knows a model's bytes or words.
 """
 
 from __future__ import annotations
@@ -15,8 +16,6 @@ from typing import Mapping, Protocol, Sequence, runtime_checkable
 import numpy as np
 
 from analysis.errors import LinparError
-from instruments.laser.frames import RawMeasurements
-from instruments.laser.values import CounterUnwrapper, decode_distance, timestamp_ms
 
 #: Distance, counter and time stamp: what alignment to the audio needs.
 DEFAULT_OUTPUTS: tuple[str, ...] = ("distance", "counter", "timestamp")
@@ -45,7 +44,7 @@ class LaserBlock:
     counter: unwrapped measurement counter (int64), NO_COUNTER if not sent
     timestamp_ms: sensor time stamp (float64), NaN if not sent
     distance_m: distance (float64), NaN where the sensor sent an error code
-    error_code: int32, 0 for a valid distance, else a ``LaserErrorCode``
+    error_code: int32, 0 for a valid distance, else the model's error code
     in_range: False for errors and for distances in the reserves
     host_time: time.monotonic() when the bytes arrived
     """
@@ -79,23 +78,6 @@ def concatenate_blocks(blocks: Sequence[LaserBlock]) -> LaserBlock:
         error_code=np.concatenate([b.error_code for b in blocks]),
         in_range=np.concatenate([b.in_range for b in blocks]),
         host_time=blocks[-1].host_time,
-    )
-
-
-def block_from_raw(raw: RawMeasurements, measuring_range_m: float,
-                   unwrapper: CounterUnwrapper, host_time: float) -> LaserBlock:
-    """Decode received measurements; the unwrapper carries the counter on."""
-    distance, error_code, in_range = decode_distance(raw.column("distance"), measuring_range_m)
-    counter = raw.column("counter")
-    lo, hi = raw.column("timestamp_lo"), raw.column("timestamp_hi")
-    n = len(raw)
-    return LaserBlock(
-        counter=unwrapper.unwrap(counter) if counter is not None else np.full(n, NO_COUNTER, np.int64),
-        timestamp_ms=timestamp_ms(lo, hi) if lo is not None else np.full(n, np.nan),
-        distance_m=distance,
-        error_code=error_code,
-        in_range=in_range,
-        host_time=host_time,
     )
 
 

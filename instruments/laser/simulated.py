@@ -1,9 +1,10 @@
 """SimulatedLaser: the DisplacementSensor protocol in-process, no port.
 
-Same constructor shape as ILD1420 (a port name it ignores, a baud rate it
-uses for the bandwidth check), plus the virtual sensor's physics. It has no
-thread: ``read_block`` hands out, in real time, the samples the virtual
-sensor has taken since the last call. Byte-level faults of the ErrorPlan
+Same constructor shape as a driver (a port name it ignores, a baud rate it
+uses for the bandwidth check), after the LaserModel it simulates: the model's
+physics measure, the model's ``check_configuration`` refuses what the real
+sensor refuses. It has no thread: ``read_block`` hands out, in real time, the
+samples the virtual sensor has taken since the last call. Byte-level faults
 (garbage, truncated frames) have no meaning without bytes and are ignored;
 error codes and a lost link are honoured.
 """
@@ -12,13 +13,8 @@ from __future__ import annotations
 
 import time
 
-from instruments.laser import commands
-from instruments.laser.frames import RawMeasurements, value_slots
-from instruments.laser.ild1420 import DEFAULT_BAUDRATE
-from instruments.laser.sensor import (
-    DEFAULT_OUTPUTS, FrameTally, LaserBlock, LaserError, LaserStats, SensorInfo, block_from_raw)
-from instruments.laser.sensor_model import Displacement, ErrorPlan, SensorModel
-from instruments.laser.values import CounterUnwrapper
+from instruments.laser.model import LaserModel
+from instruments.laser.sensor import DEFAULT_OUTPUTS, FrameTally, LaserBlock, LaserError, LaserStats, SensorInfo
 
 #: Blocks come every CHUNK_S, like the serial reader's chunks, and never
 #: hold more than MAX_BLOCK measurements (0.25 s at 4 kHz).
@@ -27,19 +23,15 @@ MAX_BLOCK = 1000
 
 
 class SimulatedLaser:
-    def __init__(self, port: str = "sim://ild1420", baudrate: int = DEFAULT_BAUDRATE, *,
-                 displacement: Displacement | None = None, measuring_range_mm: int = 10,
-                 clock_ppm: float = 0.0, start_latency_s: float = 0.0, noise_m: float = 0.0,
-                 error_plan: ErrorPlan | None = None, counter_start: int = 0,
-                 connected: bool = True, link_latency_s: float = 0.0) -> None:
-        self._url = port
-        self._baudrate = baudrate
+    def __init__(self, model: LaserModel, port: str | None = None, baudrate: int | None = None, *,
+                 connected: bool = True, **physics) -> None:
+        self.spec = model
+        self._url = port or f"sim://{model.name}"
+        self._baudrate = baudrate or model.default_baudrate
         self._connected = connected
-        self.model = SensorModel(displacement, measuring_range_mm, 4000.0, clock_ppm, start_latency_s,
-                                 noise_m, error_plan, counter_start=counter_start, link_latency_s=link_latency_s)
+        self.model = model.make_physics(**physics)
         self._open = False
-        self._slots = value_slots(DEFAULT_OUTPUTS)
-        self._unwrapper = CounterUnwrapper()
+        self._slots = model.layout(DEFAULT_OUTPUTS)
         self._tally = FrameTally()
         self._started = False
         self._sent = 0
@@ -52,29 +44,23 @@ class SimulatedLaser:
 
     def open(self) -> SensorInfo:
         if not self._connected:
-            raise LaserError(f"no ILD1420 answering on {self._url}: the simulated laser is not connected")
+            raise LaserError(f"no {self.spec.family} answering on {self._url}: the simulated laser is not connected")
         self._open = True
         mr_mm = round(self.model.measuring_range_m * 1000)
-        return SensorInfo(name=f"ILD1420-{mr_mm} (simulated)", serial="00000000",
+        return SensorInfo(name=f"{self.spec.family}-{mr_mm} (simulated)", serial="00000000",
                           measuring_range_m=self.model.measuring_range_m, firmware="simulated")
 
     def configure(self, rate_hz: float, outputs: tuple[str, ...] = DEFAULT_OUTPUTS) -> None:
         self._require_open()
         if self._started:
             raise LaserError("stop the laser before configuring it")
-        commands.check_rate(rate_hz)
-        try:
-            slots = value_slots(tuple(outputs))
-        except ValueError as exc:
-            raise LaserError(str(exc)) from exc
-        commands.check_bandwidth(self._baudrate, rate_hz, len(slots))
+        self.spec.check_configuration(self._baudrate, rate_hz, outputs)
+        self._slots = self.spec.layout(outputs)
         self.model.rate_hz = float(rate_hz)
-        self._slots = slots
 
     def start(self) -> None:
         self._require_open()
         self.model.reset_counter()
-        self._unwrapper.reset()
         self._sent = 0
         self._end_time = None
         self.model.begin(time.monotonic())
@@ -124,7 +110,7 @@ class SimulatedLaser:
         if self.model.t0 is None:
             return 0
         due = self.model.due(now if self._end_time is None else min(now, self._end_time))
-        limit = self.model.error_plan.disconnect_after
+        limit = self.model.disconnect_after
         if limit is not None and due >= limit:
             due = limit
             if self._failure is None:
@@ -132,11 +118,10 @@ class SimulatedLaser:
         return due
 
     def _block(self, k0: int, k1: int) -> LaserBlock:
-        raw = RawMeasurements(self._slots, self.model.rows(k0, k1, self._slots))
         # When the block is due by the schedule, not when this thread got to it (frame_clock.py): the
         # emulated device's latency is the link's, as chosen; the reader's own lateness is the host's.
         host_time = float(self.model.arrival_time(k1 - 1))
-        block = block_from_raw(raw, self.model.measuring_range_m, self._unwrapper, host_time)
+        block = self.model.decoded_block(k0, k1, self._slots, host_time)
         self._sent = k1
         self._tally.count(block)
         return block

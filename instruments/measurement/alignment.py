@@ -24,7 +24,7 @@ displacement's noise (capture.laser_gaps). Out-of-range distances (the
 sensor's reserves) are kept, and counted. Outliers are missing data too:
 measured distances no smooth motion through their neighbours could give. The
 line has no checksum, and now and then line noise forges a whole measurement
-that the parser cannot tell from a real one (instruments/laser/frames.py).
+that the parser cannot tell from a real one (instruments/laser/ild1420/frames.py).
 The cone's motion is smooth on the laser's grid (its content lies well below
 the laser's Nyquist frequency), so a measurement further from the cubic
 through its two neighbours on either side than OUTLIER_SIGMAS times the

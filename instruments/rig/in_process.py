@@ -81,13 +81,15 @@ class InProcessRig:
 
     def new_laser(self, error_plan=None):
         """A fresh laser (after a hang-up the old one is gone for good): what is plugged in from now on."""
-        from instruments.laser import ILD1420, LaserEmulator, SimulatedLaser
+        from instruments.laser import LaserSpec, open_laser
         self.close()
         if self.kind == "simulated":
-            self.laser = SimulatedLaser(error_plan=error_plan, **self.laser_settings)
+            self.laser = open_laser(LaserSpec(simulated=True, options=dict(error_plan=error_plan,
+                                                                             **self.laser_settings)))
         elif self.kind == "serial":
+            from instruments.laser.ild1420.emulator import LaserEmulator
             self.emulator = LaserEmulator(error_plan=error_plan, **self.laser_settings).start()
-            self.laser = ILD1420(self.emulator.port_path)
+            self.laser = open_laser(LaserSpec(port=self.emulator.port_path))
         else:
             return None
         aim_at_cone(self.model, self.feed)

@@ -58,8 +58,8 @@ from typing import Callable
 
 import numpy as np
 
-from instruments.laser.emulator import LaserEmulator
-from instruments.laser.sensor_model import SensorModel
+from instruments.laser.ild1420.emulator import LaserEmulator
+from instruments.laser.ild1420.sensor_model import SensorModel
 from instruments.rig.frame_clock import FrameClock
 
 HISTORY_FRAMES = 1 << 18          # 5.5 s at 48 kHz: far more than any laser latency

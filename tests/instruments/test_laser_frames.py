@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from instruments.laser.frames import (
+from instruments.laser.ild1420.frames import (
     FrameParser, RawMeasurements, Reply, encode_measurements, value_slots)
 
 ALL = ("distance", "counter", "timestamp")

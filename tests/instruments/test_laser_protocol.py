@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from instruments.laser import (
-    NO_COUNTER, DisplacementSensor, ErrorPlan, ILD1420, LaserBlock, LaserEmulator, LaserError,
-    LaserErrorCode, SimulatedLaser, concatenate_blocks)
+    NO_COUNTER, DisplacementSensor, LaserBlock, LaserError, LaserSpec, concatenate_blocks, open_laser)
+from instruments.laser.ild1420 import ErrorPlan, LaserErrorCode
+from instruments.laser.ild1420.emulator import LaserEmulator
 
 LSB = 0.010 * 1.02 / 65520
 
@@ -31,15 +32,17 @@ class Rig:
 
     def make(self, baudrate=921_600, connected=True, **physics):
         if self.kind == "simulated":
-            self.sensor = SimulatedLaser("sim://bench", baudrate, connected=connected, **physics)
+            self.sensor = open_laser(LaserSpec("ild1420", "sim://bench", baudrate, simulated=True,
+                                               options=dict(connected=connected, **physics)))
             self.model = self.sensor.model
         elif connected:
             self._emulator = LaserEmulator(**physics).start()
-            self.sensor = ILD1420(self._emulator.port_path, baudrate)
+            self.sensor = open_laser(LaserSpec("ild1420", self._emulator.port_path, baudrate))
             self.model = self._emulator.model
         else:
             self._silent = os.openpty()
-            self.sensor = ILD1420(os.ttyname(self._silent[1]), baudrate, reply_timeout_s=0.2)
+            self.sensor = open_laser(LaserSpec("ild1420", os.ttyname(self._silent[1]), baudrate,
+                                               options={"reply_timeout_s": 0.2}))
         return self.sensor
 
     def pull_cable(self):

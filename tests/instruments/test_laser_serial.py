@@ -10,10 +10,15 @@ import numpy as np
 import pytest
 from serial.urlhandler.protocol_loop import Serial as LoopSerial
 
-from instruments.laser import (
-    DEFAULT_BAUDRATE, ILD1420, ErrorPlan, LaserEmulator, LaserError, LaserErrorCode,
-    concatenate_blocks)
-from instruments.laser.frames import encode_measurements
+from instruments.laser import LaserError, LaserSpec, concatenate_blocks, open_laser
+from instruments.laser.ild1420 import DEFAULT_BAUDRATE, ErrorPlan, LaserErrorCode
+from instruments.laser.ild1420.emulator import LaserEmulator
+from instruments.laser.ild1420.frames import encode_measurements
+
+
+def ild1420(port, baudrate=None, **options):
+    """The driver, made as every caller makes it: through the factory."""
+    return open_laser(LaserSpec("ild1420", port, baudrate, options=options))
 
 
 def collect(sensor, n, timeout=3.0):
@@ -50,7 +55,7 @@ def rig():
 
     def make(baudrate=DEFAULT_BAUDRATE, queue_blocks=1024, rate_hz=4000.0, start=True, **emulator_kwargs):
         emulator = LaserEmulator(**emulator_kwargs).start()
-        sensor = ILD1420(emulator.port_path, baudrate, queue_blocks=queue_blocks)
+        sensor = ild1420(emulator.port_path, baudrate, queue_blocks=queue_blocks)
         made.append((sensor, emulator))
         if start:
             sensor.open()
@@ -258,13 +263,13 @@ def test_disconnect_by_hand_mid_stream(rig):
 
 def test_nothing_on_the_port_is_a_clear_error():
     with pytest.raises(LaserError, match="cannot open the laser port /nonexistent/ttyLASER"):
-        ILD1420("/nonexistent/ttyLASER").open()
+        ild1420("/nonexistent/ttyLASER").open()
 
 
 def test_a_silent_port_is_a_clear_error():
     master, slave = os.openpty()
     try:
-        sensor = ILD1420(os.ttyname(slave), reply_timeout_s=0.2)
+        sensor = ild1420(os.ttyname(slave), reply_timeout_s=0.2)
         with pytest.raises(LaserError, match="no ILD1420 answering .* no reply to 'GETINFO'"):
             sensor.open()
         sensor.close()
@@ -277,7 +282,7 @@ def test_close_leaves_no_thread_and_no_file_descriptor():
     threads = threading.active_count()
     fds = len(os.listdir("/proc/self/fd"))
     with LaserEmulator(displacement=sine) as emulator:
-        sensor = ILD1420(emulator.port_path)
+        sensor = ild1420(emulator.port_path)
         sensor.open()
         sensor.configure(4000.0)
         sensor.start()
@@ -319,7 +324,7 @@ class AnsweringLoop(LoopSerial):
 
 def test_loop_port_byte_by_byte_with_garbage_and_a_command_in_between():
     port = AnsweringLoop()
-    sensor = ILD1420(port)  # the port is handed in, and over: close() closes it
+    sensor = ild1420(port)  # the port is handed in, and over: close() closes it
     try:
         assert sensor.open().measuring_range_m == 0.05
         sensor.start()
@@ -350,7 +355,7 @@ def test_loop_port_byte_by_byte_with_garbage_and_a_command_in_between():
 
 def test_loop_port_that_goes_away_ends_the_stream_cleanly():
     port = AnsweringLoop()
-    sensor = ILD1420(port)
+    sensor = ild1420(port)
     try:
         sensor.open()
         sensor.start()

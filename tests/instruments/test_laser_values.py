@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from instruments.laser.values import (
+from instruments.laser.ild1420.values import (
     COUNTER_MODULUS, X_MAX, X_MIN, CounterUnwrapper, LaserErrorCode, decode_distance,
     describe_error, distance_to_x, timestamp_ms, timestamp_words, x_to_distance_m)
 

@@ -21,7 +21,7 @@ import pytest
 from analysis.derived import derived_from_values
 from analysis.drivers import load_driver
 from instruments.audio import portaudio
-from instruments.laser import ILD1420
+from instruments.laser import DisplacementSensor, LaserSpec, open_laser
 from instruments.measurement import MeasurementFailed, MeasurementPlan, run_measurement
 from instruments.rig.workstation import rig_audio
 from tests.pace import paced
@@ -46,8 +46,8 @@ def serial_audio(rig):
     return audio
 
 
-def laser_of(rig) -> ILD1420:
-    return ILD1420(rig.command("laser")["laser_pty"])
+def laser_of(rig) -> DisplacementSensor:
+    return open_laser(LaserSpec(port=rig.command("laser")["laser_pty"]))
 
 
 def measure(rig, tmp_path, plan_=None, *, injected=(), attempts=3, **options):

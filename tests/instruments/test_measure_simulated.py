@@ -20,7 +20,8 @@ import pytest
 
 from analysis.derived import derived_from_values
 from analysis.drivers import load_driver
-from instruments.laser import ErrorPlan, SimulatedLaser
+from instruments.laser import LaserSpec, open_laser
+from instruments.laser.ild1420 import ErrorPlan
 from instruments.measurement import (
     MeasurementCancelled, MeasurementError, MeasurementFailed, MeasurementPlan, run_measurement)
 from instruments.measurement.raw_stream import read_raw_capture
@@ -229,7 +230,7 @@ def test_without_a_serial_laser_the_analog_input_is_the_displacement(tmp_path):
 def test_a_laser_that_does_not_answer_stops_it_before_anything_plays(tmp_path):
     audio = simulated(serial=False).audio
     with pytest.raises(MeasurementError, match="not connected"):
-        run_measurement(plan(), audio, SimulatedLaser(connected=False), tmp_path, name="m")
+        run_measurement(plan(), audio, open_laser(LaserSpec(simulated=True, options={"connected": False})), tmp_path, name="m")
     assert list(tmp_path.iterdir()) == []
     assert not audio.running
 

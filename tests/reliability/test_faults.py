@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from analysis.recording import read_recording
-from instruments.laser import ErrorPlan
+from instruments.laser.ild1420 import ErrorPlan
 from instruments.measurement import MeasurementError, MeasurementFailed
 from instruments.measurement.recovery import JournalKept, find_unfinished, recover, run_journaled
 from tests.builders import PAPER

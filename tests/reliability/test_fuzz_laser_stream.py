@@ -19,10 +19,10 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from instruments.laser.commands import parse_info, parse_output_info
-from instruments.laser.frames import FrameParser, RawMeasurements, Reply, encode_measurements, value_slots
-from instruments.laser.sensor import LaserError, block_from_raw
-from instruments.laser.values import COUNTER_MODULUS, CounterUnwrapper, LaserErrorCode
+from instruments.laser.ild1420.commands import parse_info, parse_output_info
+from instruments.laser.ild1420.frames import FrameParser, RawMeasurements, Reply, encode_measurements, value_slots
+from instruments.laser.sensor import LaserError
+from instruments.laser.ild1420.values import COUNTER_MODULUS, CounterUnwrapper, LaserErrorCode, block_from_raw
 from tests.pace import paced
 from tests.reliability.fuzzing import FUZZ, FUZZ_MANY
 

@@ -20,7 +20,7 @@ import time
 import pytest
 
 from analysis.recording import read_recording
-from instruments.laser import ILD1420
+from instruments.laser import LaserSpec, open_laser
 from instruments.measurement import MeasurementFailed, MeasurementPlan
 from instruments.measurement.recovery import find_unfinished, run_journaled
 from instruments.rig.workstation import rig_audio
@@ -46,7 +46,7 @@ def rig(virtual_rig):
 def devices(rig):
     audio = rig_audio(rig)
     audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
-    return audio, ILD1420(rig.command("laser")["laser_pty"])
+    return audio, open_laser(LaserSpec(port=rig.command("laser")["laser_pty"]))
 
 
 def break_after(periods: int, action):

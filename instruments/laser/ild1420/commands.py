@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 
 from analysis.bounds import LASER_RANGE_M
-from instruments.laser.frames import Reply, value_slots
+from instruments.laser.ild1420.frames import Reply, value_slots
 from instruments.laser.sensor import LaserError, SensorInfo
 
 GETINFO = "GETINFO"
@@ -26,6 +26,8 @@ RESET_COUNTER = "RESETCNT"
 OUTPUT_ON = f"{OUTPUT} RS422"
 OUTPUT_OFF = f"{OUTPUT} NONE"
 
+#: The sensor's factory setting.
+DEFAULT_BAUDRATE = 921_600
 #: Measuring rates the sensor offers.
 RATES_HZ = (250.0, 500.0, 1000.0, 2000.0, 4000.0)
 #: Measuring ranges of the ILD1420 family.
@@ -54,6 +56,18 @@ def check_bandwidth(baudrate: int, rate_hz: float, values_per_measurement: int) 
             f"{values_per_measurement} values per measurement: it needs more than "
             f"{needed_kbd:g} kBd (33 x {rate_hz / 1000.0:g} kHz x {values_per_measurement}); "
             "lower the rate, send fewer values or raise the baud rate")
+
+
+def check_configuration(baudrate: int, rate_hz: float, outputs: tuple[str, ...]) -> None:
+    """What ``configure(rate_hz, outputs)`` must refuse before anything is sent,
+    the same for the driver and the simulation: a rate the sensor does not
+    offer, an unknown output, more than the line can carry."""
+    check_rate(rate_hz)
+    try:
+        slots = value_slots(tuple(outputs))
+    except ValueError as exc:
+        raise LaserError(str(exc)) from exc
+    check_bandwidth(baudrate, rate_hz, len(slots))
 
 
 def measrate_command(rate_hz: float) -> str:

@@ -3,15 +3,22 @@
 Every value on the RS422 line is an 18-bit word (see ``frames.py`` for how it
 is cut into bytes). Depending on its slot in a measurement it is a distance
 (or an error code in its place), a measurement counter, or one 16-bit half of
-a time stamp. This module turns those words into SI numbers and back; it knows
+a time stamp. This module turns those words into SI numbers and back, and
+received measurements into the LaserBlocks every sensor delivers; it knows
 nothing of bytes, ports or threads.
 """
 
 from __future__ import annotations
 
 import enum
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+from instruments.laser.sensor import NO_COUNTER, LaserBlock
+
+if TYPE_CHECKING:
+    from instruments.laser.ild1420.frames import RawMeasurements
 
 #: Distance words from the manual: x in [X_MIN, X_MAX] is the measuring range,
 #: 0..X_MIN-1 and X_MAX+1..65535 are the reserves at either end.
@@ -148,3 +155,20 @@ class CounterUnwrapper:
             out = start + np.cumsum(steps)
         self._last = int(out[-1])
         return out
+
+
+def block_from_raw(raw: RawMeasurements, measuring_range_m: float,
+                   unwrapper: CounterUnwrapper, host_time: float) -> LaserBlock:
+    """Decode received measurements; the unwrapper carries the counter on."""
+    distance, error_code, in_range = decode_distance(raw.column("distance"), measuring_range_m)
+    counter = raw.column("counter")
+    lo, hi = raw.column("timestamp_lo"), raw.column("timestamp_hi")
+    n = len(raw)
+    return LaserBlock(
+        counter=unwrapper.unwrap(counter) if counter is not None else np.full(n, NO_COUNTER, np.int64),
+        timestamp_ms=timestamp_ms(lo, hi) if lo is not None else np.full(n, np.nan),
+        distance_m=distance,
+        error_code=error_code,
+        in_range=in_range,
+        host_time=host_time,
+    )

@@ -17,17 +17,14 @@ from typing import Callable
 
 import serial
 
-from instruments.laser import commands
 from instruments.laser.block_queue import BlockQueue
-from instruments.laser.frames import OUTPUT_NAMES, FrameParser, RawMeasurements, Reply, value_slots
-from instruments.laser.sensor import (
-    DEFAULT_OUTPUTS, FrameTally, LaserBlock, LaserError, LaserStats, SensorInfo, block_from_raw)
-from instruments.laser.values import CounterUnwrapper
+from instruments.laser.ild1420 import commands
+from instruments.laser.ild1420.frames import OUTPUT_NAMES, FrameParser, RawMeasurements, Reply
+from instruments.laser.ild1420.values import CounterUnwrapper, block_from_raw
+from instruments.laser.sensor import DEFAULT_OUTPUTS, FrameTally, LaserBlock, LaserError, LaserStats, SensorInfo
 
 log = logging.getLogger(__name__)
 
-#: The sensor's factory setting.
-DEFAULT_BAUDRATE = 921_600
 #: How long the reader waits for a byte before it calls the line idle: this
 #: bounds the reply latency on a quiet line and how long close() waits.
 _IDLE_S = 0.02
@@ -47,7 +44,7 @@ class ILD1420:
     name, ``loop://``, ``socket://host:port``) or an already made pyserial
     port, which is then handed over: close() closes it."""
 
-    def __init__(self, port: str | serial.SerialBase, baudrate: int = DEFAULT_BAUDRATE, *,
+    def __init__(self, port: str | serial.SerialBase, baudrate: int = commands.DEFAULT_BAUDRATE, *,
                  reply_timeout_s: float = 1.0, queue_blocks: int = 1024) -> None:
         self._url = port if isinstance(port, str) else getattr(port, "port", None) or repr(port)
         self._given_port = None if isinstance(port, str) else port
@@ -100,12 +97,7 @@ class ILD1420:
         self._require_open()
         if self._started:
             raise LaserError("stop the laser before configuring it")
-        commands.check_rate(rate_hz)
-        try:
-            slots = value_slots(tuple(outputs))
-        except ValueError as exc:
-            raise LaserError(str(exc)) from exc
-        commands.check_bandwidth(self._baudrate, rate_hz, len(slots))
+        commands.check_configuration(self._baudrate, rate_hz, outputs)
         self.command(commands.measrate_command(rate_hz))
         self.command(commands.output_add_command(tuple(outputs)),
                      on_reply=lambda r: self._parser.set_outputs(tuple(outputs)))

@@ -1,5 +1,6 @@
 """What a virtual ILD1420 measures: the shared physics of the emulator
-(bytes on a pseudo-terminal) and SimulatedLaser (in-process blocks).
+(bytes on a pseudo-terminal) and SimulatedLaser (in-process blocks, through
+``decoded_block``: the words decoded as the driver decodes them).
 
 Clocks: the sensor's crystal runs ``clock_ppm`` fast, so on the host clock it
 measures at ``rate_hz * (1 + ppm*1e-6)``. Sample k of a stream is taken at
@@ -24,8 +25,11 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from instruments.laser.values import (
-    COUNTER_MODULUS, X_FULL_SCALE, LaserErrorCode, distance_to_x, timestamp_words)
+from instruments.laser.ild1420.frames import RawMeasurements
+from instruments.laser.ild1420.values import (
+    COUNTER_MODULUS, X_FULL_SCALE, CounterUnwrapper, LaserErrorCode, block_from_raw, distance_to_x,
+    timestamp_words)
+from instruments.laser.sensor import LaserBlock
 
 Displacement = Callable[[np.ndarray], np.ndarray]
 
@@ -71,6 +75,7 @@ class SensorModel:
         self._powered_on = time.monotonic()
         self._timestamp_start_s = timestamp_start_s
         self._counter_next = counter_start
+        self._unwrapper = CounterUnwrapper()  # decoded_block's, as the driver's reader keeps one
         self.t0: float | None = None
 
     @property
@@ -82,9 +87,15 @@ class SensorModel:
         """Measurement output switched on at host time t0."""
         self.t0 = t0
 
+    @property
+    def disconnect_after(self) -> int | None:
+        """The link dies after this many measurements (None: never)."""
+        return self.error_plan.disconnect_after
+
     def reset_counter(self) -> None:
         """RESETCNT: the next measurement carries ``counter_start``."""
         self._counter_next = self.counter_start
+        self._unwrapper.reset()
 
     def sample_times(self, k: np.ndarray) -> np.ndarray:
         """Host seconds after t0 at which samples k of this stream are taken."""
@@ -132,6 +143,11 @@ class SensorModel:
         """(k1-k0, len(slots)) words in slot order, ready to encode."""
         words = self.words(k0, k1)
         return np.stack([words[slot] for slot in slots], axis=1)
+
+    def decoded_block(self, k0: int, k1: int, slots: tuple[str, ...], host_time: float) -> LaserBlock:
+        """Samples k0..k1-1 as the driver would deliver them, without the bytes."""
+        raw = RawMeasurements(slots, self.rows(k0, k1, slots))
+        return block_from_raw(raw, self.measuring_range_m, self._unwrapper, host_time)
 
     def garbage(self) -> bytes:
         return self._rng.integers(0, 256, self.error_plan.garbage_bytes, dtype=np.uint8).tobytes()

@@ -23,9 +23,9 @@ from typing import Mapping
 
 import numpy as np
 
-from instruments.laser import commands
-from instruments.laser.frames import encode_measurements, value_slots
-from instruments.laser.sensor_model import Displacement, ErrorPlan, SensorModel
+from instruments.laser.ild1420 import commands
+from instruments.laser.ild1420.frames import encode_measurements, value_slots
+from instruments.laser.ild1420.sensor_model import Displacement, ErrorPlan, SensorModel
 
 #: The emulator's own error lines (the manual's numbers are not in the spec).
 UNKNOWN_COMMAND = "E200 Unknown command"
