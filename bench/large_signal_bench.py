@@ -42,19 +42,18 @@ def run(workdir: Path) -> list[Row]:
 def _plan_on_the_rig(workdir: Path) -> list[Row]:
     if shutil.which("jackd") is None:
         return [Row("large signal: plan skipped, jackd is not installed (Debian package jackd2)", 0.0, "", "", None)]
-    from instruments.audio import portaudio
+    from instruments.audio import AudioSpec, open_audio, portaudio
     from instruments.laser import LaserSpec, open_laser
     from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
     from instruments.measurement.plan import MeasurementPlan
     from instruments.rig.manager import start_rig, stop_rig
-    from instruments.rig.workstation import rig_audio
 
     name = f"linpar-bench-ls-{os.getpid()}"
     handle = start_rig(name, driver="demo-large-signal", runtime_dir=workdir, seed=5, model="nonlinear")
     times, outcomes = [], []
     try:
         for k in range(PLAN_RUNS):
-            audio = rig_audio(handle)
+            audio = open_audio(AudioSpec("rig", options={"rig": handle}))
             plan = LargeSignalPlan(MeasurementPlan.from_template("large-signal"), 0.5)
             t0 = time.monotonic()
             outcomes.append(run_large_signal(plan, audio, open_laser(LaserSpec(port=handle.state.laser_pty)), workdir / f"plan-{k}",

@@ -32,7 +32,7 @@ def run(workdir: Path) -> list[Row]:
     from analysis.drivers import load_driver
     from analysis.multitone import design_multitone
     from analysis.pipeline import analyze_recording
-    from instruments.audio import JACK_HOSTAPI, AudioDeviceChoice, SoundDeviceAudio, capture, portaudio
+    from instruments.audio import JACK_HOSTAPI, AudioDeviceChoice, AudioSpec, capture, open_audio, portaudio
     from instruments.rig.engine import default_driver
     from instruments.rig.manager import start_rig, stop_rig
 
@@ -42,8 +42,8 @@ def run(workdir: Path) -> list[Row]:
     try:
         portaudio.use_jack_server(rig.state.jack_server)
         mt = design_multitone(SAMPLE_RATE, PERIOD, 5.0, 10000.0, rms=1.0)
-        audio = SoundDeviceAudio(AudioDeviceChoice("system", JACK_HOSTAPI), rig.state.workstation_calibration,
-                                 SAMPLE_RATE, rig.state.workstation_channel_map)
+        audio = open_audio(AudioSpec("sounddevice", AudioDeviceChoice("system", JACK_HOSTAPI),
+                                     rig.state.workstation_calibration, SAMPLE_RATE, rig.state.workstation_channel_map))
         n_periods = math.ceil(MEASURE_S * SAMPLE_RATE / PERIOD)
         rig_xruns_before = rig.command("status")["xruns"]
         cpu_before = {"rig": _cpu_seconds(rig.pid), "jackd": _cpu_seconds(rig.state.jackd_pid), "self": _own_cpu()}

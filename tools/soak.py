@@ -71,8 +71,8 @@ class VirtualRig:
         import dataclasses
 
         from instruments.laser import LaserSpec, open_laser
-        from instruments.rig.workstation import rig_audio
-        audio = rig_audio(self.handle)
+        from instruments.audio import AudioSpec, open_audio
+        audio = open_audio(AudioSpec("rig", options={"rig": self.handle}))
         audio.channel_map = dataclasses.replace(audio.channel_map, laser_analog=None)
         return audio, open_laser(LaserSpec(port=self.handle.command("laser")["laser_pty"]))
 

@@ -23,7 +23,7 @@ def open_devices(args: argparse.Namespace, stack: ExitStack):
         return _sound_card(args), _laser_choice(args.laser, None), {}
     from instruments.audio import portaudio
     from instruments.rig import manager
-    from instruments.rig.workstation import rig_audio
+    from instruments.audio import AudioSpec, open_audio
 
     handle = manager.find_rig(args.rig_name, args.runtime_dir)
     if handle is None:
@@ -31,7 +31,7 @@ def open_devices(args: argparse.Namespace, stack: ExitStack):
         handle = manager.start_rig(args.rig_name, runtime_dir=args.runtime_dir)
         stack.callback(lambda: (say(f"stopping the virtual rig {args.rig_name!r}"),
                                 manager.stop_rig(args.rig_name, args.runtime_dir)))
-    audio = rig_audio(handle)
+    audio = open_audio(AudioSpec("rig", options={"rig": handle}))
     stack.callback(portaudio.release)      # PortAudio lets go of the rig's JACK server before it may stop
     laser = _laser_choice(args.laser, handle.state.laser_pty)
     if args.laser is None and laser is None:
@@ -57,7 +57,7 @@ def laser_sensor(port: str | None):
 
 
 def _sound_card(args: argparse.Namespace):
-    from instruments.audio import Calibration, ChannelMap, SoundDeviceAudio, list_devices
+    from instruments.audio import AudioSpec, Calibration, ChannelMap, list_devices, open_audio
     if args.calibration is None:
         raise MeasurementError("--rig soundcard needs --calibration FILE (the sound card's calibration and "
                                "channel map)")
@@ -83,7 +83,7 @@ def _sound_card(args: argparse.Namespace):
             f"{len(devices)} sound cards match; name one with --device"
         raise MeasurementError(f"{what}; full-duplex cards: {names}")
     rate = SAMPLE_RATE.check(doc.get("sample_rate", 48000), f"{args.calibration}: sample_rate", MeasurementError)
-    return SoundDeviceAudio(devices[0].choice, calibration, rate, channel_map)
+    return open_audio(AudioSpec("sounddevice", devices[0].choice, calibration, rate, channel_map))
 
 
 class Progress:

@@ -112,25 +112,24 @@ def open_audio(config: HardwareConfig, calibration: Calibration | None = None):
     The simulated hardware keeps the true calibration: a correction changes
     only how the workstation reads the samples, as on a real bench.
     """
+    from instruments.audio.factory import AudioSpec
+    from instruments.audio.factory import open_audio as open_spec
+
     calibration = calibration or config.calibration
     if config.kind == SIMULATOR:
-        from instruments.audio.simulated import SimulatedAudio
-        audio = SimulatedAudio(calibration=RIG_CALIBRATION, sample_rate=config.sample_rate,
-                               channel_map=RIG_CHANNEL_MAP, driver=config.simulated_driver,
-                               realtime=config.realtime)
-        audio.channel_map = config.measured_channel_map()
+        spec = AudioSpec("simulated", calibration=RIG_CALIBRATION, sample_rate=config.sample_rate,
+                         options={"driver": config.simulated_driver, "realtime": config.realtime})
     elif config.kind == RIG:
         from instruments.rig.manager import RigError
-        from instruments.rig.workstation import rig_audio
         handle = find_virtual_rig(config.rig_name, config.rig_runtime_dir)
         if handle is None:
             raise RigError(f"the virtual rig {config.rig_name!r} is not running (start it with 'linpar rig "
                            f"start', or choose the in-process simulator)")
-        audio = rig_audio(handle)
-        audio.channel_map = config.measured_channel_map()
+        spec = AudioSpec("rig", options={"rig": handle})
     else:
-        from instruments.audio.sounddevice_audio import SoundDeviceAudio
-        audio = SoundDeviceAudio(config.device, calibration, config.sample_rate, config.measured_channel_map())
+        spec = AudioSpec("sounddevice", config.device, calibration, config.sample_rate)
+    audio = open_spec(spec)
+    audio.channel_map = config.measured_channel_map()
     audio.calibration = calibration
     return audio
 

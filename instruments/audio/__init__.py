@@ -3,7 +3,8 @@ voltage, current and (optionally) the laser's analog output.
 
 ``SoundDeviceAudio`` is the real one (python-sounddevice / PortAudio),
 ``SimulatedAudio`` the in-process simulation with the same constructor shape;
-both satisfy ``AudioInterface``. ``capture`` runs one measurement on either.
+both satisfy ``AudioInterface`` and are made by ``open_audio(AudioSpec(...))``
+(factory.py). ``capture`` runs one measurement on either.
 
 Names are loaded on first use (PEP 562): importing the package loads neither
 PortAudio (that happens when a real stream is opened or the devices are
@@ -16,6 +17,7 @@ _EXPORTS = {
     "capture": "capture_loop", "CaptureStats": "captured", "CapturedSignals": "captured",
     "AudioConfigError": "config", "AudioDeviceChoice": "config", "Calibration": "config", "ChannelMap": "config",
     "JACK_HOSTAPI": "config",
+    "AudioSpec": "factory", "audio_backends": "factory", "open_audio": "factory",
     "AudioError": "errors", "AudioUnavailable": "errors", "CaptureCancelled": "errors",
     "AudioDeviceInfo": "interface", "AudioInterface": "interface",
     "SimulatedAudio": "simulated",

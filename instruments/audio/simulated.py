@@ -43,6 +43,12 @@ SIMULATED_DEVICE = AudioDeviceChoice("simulated rig", "in-process")
 PRECISE_S = 0.0005       # the last stretch before a hand-over is waited out in short sleeps
 
 
+def open_from_spec(spec) -> SimulatedAudio:
+    """The factory's back end "simulated" (instruments/audio/factory.py)."""
+    return SimulatedAudio(spec.device, spec.calibration or RIG_CALIBRATION, spec.sample_rate or 48000,
+                          spec.channel_map or RIG_CHANNEL_MAP, **spec.options)
+
+
 class SimulatedAudio(CoreBackedDevice):
     """AudioInterface on a simulated rig. Constructor shape shared with SoundDeviceAudio.
 

@@ -54,6 +54,14 @@ def find_device(choice: AudioDeviceChoice | None, devices: list[AudioDeviceInfo]
     raise AudioError(f"sound card {choice} not found{hint}; PortAudio lists: {listed}")
 
 
+def open_from_spec(spec) -> SoundDeviceAudio:
+    """The factory's back end "sounddevice" (instruments/audio/factory.py)."""
+    if spec.calibration is None:
+        raise AudioError(f"sound card {spec.device or 'default'}: no calibration given (calibrate the chain first)")
+    return SoundDeviceAudio(spec.device, spec.calibration, spec.sample_rate or 48000,
+                            spec.channel_map or ChannelMap(), **spec.options)
+
+
 class SoundDeviceAudio(CoreBackedDevice):
     """AudioInterface on a PortAudio device. Constructor shape shared with SimulatedAudio."""
 

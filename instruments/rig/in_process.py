@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from instruments.audio.config import ChannelMap
-from instruments.audio.simulated import SimulatedAudio
+from instruments.audio.factory import AudioSpec, open_audio
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.laser_feed import DisplacementFeed, aim_at_cone
 from instruments.simulation.block_driver import BlockDriver
@@ -59,12 +59,11 @@ class InProcessRig:
             raise ValueError(f"laser: {laser!r}, expected one of {', '.join(KINDS)}")
         self.kind = laser
         self.feed = DisplacementFeed(driver.sample_rate)
-        self.audio = SimulatedAudio(calibration=calibration,
-                                    channel_map=RIG_CHANNEL_MAP if laser in ("analog", "none") else
-                                    SERIAL_CHANNEL_MAP,
-                                    sample_rate=driver.sample_rate, driver=driver, blocksize=blocksize,
-                                    realtime=laser in ("simulated", "serial") if realtime is None else realtime,
-                                    seed=seed, feed=self.feed)
+        self.audio = open_audio(AudioSpec(
+            "simulated", calibration=calibration, sample_rate=driver.sample_rate,
+            channel_map=RIG_CHANNEL_MAP if laser in ("analog", "none") else SERIAL_CHANNEL_MAP,
+            options=dict(driver=driver, blocksize=blocksize, seed=seed, feed=self.feed,
+                         realtime=laser in ("simulated", "serial") if realtime is None else realtime)))
         self.laser_settings = {"clock_ppm": float(ppm), "start_latency_s": float(start_latency_s),
                                "link_latency_s": float(link_latency_s)}
         self.error_plan = error_plan

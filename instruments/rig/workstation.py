@@ -19,12 +19,23 @@ def rig_audio(rig: RigHandle | str = DEFAULT_NAME, runtime_dir: Path | None = No
     Call instruments.audio.portaudio.release() before stopping the rig.
     """
     from instruments.audio import portaudio
-    from instruments.audio.sounddevice_audio import SoundDeviceAudio
+    from instruments.audio.factory import AudioSpec, open_audio
 
     handle = rig if isinstance(rig, RigHandle) else find_rig(rig, runtime_dir)
     if handle is None:
         raise RigError(f"rig {rig!r} is not running (start it with 'linpar rig start')")
     state = handle.state
     portaudio.use_jack_server(state.jack_server)
-    return SoundDeviceAudio(RIG_DEVICE, state.workstation_calibration, state.sample_rate,
-                            state.workstation_channel_map, **options)
+    return open_audio(AudioSpec("sounddevice", RIG_DEVICE, state.workstation_calibration, state.sample_rate,
+                                state.workstation_channel_map, options))
+
+
+def open_from_spec(spec):
+    """The factory's back end "rig" (instruments/audio/factory.py): options rig (handle or name) and
+    runtime_dir pick the rig, the others go to SoundDeviceAudio; a calibration or channel map given in
+    the spec replaces the rig's own."""
+    options = dict(spec.options)
+    audio = rig_audio(options.pop("rig", DEFAULT_NAME), options.pop("runtime_dir", None), **options)
+    audio.calibration = spec.calibration or audio.calibration
+    audio.channel_map = spec.channel_map or audio.channel_map
+    return audio

@@ -19,10 +19,9 @@ from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
 from analysis.pipeline import analyze_recording
 from instruments.audio import (
-    JACK_HOSTAPI, AudioDeviceChoice, AudioError, AudioInterface, CaptureCancelled, SimulatedAudio,
-    SoundDeviceAudio, capture)
+    JACK_HOSTAPI, AudioDeviceChoice, AudioError, AudioInterface, AudioSpec, CaptureCancelled, SimulatedAudio,
+    SoundDeviceAudio, capture, open_audio)
 from instruments.rig.engine import RigFaults
-from instruments.rig.workstation import rig_audio
 from tests.pace import paced
 
 PAPER = load_driver("paper")
@@ -39,7 +38,7 @@ class SimulatedSetup:
         self.audio = None
 
     def make_audio(self) -> SimulatedAudio:
-        self.audio = SimulatedAudio(realtime=False, seed=2)
+        self.audio = open_audio(AudioSpec("simulated", options={"realtime": False, "seed": 2}))
         return self.audio
 
     @contextmanager
@@ -59,9 +58,9 @@ class RigSetup:
 
     def make_audio(self) -> SoundDeviceAudio:
         state = self.rig.state
-        audio = SoundDeviceAudio(AudioDeviceChoice("system", JACK_HOSTAPI), state.workstation_calibration,
-                                 state.sample_rate, state.workstation_channel_map)
-        helper = rig_audio(self.rig)                           # the helper builds the same
+        audio = open_audio(AudioSpec("sounddevice", AudioDeviceChoice("system", JACK_HOSTAPI),
+                                     state.workstation_calibration, state.sample_rate, state.workstation_channel_map))
+        helper = open_audio(AudioSpec("rig", options={"rig": self.rig}))     # the rig's back end builds the same
         assert (helper.device, helper.calibration, helper.channel_map) == (audio.device, audio.calibration,
                                                                             audio.channel_map)
         return audio
