@@ -72,3 +72,18 @@ def trace_header(driver: Mapping | None, session: Mapping | None) -> dict:
 def recording_header(recording) -> dict:
     """trace_header of a Recording."""
     return trace_header(recording.driver, session_of(recording))
+
+
+def trace_items(header: Mapping) -> list[str]:
+    """A header as 'key value' items, in HEADER_KEYS order."""
+    return [f"{k.replace('_', ' ')} {header[k]}" for k in HEADER_KEYS if header.get(k)]
+
+
+def trace_line(header: Mapping) -> str:
+    """A header on one line, for the comment lines of curve files."""
+    return ", ".join(trace_items(header))
+
+
+def comment_lines(title: str, header: Mapping, marker: str = "#") -> list[str]:
+    """Comment lines above a table (CSV exports): what it is, the header one item a line, the exporting software."""
+    return [f"{marker} {line}" for line in (title, *trace_items(header), f"exported by {software()}")]

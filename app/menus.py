@@ -21,11 +21,22 @@ GUIDE = "guide.md"
 # The libraries linpar is built on (pyproject.toml's dependencies), for About.
 DEPENDENCIES = ("PySide6-Essentials", "pyqtgraph", "numpy", "scipy", "lmfit", "uncertainties", "matplotlib",
                 "sounddevice", "pyserial", "JACK-Client")
-# Export data…: what each file type holds (analysis.export's kinds).
-DATA_FILTERS = {"Parameters, CSV (*.csv)": "csv", "Parameters, JSON (*.json)": "json",
-                "Measured impedance (*.zma)": "zma", "Predicted SPL (*.frd)": "frd",
-                "WinISD driver file (*.wdr)": "driver"}
-SUFFIX_KIND = {".csv": "csv", ".json": "json", ".zma": "zma", ".frd": "frd", ".wdr": "driver"}
+
+
+def data_filters() -> dict[str, str]:
+    """Export data…: file-dialog filter -> export kind, the registry's formats offered in the menu."""
+    from analysis.export import exporters
+    return {f"{e.title} (*{e.suffix})": e.kind for e in exporters().values() if e.in_menu}
+
+
+def suffix_kind() -> dict[str, str]:
+    """A file's suffix -> the export it gets (the first format of that suffix offered in the menu)."""
+    from analysis.export import exporters
+    kinds: dict[str, str] = {}
+    for e in exporters().values():
+        if e.in_menu:
+            kinds.setdefault(e.suffix, e.kind)
+    return kinds
 
 
 def licence_of(name: str) -> str:
@@ -140,9 +151,10 @@ class Menus:
             return
         stem = result.source.with_suffix("").name if result.source else "parameters"
         start = str(result.source.with_name(stem + ".csv")) if result.source else "parameters.csv"
-        path, chosen = QFileDialog.getSaveFileName(self.window, "Export data", start, ";;".join(DATA_FILTERS))
+        filters = data_filters()
+        path, chosen = QFileDialog.getSaveFileName(self.window, "Export data", start, ";;".join(filters))
         if path:
-            self.export_data_to(Path(path), DATA_FILTERS.get(chosen))
+            self.export_data_to(Path(path), filters.get(chosen))
 
     def export_data_to(self, path: Path, kind: str | None = None) -> bool:
         """Write the shown result as `kind` (from the suffix when None); False, and why, when it cannot be."""
@@ -150,10 +162,11 @@ class Menus:
         from analysis.export import write_exports
         from analysis.recording import read_recording
         result = self.window.results.result
-        kind = kind or SUFFIX_KIND.get(path.suffix.lower())
+        suffixes = suffix_kind()
+        kind = kind or suffixes.get(path.suffix.lower())
         if result is None or kind is None:
             self.window.show_error("Cannot export", f"{path.name}: choose one of "
-                                   f"{', '.join(SUFFIX_KIND)} (the file type says what is written)")
+                                   f"{', '.join(suffixes)} (the file type says what is written)")
             return False
         try:
             recording = read_recording(result.source) if result.source and Path(result.source).exists() else None

@@ -82,7 +82,7 @@ def test_export_csv_json_dfq(capsys, line, tmp_path):
                          "--json", tmp_path / "p.json", "--dfq", tmp_path / "p.dfq")
     assert code == 0, err
     assert out.count("written: ") == 3 and "60 measurement(s)" in err
-    rows = list(csv.DictReader((tmp_path / "p.csv").open()))
+    rows = list(csv.DictReader(line for line in (tmp_path / "p.csv").open() if not line.startswith("#")))
     assert len({r["id"] for r in rows}) == 60 and {r["station"] for r in rows} == {"QA1"}
     assert len(json.loads((tmp_path / "p.json").read_text())["measurements"]) == 60
     from analysis.production.aqdef import read_dfq

@@ -16,12 +16,14 @@ SPL_VOLTAGE), which needs Hx (the laser) and Sd.
 """
 from __future__ import annotations
 
-from typing import Iterable
+from typing import Iterable, Mapping
 
 import numpy as np
 
 from analysis.archive.results import StoredResult
 from analysis.errors import LinparError
+from analysis.export.registry import Exporter
+from analysis.session import trace_line
 from analysis.spl import predicted_spl
 
 MODEL_PER_DECADE = 100
@@ -91,3 +93,17 @@ def frd_text(result: StoredResult, which: str = "measured", title: str = "") -> 
                 f"{SPL_VOLTAGE:g} V rms, {SPL_DISTANCE_M:g} m, half space, Sd = {result.sd_m2:g} m^2",
                 "columns: frequency [Hz], SPL [dB re 20 uPa], phase [degrees]"]
     return _table(comments, "Freq(Hz) SPL(dB) Phase(deg)", (f, spl, phase))
+
+
+def _curve_file(text, which: str):
+    def write(result: StoredResult, header: Mapping) -> bytes:
+        return text(result, which, trace_line(header)).encode("utf-8")
+    return write
+
+
+EXPORTERS = (
+    Exporter("zma", "Measured impedance", ".zma", _curve_file(zma_text, "measured"), rank=20),
+    Exporter("zma_model", "Modelled impedance", ".zma", _curve_file(zma_text, "model"), in_menu=False, rank=21),
+    Exporter("frd", "Predicted SPL from the measured displacement", ".frd", _curve_file(frd_text, "measured"), rank=22),
+    Exporter("frd_model", "Modelled SPL", ".frd", _curve_file(frd_text, "model"), in_menu=False, rank=23),
+)

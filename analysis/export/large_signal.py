@@ -4,30 +4,35 @@
 
 One row per point, CSV_POINTS across the range the measurements covered (the
 polynomials are not exported where they would extrapolate); comment lines
-('#') above the header give the driver, the polynomials (ascending powers of
-x in m), the rest offset and the limits. SI units, decimal point, numbers in
+('#') above the header give the traceability header (analysis.session: driver,
+serial, date, operator, station, template, software), the exporting software,
+the polynomials (ascending powers of x in m), the rest offset and the limits. SI units, decimal point, numbers in
 Python's shortest round-trip form.
 """
 from __future__ import annotations
 
 import json
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from analysis.json_finite import dumps
-from analysis.large_signal.curves import compliance_of
-from analysis.large_signal.result import LargeSignalResult
+from analysis.session import comment_lines
+
+if TYPE_CHECKING:       # the registry looks through this module: it must not load the large-signal fit
+    from analysis.large_signal.result import LargeSignalResult
 
 CSV_POINTS = 101
 
 
 def curves_csv(result: LargeSignalResult) -> str:
+    from analysis.large_signal.curves import compliance_of
     model, derived = result.model, result.derived
     lo, hi = model.x_range
     x = np.linspace(lo, hi, CSV_POINTS)
     names = [n for n in ("Bl", "Kms", "Le", "L2") if n in model.curves]
-    comments = [f"large-signal curves of {result.driver.get('name') or 'the driver'} (linpar)",
-                f"x from {lo!r} to {hi!r} m, positive outwards; 1-sigma columns from the identification"]
+    title = f"large-signal curves of {result.driver.get('name') or 'the driver'} (linpar)"
+    comments = [f"x from {lo!r} to {hi!r} m, positive outwards; 1-sigma columns from the identification"]
     for name in names:
         curve = model.curves[name]
         comments.append(f"{name}(x) = sum c_k x^k [{curve.unit}], c = {json.dumps(curve.coefficients.tolist())}")
@@ -43,7 +48,7 @@ def curves_csv(result: LargeSignalResult) -> str:
         columns[f"{name}_std_{units[name]}"] = curve.sigma(x)
         if name == "Kms":
             columns["Cms_m_per_N"] = compliance_of(curve, x)
-    lines = [f"# {c}" for c in comments] + [",".join(columns)]
+    lines = comment_lines(title, result.header) + [f"# {c}" for c in comments] + [",".join(columns)]
     for row in zip(*columns.values()):
         lines.append(",".join(repr(float(v)) for v in row))
     return "\n".join(lines) + "\n"

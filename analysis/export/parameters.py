@@ -1,12 +1,15 @@
 """Parameters as CSV and JSON: SI values with their standard uncertainty, and the customary unit beside.
 
-CSV: one row per parameter, columns
+CSV: comment lines starting with '#' (what the file is, the traceability
+header of analysis.session one item a line: driver, serial, date, operator,
+station, template, software; and the exporting software), then one row per
+parameter, columns
 
     parameter, value, std, unit, display_value, display_std, display_unit, note
 
 (value and std in SI; display_* = SI x display_scale; an empty value with a
 note says why it is missing). Decimal point '.', comma-separated, UTF-8,
-RFC 4180 quoting.
+RFC 4180 quoting. A reader skips the '#' lines (pandas: comment="#").
 
 JSON ("linpar-parameters/1"): the driver header, the parameters keyed by
 name ({value, std, unit, display_unit, display_scale, reason}), the model
@@ -20,6 +23,8 @@ import json
 from typing import Mapping
 
 from analysis.archive.results import StoredResult
+from analysis.export.registry import Exporter
+from analysis.session import comment_lines
 
 JSON_FORMAT = "linpar-parameters/1"
 CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note")
@@ -29,8 +34,10 @@ def _num(x) -> str:
     return "" if x is None else repr(float(x))
 
 
-def parameters_csv(result: StoredResult) -> str:
+def parameters_csv(result: StoredResult, header: Mapping | None = None) -> str:
     buf = io.StringIO()
+    title = "linpar parameters: value and std in SI, display_value and display_std in display_unit"
+    buf.writelines(line + "\n" for line in comment_lines(title, header or {}))
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
     for p in result.parameters.values():
@@ -55,3 +62,12 @@ def parameters_json(result: StoredResult, header: Mapping | None = None) -> str:
         "validity": result.overall,
     }
     return json.dumps(doc, indent=1, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+# A result with nothing fitted (a broken measurement) still exports its parameters, each "not measured" and why.
+EXPORTERS = (
+    Exporter("csv", "Parameters, CSV", ".csv", lambda result, header: parameters_csv(result, header).encode("utf-8"),
+             needs_fit=False, rank=10),
+    Exporter("json", "Parameters, JSON", ".json",
+             lambda result, header: parameters_json(result, header).encode("utf-8"), needs_fit=False, rank=11),
+)

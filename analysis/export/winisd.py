@@ -110,6 +110,7 @@ import numpy as np
 
 from analysis.archive.results import StoredResult
 from analysis.derived import C_SOUND, RHO
+from analysis.export.registry import Exporter
 
 ENCODING = "utf-8"
 NEWLINE = "\r\n"
@@ -254,3 +255,6 @@ def wdr_text(result: StoredResult, header: Mapping | None = None) -> str:
 
 def wdr_bytes(result: StoredResult, header: Mapping | None = None) -> bytes:
     return wdr_text(result, header).encode(ENCODING)
+
+
+EXPORTERS = (Exporter("driver", "WinISD driver file", ".wdr", wdr_bytes, rank=30),)

@@ -12,7 +12,7 @@ must read) and "distortion" (the predictions asked for).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Sequence
 
@@ -27,6 +27,7 @@ from analysis.large_signal.model import LargeSignalModel, model_of
 from analysis.large_signal.simulate import SimulationDiverged
 from analysis.large_signal.stepping import VOLTAGE_DISTORTION_DB, clipped_inputs, distortion_db
 from analysis.recording import Recording, read_recording
+from analysis.session import recording_header
 
 # Flags: a misfit this many times the noise; explained distortion below this; a band wider than this at the edges.
 CHI2_RED_DOUBTFUL = 2.0
@@ -53,6 +54,7 @@ class LargeSignalResult:
     flags: tuple[str, ...]
     predictions: tuple[dict, ...]
     driver: dict
+    header: dict = field(default_factory=dict)     # traceability (analysis.session) of the first recording
 
     def as_json(self) -> dict:
         ident, model = self.identification, self.model
@@ -121,7 +123,8 @@ def large_signal(items: Sequence[Recording | str | Path], max_order: int = MAX_O
         if distorted >= VOLTAGE_DISTORTION_DB:
             flags.append(f"{d.label}: the voltage itself is distorted ({distorted:.0f} dB): the amplifier or the "
                          f"sound card limits at {fit.drive_rms_v:.3g} V (the curves rest on the voltage measured)")
-    return LargeSignalResult(model, ident, limits, thresholds, fits, tuple(flags), tuple(done), driver)
+    return LargeSignalResult(model, ident, limits, thresholds, fits, tuple(flags), tuple(done), driver,
+                             recording_header(recordings[0]))
 
 
 def _prediction(model: LargeSignalModel, data, p: Prediction) -> dict:

@@ -4,11 +4,16 @@ Values in SI with their unit, as the archive keeps them; a parameter a
 measurement could not give is a row with an empty value (CSV) or null (JSON),
 so that its absence is seen, not guessed. The measurements a statistic leaves
 out (red, not judgeable) are exported too, with their validity and verdict.
+The CSV starts with '#' comment lines (what it is, the exporting software);
+each row carries its own measurement's traceability (date, station, driver,
+serial, operator).
 """
 from __future__ import annotations
 
 import csv
 import io
+
+from analysis.session import comment_lines
 
 CSV_COLUMNS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict",
                "limits_version", "parameter", "value", "std", "unit")
@@ -23,6 +28,8 @@ def _units(names) -> dict[str, str]:
 
 def population_csv(population) -> str:
     out = io.StringIO()
+    title = "linpar population: one row per measurement and parameter, value and std in the unit of the row"
+    out.writelines(line + "\n" for line in comment_lines(title, {}))
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
     units = _units(population.values)

@@ -18,10 +18,12 @@ from app.cli import effects
 from app.cli.archive_server import add_archive_options, open_from_args
 from app.cli.options import CliError, add_model_option, add_sd_option, model_effects
 
-EXPORT_OPTIONS = (("csv", "parameters as CSV"), ("json", "parameters as JSON"),
-                  ("zma", "measured impedance (.zma)"), ("zma_model", "modelled impedance (.zma)"),
-                  ("frd", "predicted SPL from the measured Hx (.frd)"), ("frd_model", "modelled SPL (.frd)"),
-                  ("driver", "driver file for WinISD (.wdr)"))
+
+
+def export_options() -> list[tuple[str, str]]:
+    """(kind, help) of every export format in analysis.export's registry."""
+    from analysis.export import exporters
+    return [(e.kind, f"{e.title} ({e.suffix})") for e in exporters().values()]
 
 
 def _source_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,7 +45,7 @@ def register(sub) -> None:
 
     export = sub.add_parser("export", help="parameters, curves and a driver file of one measurement")
     _source_arguments(export)
-    for kind, what in EXPORT_OPTIONS:
+    for kind, what in export_options():
         export.add_argument(f"--{kind.replace('_', '-')}", dest=kind, metavar="FILE", help=what)
     export.set_defaults(run=run_export)
 
@@ -94,10 +96,11 @@ def run_report(args: argparse.Namespace) -> int:
 
 
 def run_export(args: argparse.Namespace) -> int:
-    targets = {kind: getattr(args, kind) for kind, _ in EXPORT_OPTIONS if getattr(args, kind)}
+    options = export_options()
+    targets = {kind: getattr(args, kind) for kind, _ in options if getattr(args, kind)}
     if not targets:
         raise CliError("export: give at least one of " + ", ".join(
-            f"--{k.replace('_', '-')} FILE" for k, _ in EXPORT_OPTIONS))
+            f"--{k.replace('_', '-')} FILE" for k, _ in options))
     _outputs_spare_the_inputs(args, [(f"--{k.replace('_', '-')}", p) for k, p in targets.items()])
     from analysis.export import write_exports
     stored, header, _, _ = load_source(args)

@@ -69,8 +69,13 @@ def test_frd_needs_hx_and_sd(z_only):
         export_bytes("frd", z_only)
 
 
+def csv_rows(data: bytes) -> list[dict]:
+    """The rows of a CSV export, its '#' comment lines skipped as any reader of it would."""
+    return list(csv.DictReader(line for line in io.StringIO(data.decode()) if not line.startswith("#")))
+
+
 def test_parameters_csv_and_json(stored):
-    rows = list(csv.DictReader(io.StringIO(export_bytes("csv", stored).decode())))
+    rows = csv_rows(export_bytes("csv", stored))
     by_name = {r["parameter"]: r for r in rows}
     assert list(by_name) == list(stored.parameters)
     mms = by_name["Mms"]
@@ -85,7 +90,7 @@ def test_parameters_csv_and_json(stored):
 
 
 def test_missing_parameters_are_empty_with_a_reason(z_only):
-    rows = {r["parameter"]: r for r in csv.DictReader(io.StringIO(export_bytes("csv", z_only).decode()))}
+    rows = {r["parameter"]: r for r in csv_rows(export_bytes("csv", z_only))}
     assert rows["Bl"]["value"] == "" and "displacement" in rows["Bl"]["note"]
 
 
@@ -93,3 +98,16 @@ def test_one_failing_export_writes_no_file(tmp_path, z_only):
     with pytest.raises(ExportError):
         write_exports(z_only, {"csv": tmp_path / "p.csv", "frd": tmp_path / "s.frd"})
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_parameters_csv_carries_the_traceability_header(stored):
+    header = {"driver": "W6", "serial": "SN-7", "measured_at": "2026-01-02T03:04:05Z", "operator": "A. Tester",
+              "station": "bench-2", "template": "woofer", "software": "linpar 9.9"}
+    text = export_bytes("csv", stored, header).decode()
+    comments = [line for line in text.splitlines() if line.startswith("#")]
+    assert text.startswith("# linpar parameters") and len(comments) == 2 + len(header)
+    for value in header.values():
+        assert sum(value in line for line in comments) == 1
+    assert comments[-1].startswith("# exported by linpar")
+    first_row = text.splitlines()[len(comments)]
+    assert first_row == "parameter,value,std,unit,display_value,display_std,display_unit,note"

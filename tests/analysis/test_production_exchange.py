@@ -56,7 +56,9 @@ def test_golden_units_that_cannot_be_used_are_refused_with_one_line():
 
 def test_csv_is_long_and_json_has_every_measurement():
     pop = population([70.0, None, 71.0])
-    rows = list(csv.reader(io.StringIO(population_csv(pop))))
+    text = population_csv(pop)
+    assert text.startswith("# linpar population") and "# exported by linpar" in text
+    rows = list(csv.reader(line for line in io.StringIO(text) if not line.startswith("#")))
     assert tuple(rows[0]) == CSV_COLUMNS and len(rows) == 1 + 3 * 2
     fs_rows = [r for r in rows[1:] if r[9] == "fs"]
     assert [r[10] for r in fs_rows] == ["70.0", "", "71.0"] and fs_rows[0][12] == "Hz"

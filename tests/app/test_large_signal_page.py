@@ -94,6 +94,10 @@ def test_the_report_and_the_curves_are_saved_by_their_suffix(page, result, tmp_p
     assert json.loads((tmp_path / "r.json").read_text())["x_unit"] == "m"
     assert (tmp_path / "r.pdf").read_bytes().startswith(b"%PDF")
     assert "x_m,Bl_Tm" in (tmp_path / "r.csv").read_text()
+    from analysis.importers.table import read_table      # the project's own reader takes it back, comments and all
+    table = read_table(tmp_path / "r.csv")
+    assert table.header[:2] == ("x_m", "Bl_Tm") and table.values.shape[0] == 101
+    assert "# exported by linpar" in (tmp_path / "r.csv").read_text()
     page.save(tmp_path / "r.txt")
     assert "Not saved" in page.status.text() and not (tmp_path / "r.txt").exists()
     page.save(tmp_path)

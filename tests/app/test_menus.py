@@ -73,7 +73,9 @@ def test_exports_wait_for_a_result_then_write_report_and_data(qtbot, window, rec
     data = tmp_path / "parameters.csv"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(data), "Parameters, CSV (*.csv)"))
     window.menus.export_data_action.trigger()
-    rows = {row["parameter"]: row for row in csv.DictReader(data.open(encoding="utf-8"))}
+    lines = data.read_text(encoding="utf-8").splitlines()
+    assert lines[0].startswith("# linpar parameters")
+    rows = {row["parameter"]: row for row in csv.DictReader(line for line in lines if not line.startswith("#"))}
     assert float(rows["RE"]["value"]) == window.results.result.parameters["RE"].value
     assert str(data) in window.status_label.text()
 
