@@ -25,7 +25,7 @@ MAX_BLOCK = 1000
 class SimulatedLaser:
     def __init__(self, model: LaserModel, port: str | None = None, baudrate: int | None = None, *,
                  connected: bool = True, **physics) -> None:
-        self.spec = model
+        self.laser_model = model
         self._url = port or f"sim://{model.name}"
         self._baudrate = baudrate or model.default_baudrate
         self._connected = connected
@@ -44,18 +44,19 @@ class SimulatedLaser:
 
     def open(self) -> SensorInfo:
         if not self._connected:
-            raise LaserError(f"no {self.spec.family} answering on {self._url}: the simulated laser is not connected")
+            raise LaserError(f"no {self.laser_model.family} answering on {self._url}: "
+                             "the simulated laser is not connected")
         self._open = True
         mr_mm = round(self.model.measuring_range_m * 1000)
-        return SensorInfo(name=f"{self.spec.family}-{mr_mm} (simulated)", serial="00000000",
+        return SensorInfo(name=f"{self.laser_model.family}-{mr_mm} (simulated)", serial="00000000",
                           measuring_range_m=self.model.measuring_range_m, firmware="simulated")
 
     def configure(self, rate_hz: float, outputs: tuple[str, ...] = DEFAULT_OUTPUTS) -> None:
         self._require_open()
         if self._started:
             raise LaserError("stop the laser before configuring it")
-        self.spec.check_configuration(self._baudrate, rate_hz, outputs)
-        self._slots = self.spec.layout(outputs)
+        self.laser_model.check_configuration(self._baudrate, rate_hz, outputs)
+        self._slots = self.laser_model.layout(outputs)
         self.model.rate_hz = float(rate_hz)
 
     def start(self) -> None:
