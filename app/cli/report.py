@@ -19,7 +19,6 @@ from app.cli.archive_server import add_archive_options, open_from_args
 from app.cli.options import CliError, add_model_option, add_sd_option, model_effects
 
 
-
 def export_options() -> list[tuple[str, str]]:
     """(kind, help) of every export format in analysis.export's registry."""
     from analysis.export import exporters

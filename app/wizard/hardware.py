@@ -164,7 +164,7 @@ def test_audio(config: HardwareConfig, cancel: threading.Event | None = None, pr
 
 def test_laser(config: HardwareConfig) -> str:
     """Open the serial laser, set its rate, read a little: what it is and what it reads."""
-    from instruments.laser import open_laser
+    from instruments.laser import LaserError, open_laser
 
     if config.laser != SERIAL_LASER:
         return "no serial laser chosen"
