@@ -17,8 +17,7 @@ PATH_CALLS = {"Path", "PurePath", "PurePosixPath", "open", "join", "listdir", "s
 # Where a system's own path is the point, and why.
 ALLOWED = {
     "instruments/rig/": "the virtual rig: JACK and pseudo-terminals, Linux only by design",
-    "instruments/laser/emulator.py": "the laser's emulator on a pseudo-terminal (Linux, macOS)",
-    "instruments/laser/ild1420/emulator.py": "the same, in the laser model's own package",
+    "instruments/laser/ild1420/emulator.py": "the laser's emulator on a pseudo-terminal (Linux, macOS)",
     "instruments/serial_ports.py": "each system's name for a USB serial port, shown as an example",
     "instruments/audio/portaudio.py": "JACK2's socket folder, asked on Linux only",
     "tools/soak.py": "soaks the virtual rig (Linux): memory, files and threads from /proc/self",

@@ -71,5 +71,6 @@ def open_laser(spec: LaserSpec) -> DisplacementSensor:
         from instruments.laser.simulated import SimulatedLaser
         return SimulatedLaser(model, spec.port or None, baudrate, **spec.options)
     if not spec.port:
-        raise LaserError("give the laser's serial port (a device such as /dev/ttyUSB0 or COM3)")
+        from instruments.serial_ports import port_example
+        raise LaserError(f"give the laser's serial port (a device such as {port_example()})")
     return model.make_driver(spec.port, baudrate, **spec.options)
