@@ -11,10 +11,6 @@ What crosses to the GUI thread is frozen: LiveFrames (analysis.live), the
 level decision, the resistor check, the finished measurement (a
 MeasureOutcome holding an app.workers.AnalysisOutcome, ready for the Results
 page and the Model lab), or one line of text.
-
-The measurement itself is instruments.measurement's run_measurement when
-that is installed, else app.wizard.tasks' fallback (capture + live frames +
-write_recording + analyze_recording); `runner_name()` says which.
 """
 from __future__ import annotations
 
@@ -33,20 +29,11 @@ from app.job_book import JobBook, failure_text
 
 
 PROGRESS_STEP = 0.005       # a progress bar 200 pixels wide does not move for less
-FALLBACK_NAME = "app.wizard.tasks (capture, live frames, write_recording, analyze_recording)"
-
-
-def runner_name() -> str:
-    from app.wizard.plans import find_runner
-    return "instruments.measurement.run_measurement" if find_runner() is not None else FALLBACK_NAME
 
 
 def _cancel_errors() -> tuple[type[BaseException], ...]:
     from instruments.audio.errors import CaptureCancelled
-    try:
-        from instruments.measurement import MeasurementCancelled
-    except ImportError:
-        return CaptureCancelled, FitCancelled
+    from instruments.measurement import MeasurementCancelled
     return CaptureCancelled, FitCancelled, MeasurementCancelled
 
 

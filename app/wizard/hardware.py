@@ -28,9 +28,6 @@ TEST_PERIOD = 8192
 TEST_PERIODS = 2
 TEST_SETTLE = 9           # 9 x 8192 > the virtual rig's 65,536-tap FIR plus a block of latency
 TEST_LEVEL_V = 0.1        # V rms: quiet, and well inside any driver's small-signal range
-# What the wizard can measure today. The serial laser needs the audio-laser alignment of the measurement runner.
-SERIAL_LASER_MISSING = ("the serial laser needs the measurement runner (instruments/measurement), which is not "
-                        "in this installation: use the laser's analog output on an input of the sound card")
 
 
 @dataclass(frozen=True, slots=True)

@@ -10,10 +10,9 @@ from PySide6.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, 
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
 from app.wizard.device_lists import SerialPortList, SoundCardList
 from app.wizard.hardware import (
-    ANALOG_LASER, NO_LASER, RIG, SERIAL_LASER, SERIAL_LASER_MISSING, SIMULATOR, SOUNDCARD, HardwareConfig,
+    ANALOG_LASER, NO_LASER, RIG, SERIAL_LASER, SIMULATOR, SOUNDCARD, HardwareConfig,
     find_virtual_rig, virtual_rig_unavailable)
 from app.wizard.hardware_form import CalibrationForm, ChannelMapForm
-from app.wizard.plans import find_runner
 from instruments.audio.config import AudioConfigError, AudioDeviceChoice, Calibration, ChannelMap
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 from instruments.rig.state import DEFAULT_NAME
@@ -208,11 +207,8 @@ class HardwarePage(WizardPage):
             return f"The channel map is not possible: {exc}"
         if config.laser == ANALOG_LASER and config.channel_map.laser_analog is None:
             return "Give the laser's analog input in the channel map, or choose 'No laser'."
-        if config.laser == SERIAL_LASER:
-            if find_runner() is None:
-                return "The serial laser cannot be used yet: " + SERIAL_LASER_MISSING + "."
-            if not config.laser_port:
-                return f"Give the laser's serial port (a device such as {port_example()}), or choose another laser."
+        if config.laser == SERIAL_LASER and not config.laser_port:
+            return f"Give the laser's serial port (a device such as {port_example()}), or choose another laser."
         return None
 
     @property

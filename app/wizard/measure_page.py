@@ -8,7 +8,6 @@ from PySide6.QtCore import QStandardPaths, Signal
 from PySide6.QtWidgets import QDoubleSpinBox, QFileDialog, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.live_panels import LivePanels
-from app.measure_session import runner_name
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
 from app.wizard.plans import LARGE_SIGNAL, TEMPLATES
 from app.wizard.tasks import MeasurementRequest
@@ -127,7 +126,7 @@ class MeasurePage(WizardPage):
         self.large_signal.setVisible(self.is_large_signal())
         self.start_button.setText("Start the large-signal plan" if self.is_large_signal() else
                                   "Start the measurement")
-        self.summary.setToolTip(f"Level: {s.level_reason}\nMeasured by {runner_name()}")
+        self.summary.setToolTip(f"Level: {s.level_reason}")
         self.changed.emit()
 
     def missing(self) -> str | None:

@@ -1,12 +1,10 @@
 """What the wizard measures with: the driver's data and a template per driver class. Qt-free.
 
 The excitation of each class (band, period, periods averaged) is
-instruments.measurement's template when that runner is installed, so the
-wizard measures exactly what `linpar measure` would; the level check's limits
-(where to start, the maximum voltage, the excursion limit) are the wizard's
-own, since the runner measures at one given level. Without the runner the
-FALLBACK excitations below are used: periods of 16,384 samples at 48 kHz,
-which divide the virtual rig's 65,536-tap FIR so its steady state is exact.
+instruments.measurement's template, so the wizard measures exactly what
+`linpar measure` would; the level check's limits (where to start, the maximum
+voltage, the excursion limit) are the wizard's own, since the runner measures
+at one given level.
 """
 from __future__ import annotations
 
@@ -14,6 +12,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from analysis.multitone import Multitone, design_multitone
+from instruments.measurement import TEMPLATES as RUNNER_TEMPLATES, MeasurementPlan
 
 SAMPLE_RATE = 48000
 LARGE_SIGNAL = "large-signal"       # the template whose measurement is the large-signal plan, not one recording
@@ -80,45 +79,18 @@ LEVEL_LIMITS = {
     # The level check finds the small-signal level the large-signal plan starts from (app/wizard/tasks.py).
     LARGE_SIGNAL: ("Large signal: Bl(x), Kms(x), Le(x) (woofers, midranges)", 0.05, 5.0, 0.5e-3),
 }
-# key: (f_min, f_max, period, periods, settle) when instruments.measurement is not installed.
-FALLBACK = {
-    "woofer": (5.0, 10000.0, 16384, 16, 5),
-    "midrange": (20.0, 20000.0, 16384, 16, 5),
-    "tweeter": (200.0, 20000.0, 16384, 16, 5),
-    "microspeaker": (50.0, 20000.0, 16384, 16, 5),
-    "large-signal": (5.0, 10000.0, 16384, 4, 5),
-}
-
-
-def find_runner():
-    """instruments.measurement's runner with its crash journal (recovery.run_journaled: run_measurement's
-    arguments and outcome), or None while that package does not have it."""
-    try:
-        from instruments.measurement.recovery import run_journaled
-    except ImportError:
-        return None
-    return run_journaled
-
-
 def _probe_periods(period: int) -> int:
     return max(3, math.ceil(PROBE_SECONDS * SAMPLE_RATE / period))
 
 
 def _templates() -> dict[str, Template]:
     out = {}
-    runner = find_runner()
     for key, (title, v_min, v_max, x_limit) in LEVEL_LIMITS.items():
-        if runner is not None:
-            from instruments.measurement import TEMPLATES as RUNNER_TEMPLATES, MeasurementPlan
-            t = RUNNER_TEMPLATES[key]
-            settle = MeasurementPlan.from_template(key).settle
-            out[key] = Template(key, title, t.f_min_hz, t.f_max_hz, t.period_samples, t.n_periods, settle,
-                                _probe_periods(t.period_samples), v_min, v_max, x_limit,
-                                lines_per_octave=t.lines_per_octave)
-        else:
-            f_min, f_max, period, n, settle = FALLBACK[key]
-            out[key] = Template(key, title, f_min, f_max, period, n, settle, _probe_periods(period), v_min, v_max,
-                                x_limit)
+        t = RUNNER_TEMPLATES[key]
+        settle = MeasurementPlan.from_template(key).settle
+        out[key] = Template(key, title, t.f_min_hz, t.f_max_hz, t.period_samples, t.n_periods, settle,
+                            _probe_periods(t.period_samples), v_min, v_max, x_limit,
+                            lines_per_octave=t.lines_per_octave)
     return out
 
 
