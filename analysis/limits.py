@@ -253,12 +253,13 @@ def _blocker(validity: Mapping | str) -> tuple[str, str] | None:
 
 
 def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
-    """The QA verdict as JSON: "pass", "fail", "invalid" when the measurement itself is red, or "not judged"
-    when the model does not describe it (analysis.validity_fit.qa_blocker; `validity`: the result's validity,
-    or its overall light alone).
+    """The QA verdict as JSON: "pass", "fail", "invalid" when the measurement itself is red (shown as FAIL), or
+    "not judged" when the model does not describe it (analysis.validity_fit.qa_blocker; `validity`: the result's
+    validity, or its overall light alone).
 
-    A red measurement's parameters are worthless (physics.md section 5):
-    they can neither pass nor fail a driver, the driver must be measured again.
+    A red measurement's parameters are worthless (physics.md section 5): none
+    of them is judged against its limit; the unit fails the test, and the why
+    says it is the measurement that must be repeated.
     """
     verdicts = limits.judge(parameters)
     blocker = _blocker(validity)
@@ -279,10 +280,7 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
         mark = "pass" if v.passed else "FAIL"
         lines.append(f"  {limit.name:<14}{shown:>18}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))
-    if doc["verdict"] == "invalid":
-        lines.append(f"QA: INVALID: {doc['why']}")
-    elif doc["verdict"] == "not judged":
-        lines.append(f"QA: NOT JUDGED: {doc['why']}")
-    else:
-        lines.append(f"QA: {doc['verdict'].upper()}")
+    from analysis.validity_fit import VERDICT_HEADLINES
+    why = f" — {doc['why']}" if doc.get("why") else ""
+    lines.append(f"QA: {VERDICT_HEADLINES[doc['verdict']]}{why}")
     return "\n".join(lines)

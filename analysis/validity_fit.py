@@ -15,8 +15,13 @@ the measurement's analysis step, the GUI), in three steps:
    finding: the model does not describe this measurement. Its findings go on
    the signal the fitted channel answers with: the impedance's on the current
    (Z = U / I, the current's response to the voltage), Hx's on the displacement.
-3. `qa_blocker(validity)`: a red measurement is invalid, a misfit one is not
-   judged; neither ever passes (or fails) a driver against QA limits.
+3. `qa_blocker(validity)`: a red measurement FAILS the QA test (the unit does
+   not pass it) with the honest reason: the measurement is broken, the unit
+   itself was not judged, and what to do. A misfit one (a valid measurement
+   the model does not describe) is NOT JUDGED, with the reason. Neither is
+   judged against the limits parameter by parameter. Every place that shows a
+   QA verdict (the QA page, reports, `linpar analyze --limits`) takes its
+   headline from VERDICT_HEADLINES.
 """
 from __future__ import annotations
 
@@ -33,7 +38,10 @@ from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Fi
 UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)
 # The signal channel whose light a fitted channel's findings go on.
 FIT_SIGNAL = {"impedance": "current", "displacement": "displacement"}
+# The QA verdicts' codes (as stored in the archive and written in JSON) and what a user reads for each: a broken
+# measurement keeps its own code, so production statistics leave it out, but it is shown as a FAIL.
 INVALID, NOT_JUDGED = "invalid", "not judged"
+VERDICT_HEADLINES = {"pass": "PASS", "fail": "FAIL", INVALID: "FAIL", NOT_JUDGED: "NOT JUDGED"}
 MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar diagnose') and fit again; if no effect "
                  "helps, check the wiring and the channels' findings")
 
@@ -104,17 +112,19 @@ def red_findings_text(validity: Mapping) -> str:
     red = [f for channel in (validity.get("channels") or {}).values() for f in channel.get("findings") or ()
            if f.get("severity") == "red"]
     if not red:
-        return "a channel is red"
+        return "a channel is red: read its light"
     first = red[0]
     more = f" (and {len(red) - 1} more red finding{'s' if len(red) > 2 else ''})" if len(red) > 1 else ""
-    return f"{first.get('message')} [{first.get('code')}]{more}; remedy: {first.get('remedy')}"
+    return f"{first.get('message')} [{first.get('code')}]{more}: {first.get('remedy')}"
 
 
 def qa_blocker(validity: Mapping) -> tuple[str, str] | None:
-    """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None."""
+    """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None.
+
+    INVALID is shown as FAIL (VERDICT_HEADLINES): the why says it is the measurement that is broken."""
     if validity.get("overall") == "red":
-        return INVALID, (f"the measurement is invalid: {red_findings_text(validity)}; its parameters judge "
-                         "nothing: fix this and measure this driver again")
+        return INVALID, (f"measurement invalid: {red_findings_text(validity)}, and measure again; the unit "
+                         "itself was not judged")
     for channel in (validity.get("channels") or {}).values():
         for finding in channel.get("findings") or ():
             if finding.get("code") == MODEL_MISFIT:

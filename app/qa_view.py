@@ -6,8 +6,9 @@ file (analysis.limits), and the report export (analysis.report). Both come
 from other packages: when one is not installed its button stays disabled and
 says why, rather than pretending.
 
-The verdict keeps the two questions apart: a red measurement is not a failed
-driver, it is a driver not judged (measure it again).
+A red measurement FAILS the test, with a reason that says it is the
+measurement that is broken (measure again; the unit itself was not judged);
+one the model does not describe is NOT JUDGED (analysis.validity_fit).
 """
 from __future__ import annotations
 
@@ -30,8 +31,7 @@ LIMITS_MODULE, REPORT_MODULE = "analysis.limits", "analysis.report"
 NO_LIMITS = "QA limits need analysis/limits.py, which this installation does not have."
 NO_REPORT = "Reports need the analysis.report package, which this installation does not have."
 LIMITS_KEY = "qa/limits_file"
-VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"),
-                   "not judged": ("#fff1c9", "#7a5300"), "none": ("#e6e6e6", "#404040")}
+NO_VERDICT = ("#e6e6e6", "#404040")         # (background, text) before there is anything to judge
 COLUMNS = ("Parameter", "Measured", "Limit", "Result")
 
 
@@ -58,7 +58,7 @@ def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str
     validity_overall = str(validity.get("overall", "unknown"))
     blocker = qa_blocker(validity)
     if blocker is not None:
-        return "not judged", blocker[1]
+        return blocker
     if limits_verdict is None:
         return "none", "no limits loaded: only the measurement's validity is judged"
     if limits_verdict == "fail":
@@ -108,7 +108,7 @@ class ReportWorker(QObject):
 
 
 class QAView(QWidget):
-    verdict_changed = Signal(str)       # "pass" | "fail" | "not judged" | "none"
+    verdict_changed = Signal(str)       # "pass" | "fail" | "invalid" | "not judged" | "none"
     report_written = Signal(str)
 
     def __init__(self, settings: QSettings | None = None, parent=None):
@@ -269,7 +269,7 @@ class QAView(QWidget):
             return
         self.verdicts = self.limits.judge(self.result.parameters)
         # Parameters of an invalid measurement, or of a model that does not describe it, are worthless
-        # (physics.md section 5): not a pass, not a fail.
+        # (physics.md section 5): no parameter is judged against its limit (the verdict says why).
         from analysis.validity_fit import qa_blocker
         invalid = qa_blocker(self.result.validity) is not None
         self.table.setRowCount(len(self.verdicts))
@@ -299,8 +299,10 @@ class QAView(QWidget):
             verdict, why = "none", "nothing to judge yet"
         else:
             verdict, why = qa_verdict(self.result.validity, limits_verdict)
-        background, text = VERDICT_COLOURS[verdict]
-        title = {"pass": "PASS", "fail": "FAIL", "not judged": "NOT JUDGED", "none": "NO VERDICT"}[verdict]
+        from analysis.report.qa import VERDICT_COLOURS
+        from analysis.validity_fit import VERDICT_HEADLINES
+        background, text = VERDICT_COLOURS.get(verdict, NO_VERDICT)
+        title = VERDICT_HEADLINES.get(verdict, "NO VERDICT")
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "
                                          f"border: 1px solid {text}; border-radius: 4px; }}")
         self.verdict_label.setText(f"<span style='font-size:20pt'><b>{title}</b></span><br>{html.escape(why)}")

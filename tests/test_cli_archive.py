@@ -121,7 +121,7 @@ def test_analyze_limits_exit_codes(capsys, rec_path, red_path, tmp_path):
     doc = json.loads(out)
     assert code == 1 and doc["limits"]["verdict"] == "fail" and doc["limits"]["parameters"][0]["pass"] is False
     code, out, err = run(capsys, "analyze", red_path, "--limits", ok)
-    assert code == 2 and "INVALID" in out
+    assert code == 2 and "QA: FAIL — measurement invalid" in out
     broken = write_limits(tmp_path, fs={"nominal": 50, "unit": "Hz"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", broken)
     assert code == 2 and out == ""

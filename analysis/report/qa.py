@@ -1,11 +1,11 @@
 """The QA limits part of a report: the overall verdict and, per parameter, value, limit and margin.
 
 Numbers are shown in the unit the limits file uses for that parameter, so
-the operator reads them against the file as written. The verdict keeps the
-two questions apart as the QA page does: a red measurement, or one the model
-does not describe, is not judged (its parameters are worthless: measure the
-driver again, or find the model; analysis.validity_fit.qa_blocker), it does
-not fail the driver.
+the operator reads them against the file as written. The verdict is the QA
+page's (analysis.validity_fit.qa_blocker): a red measurement FAILS with the
+reason that the measurement is broken (measure again; the unit itself was
+not judged), one the model does not describe is NOT JUDGED (find the model).
+Either way no parameter is judged against its limit.
 """
 from __future__ import annotations
 
@@ -14,11 +14,11 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue
 from analysis.report.numbers import format_number
+from analysis.validity_fit import INVALID, NOT_JUDGED, VERDICT_HEADLINES, qa_blocker
 
-HEADLINES = {"pass": "PASS", "fail": "FAIL", "not judged": "NOT JUDGED"}
-# (background, text) of the verdict banner: the QA page's colours.
-VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"),
-                   "not judged": ("#fff1c9", "#7a5300")}
+# (background, text) of the verdict banner, also the QA page's: an invalid measurement is a FAIL, in red.
+VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"), INVALID: ("#f8d4d4", "#8e1b1b"),
+                   NOT_JUDGED: ("#fff1c9", "#7a5300")}
 
 
 @dataclass(frozen=True)
@@ -36,13 +36,13 @@ class LimitRow:
 class QASection:
     file: str            # the limits file's name (no folders: a report travels)
     name: str            # the name the file gives itself
-    verdict: str         # "pass" | "fail" | "not judged"
+    verdict: str         # "pass" | "fail" | "invalid" | "not judged"
     why: str
     rows: tuple[LimitRow, ...]
 
     @property
     def headline(self) -> str:
-        return HEADLINES[self.verdict]
+        return VERDICT_HEADLINES[self.verdict]
 
 
 def _unit(limit) -> str:
@@ -70,7 +70,6 @@ def _row(verdict, parameter: ParameterValue | None, judged: bool) -> LimitRow:
 def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> QASection:
     """limits: analysis.limits.Limits; parameters in SI as the result has them; validity: the result's (as
     JSON), or its overall light alone."""
-    from analysis.validity_fit import qa_blocker
     validity = {"overall": validity} if isinstance(validity, str) else validity
     validity_overall = str(validity.get("overall", "unknown"))
     verdicts = limits.judge(parameters)
@@ -79,7 +78,7 @@ def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mappi
     rows = tuple(_row(v, parameters.get(v.limit.name), judged) for v in verdicts)
     failed = [v.limit.name for v in verdicts if not v.passed]
     if blocker is not None:
-        verdict, why = "not judged", blocker[1]
+        verdict, why = blocker
     elif failed:
         verdict, why = "fail", (f"{len(failed)} of {len(verdicts)} parameters outside their limits: "
                                 + ", ".join(failed))

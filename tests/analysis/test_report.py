@@ -154,9 +154,11 @@ def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
     assert rows["Bl"].margin == "0.27 T*m below min"   # 5.23 T*m against >= 5.5 T*m
 
 
-def test_a_red_measurement_is_not_judged_and_a_missing_parameter_fails(stored, faulty, tmp_path):
+def test_a_red_measurement_fails_unjudged_and_a_missing_parameter_fails(stored, faulty, tmp_path):
     c = build_report(faulty, HEADER, limits=limits_file(tmp_path, **PASSING))
-    assert c.qa.verdict == "not judged" and {r.outcome for r in c.qa.rows} == {"not judged"}
+    # FAIL, because the measurement is broken: no parameter is judged, and the why says so.
+    assert c.qa.verdict == "invalid" and c.qa.headline == "FAIL" and {r.outcome for r in c.qa.rows} == {"not judged"}
+    assert c.qa.why.startswith("measurement invalid: ") and "the unit itself was not judged" in c.qa.why
     rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=10, displacement=False)
     no_laser = StoredResult.from_json(results_document(analyze_recording(rec), rec))
     c = build_report(no_laser, HEADER, limits=limits_file(tmp_path, **PASSING))

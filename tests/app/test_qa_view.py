@@ -47,8 +47,11 @@ def test_a_faulty_recording_shows_a_red_light_and_its_message(qtbot, window, fau
     assert finding["message"] in shown and finding["remedy"] in shown
     assert current.details.isVisible() and current.details.width() > 100
     assert qa.channels["voltage"].light.status == "green"
-    assert qa.verdict == "not judged"            # an invalid measurement fails no driver
-    assert "measure this driver again" in plain(qa.verdict_label)
+    # A broken measurement FAILS the test, and the verdict says it is the measurement, not necessarily the unit.
+    assert qa.verdict == "invalid"
+    verdict = plain(qa.verdict_label)
+    assert verdict.startswith("FAIL") and "measurement invalid" in verdict and "measure again" in verdict
+    assert "the unit itself was not judged" in verdict
 
 
 @pytest.fixture(scope="module")
@@ -70,14 +73,17 @@ def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_curren
     assert qa.channels["current"].light.status == "red" and qa.channels["voltage"].light.status == "green"
     assert "no signal" in plain(qa.channels["current"].details)
     assert f"[{NO_SIGNAL}]" in plain(qa.channels["current"].details)        # the finding's code, on the light
-    assert qa.verdict == "not judged"
+    assert qa.verdict == "invalid"
     assert "Nothing could be fitted" in window.results.fit_quality.text()
     assert "Nothing to model" in window.model_lab.empty.text()
-    # Judged against limits: every row "not judged", and the verdict says which finding and what to do.
+    # Against limits: FAIL, no row judged, and the verdict says which finding, what to do, and that the unit
+    # itself was not judged.
     assert qa.load_limits(limits_file)
     assert {qa.table.item(r, 3).text() for r in range(qa.table.rowCount())} == {"not judged"}
     verdict = plain(qa.verdict_label)
-    assert "NOT JUDGED" in verdict and NO_SIGNAL in verdict and "check the current sense" in verdict
+    assert verdict.startswith("FAIL") and "NOT JUDGED" not in verdict
+    assert "measurement invalid: current" in verdict and f"[{NO_SIGNAL}]" in verdict
+    assert "check the current sense" in verdict and "the unit itself was not judged" in verdict
     # The report of the broken measurement is written, and says why.
     assert qa.export_button.isEnabled()
     target = tmp_path / "broken-report.pdf"
@@ -85,7 +91,8 @@ def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_curren
         qa.export_to(target)
     assert "Written" in qa.export_label.text()
     text = " ".join(pdf_text(target).split())
-    assert "QA: NOT JUDGED" in text and f"{NO_SIGNAL}: current: only 0%" in text
+    assert "QA: FAIL" in text and "measurement invalid: current" in text and f"{NO_SIGNAL}: current: only 0%" in text
+    assert "the unit itself was not judged" in text
     assert "Remedy: check the current sense" in text and "Nothing was fitted" in text
 
 
