@@ -75,7 +75,7 @@ class Limit:
     to_si: float              # SI = value in `unit` x to_si
     low: float | None         # SI
     high: float | None        # SI
-    text: str                 # how the file said it, for the report
+    text: str                 # how the file said it (its unit in proper notation), for the pages and reports
 
     def judge(self, p: ParameterValue | None) -> "Verdict":
         if p is None or p.value is None:
@@ -164,6 +164,8 @@ def _refuse_constant(name: str):
 
 
 def parse_limits(doc, text: str, path: Path) -> Limits:
+    from analysis.report.numbers import pretty_unit
+
     def fail(line: int, key: str, message: str):
         where = f"line {line}: " if line else ""
         raise LimitsError(f"{path}: {where}{key}: {message}")
@@ -195,7 +197,8 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
         if not isinstance(unit, str) or _unit(unit) not in accepted:
             fail(line, f"{key}.unit", f"found {unit!r}, expected {si!r} (SI) or {customary!r}")
         to_si = accepted[_unit(unit)]
-        shown_unit = "" if _unit(unit) == "1" else unit    # dimensionless: no unit in the text
+        # The file's numbers and unit, the unit in proper notation (Ω, T·m); dimensionless: no unit in the text.
+        shown_unit = "" if _unit(unit) == "1" else pretty_unit(unit)
 
         def number(k):
             v = entry.get(k)

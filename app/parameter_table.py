@@ -91,6 +91,14 @@ def format_value(p: ParameterValue, all_digits: bool = True) -> tuple[str, str]:
     return f"{value:.{decimals}f}", f"{std:.{decimals}f}"
 
 
+def value_with_unit(p: ParameterValue) -> str:
+    """"3.02 Ω": the value as the table rounds it (at most 4 digits) and its unit, for a page with one cell."""
+    if p.value is None:
+        return "not measured"
+    unit = "" if p.display_unit in ("1", "-") else pretty_unit(p.display_unit)
+    return f"{short_value(p)[0]} {unit}".rstrip()
+
+
 def short_value(p: ParameterValue) -> tuple[str, str]:
     """(value, 1-sigma): as many significant digits as the sigma supports (its second digit), at most 4;
     the sigma with 2 significant digits, written out without an exponent."""

@@ -9,6 +9,7 @@ from PySide6.QtCore import Qt
 
 from app import style
 from app.grid_axis import OpaqueGridAxis, show_grid
+from app.parameter_table import display_name
 
 ALARM = "#c62828"
 CONTROL = "#8e5bb5"          # control limits (the process)
@@ -70,7 +71,8 @@ class ControlChartView(pg.GraphicsLayoutWidget):
         x = np.arange(1, chart.values.size + 1)
         y = chart.values * scale
         unit = display_unit(unit)
-        self.individuals.setLabel("left", f"{p.name} ({unit})" if unit else p.name)
+        name = display_name(p.name)
+        self.individuals.setLabel("left", f"{name} ({unit})" if unit else name)
         self.individuals.plot(x, y, pen=pg.mkPen("#9bb7e0", width=1), symbol="o", symbolSize=4,
                               symbolBrush=style.MEASURED, symbolPen=None)
         _hline(self.individuals, chart.centre * scale, style.GUIDE, dashed=False, label="centre")
@@ -108,8 +110,8 @@ class ControlChartView(pg.GraphicsLayoutWidget):
             k = np.array(jumps)
             self.ranges.plot(x[k], chart.moving_ranges[k - 1] * abs(scale), pen=None, symbol="o", symbolSize=7,
                              symbolBrush=ALARM, symbolPen=None)
-        self.individuals.setTitle(f"{p.name}: individuals, centre and σ from the first {chart.baseline} units; "
-                                  f"{len(chart.alarms)} alarm(s)")
+        self.individuals.setTitle(f"{display_name(p.name)}: individuals, centre and σ from the first "
+                                  f"{chart.baseline} units; {len(chart.alarms)} alarm(s)")
 
 
 class HistogramView(pg.PlotWidget):
@@ -138,7 +140,8 @@ class HistogramView(pg.PlotWidget):
                                                                                         style=Qt.DashLine),
                                              label=name, labelOpts={"position": 0.9, "color": SPEC}))
         unit = display_unit(p.display_unit)
-        plot.setLabel("bottom", f"{p.name} ({unit})" if unit else p.name)
+        name = display_name(p.name)
+        plot.setLabel("bottom", f"{name} ({unit})" if unit else name)
         c = p.capability
-        plot.setTitle(f"{p.name}: n = {c.n}" + (f", yield {100 * c.yield_fraction:.1f} %"
+        plot.setTitle(f"{name}: n = {c.n}" + (f", yield {100 * c.yield_fraction:.1f} %"
                                                 if c.yield_fraction is not None else ", no limits"))

@@ -23,6 +23,7 @@ from analysis.archive.backends import shown
 from app import style
 from app.archive_filter import NO_DATE, date_edit
 from app.archive_page import archive_source
+from app.parameter_table import display_name
 from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit
 from app.production_worker import ProductionRequest, ProductionWorker
 
@@ -230,7 +231,9 @@ class ProductionPage(QWidget):
             c, s = p.capability, p.display_scale
             unit = f" {display_unit(p.display_unit)}".rstrip()
             alarms = 0 if p.chart is None else len(p.chart.alarms)
-            cells = [_item(p.name), _item(str(c.n)), _item(_number(c.mean, s) + unit,
+            name = _item(display_name(p.name))
+            name.setData(Qt.ItemDataRole.UserRole, p.name)         # the statistics' key, for on_parameter_chosen
+            cells = [name, _item(str(c.n)), _item(_number(c.mean, s) + unit,
                                                            f"min {_number(c.minimum, s)}, max {_number(c.maximum, s)}"),
                      _item(_number(c.sigma_overall, s), f"within (moving range): {_number(c.sigma_within, s)}"),
                      _item(p.limit_text or "–")]
@@ -257,7 +260,7 @@ class ProductionPage(QWidget):
         rows = self.stats_table.selectionModel().selectedRows() if self.stats_table.selectionModel() else []
         if self.data is None or not rows:
             return
-        name = self.stats_table.item(rows[0].row(), 0).text()
+        name = self.stats_table.item(rows[0].row(), 0).data(Qt.ItemDataRole.UserRole)
         self.parameter = name
         p = self.data.stats.parameters[name]
         self.chart.show_parameter(p)
@@ -277,7 +280,7 @@ class ProductionPage(QWidget):
                                         _item(ids[0] + (f" and {len(ids) - 1} more" if len(ids) > 1 else ""),
                                               "\n".join(ids)))):
                 self.alarms_table.setItem(row, col, item)
-        self.details.setTabText(0, f"{p.name}: alarms ({len(alarms)})")
+        self.details.setTabText(0, f"{display_name(p.name)}: alarms ({len(alarms)})")
 
     def _fill_stations(self, p) -> None:
         rows = p.stations.stations
@@ -293,7 +296,7 @@ class ProductionPage(QWidget):
                      _item(offset, tip), _item(st.reads or "as the others", tip, "red" if st.reads else None))
             for col, item in enumerate(cells):
                 self.stations_table.setItem(row, col, item)
-        self.details.setTabText(1, f"{p.name}: stations" + (f" ({sum(1 for s in rows if s.reads)} differ)"
+        self.details.setTabText(1, f"{display_name(p.name)}: stations" + (f" ({sum(1 for s in rows if s.reads)} differ)"
                                                             if any(s.reads for s in rows) else ""))
 
     # -- export ------------------------------------------------------------------------------

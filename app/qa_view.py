@@ -23,6 +23,8 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxL
                                QProgressBar, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.pipeline import AnalysisResult
+from app.fit_quality import model_words
+from app.parameter_table import display_name, value_with_unit
 from app.traffic_light import CHANNELS, ChannelLight, TrafficLight
 from app.job_book import failure_text
 
@@ -43,12 +45,12 @@ def available(module: str) -> bool:
 
 
 def display(value: float | None, parameter) -> str:
+    """The measured value as the Results page shows it: rounded to its sigma, the unit in proper notation."""
     if value is None:
         return "–"
     if parameter is None:
         return f"{value:.4g}"
-    unit = "" if parameter.display_unit in ("-", "1", "") else f" {parameter.display_unit}"
-    return f"{value * parameter.display_scale:.4g}{unit}"
+    return value_with_unit(parameter)
 
 
 def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str, str]:
@@ -243,7 +245,7 @@ class QAView(QWidget):
             light.set_state(str(entry.get("status", "unknown" if result is None else "absent")),
                             entry.get("findings") or ())
         if result is not None:
-            model = f"model {result.fit.model.describe()}" if result.fit is not None else "nothing fitted"
+            model = f"fitted with {model_words(result)}" if result.fit is not None else "nothing fitted"
             self.source.setText(f"Result of {result.source.name if result.source else 'an unsaved measurement'}"
                                 f" — {model}")
         self._show_limits(keep_limits_text)
@@ -279,7 +281,7 @@ class QAView(QWidget):
             # Limit and Result columns stay in view.
             measured = display(v.value, parameter) if v.value is not None else "not measured"
             outcome = "not judged" if invalid else ("pass" if v.passed else "FAIL")
-            cells = (v.limit.name, measured, v.limit.text, outcome)
+            cells = (display_name(v.limit.name), measured, v.limit.text, outcome)
             for col, text in enumerate(cells):
                 item = QTableWidgetItem(text)
                 if v.value is None and v.note:

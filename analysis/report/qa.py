@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from analysis.derived import ParameterValue
-from analysis.report.numbers import format_number
+from analysis.report.numbers import format_number, pretty_unit
 from analysis.validity_fit import INVALID, NOT_JUDGED, VERDICT_HEADLINES, qa_blocker
 
 # (background, text) of the verdict banner, also the QA page's: an invalid measurement is a FAIL, in red.
@@ -25,7 +25,7 @@ VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"
 class LimitRow:
     name: str
     value: str           # in the limits file's unit
-    limit: str           # as the file gives it ("70 ± 5 Hz", "11 .. 13 g", "≥ 5 T*m")
+    limit: str           # as the file gives it ("70 ± 5 Hz", "11 .. 13 g", "≥ 5 T·m")
     margin: str          # "inside by 0.3 Hz" | "0.8 Hz above max" | "0.2 g below min" | ""
     used: str            # share of a two-sided tolerance used ("58 %"), or ""
     outcome: str         # "pass" | "FAIL" | "not judged"
@@ -46,7 +46,7 @@ class QASection:
 
 
 def _unit(limit) -> str:
-    return "" if limit.unit.strip() in ("", "-", "1") else limit.unit
+    return "" if limit.unit.strip() in ("", "-", "1") else pretty_unit(limit.unit)
 
 
 def _row(verdict, parameter: ParameterValue | None, judged: bool) -> LimitRow:

@@ -151,7 +151,7 @@ def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
     assert rows["fs"].margin == "19.6 Hz above max"    # 70.56 Hz against 50 Hz ± 1 Hz
     assert rows["fs"].used == "2056 %"
     assert rows["Mms"].margin == "0.844 g above max"   # 11.84 g against <= 11 g
-    assert rows["Bl"].margin == "0.27 T*m below min"   # 5.23 T*m against >= 5.5 T*m
+    assert rows["Bl"].margin == "0.27 T·m below min"   # 5.23 T*m against >= 5.5 T*m
 
 
 def test_a_red_measurement_fails_unjudged_and_a_missing_parameter_fails(stored, faulty, tmp_path):

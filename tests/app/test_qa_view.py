@@ -104,7 +104,7 @@ def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limi
     assert qa.load_button.isEnabled()
     assert qa.load_limits(limits_file)
     rows = {qa.table.item(r, 0).text(): qa.table.item(r, 3).text() for r in range(qa.table.rowCount())}
-    assert rows == {"RE": "pass", "fs": "pass", "Bl": "FAIL"}          # the paper's Bl is 5.23 T*m
+    assert rows == {"Re": "pass", "fs": "pass", "Bl": "FAIL"}          # the paper's Bl is 5.23 T*m
     assert qa.verdict == "fail"
     assert window.settings.qsettings.value("qa/limits_file") == str(limits_file)
     looser = copy.deepcopy(LIMITS)          # the module's LIMITS stay as other tests expect them

@@ -158,3 +158,90 @@ def test_a_details_section_may_hold_the_numbers(qtbot, window, recordings):
     assert offending_texts(window.results) == []
     window.results.fit_quality.headline.setText("ΔBIC -12")      # outside: caught
     assert len(offending_texts(window.results)) == 1
+
+
+# --- the QA and Production pages: plain names and proper units in their cells ---------------------------------
+
+def code_words() -> dict[str, re.Pattern]:
+    """What a developer writes and a user should not read: effect ids, the code's parameter names where the
+    customary name differs (RE for Re), and units as the code spells them (ohm, T*m, uF)."""
+    from analysis.effects import CATALOGUE
+    from app.parameter_table import DISPLAY_NAMES
+    ids = "|".join(re.escape(i) for i in sorted(CATALOGUE, key=len, reverse=True))
+    return {
+        "an effect id": re.compile(rf"(?<![\w-])(?:{ids})(?![\w-])"),
+        "a code parameter name": re.compile(rf"^(?:{'|'.join(re.escape(n) for n in DISPLAY_NAMES)})$"),
+        "a code unit": re.compile(r"\bohms?\b|T\*m|\buF\b|\bus\b|\^"),
+    }
+
+
+def code_texts(root: QWidget) -> list[str]:
+    patterns = code_words()
+    found = []
+    for widget in [root, *root.findChildren(QWidget)]:
+        if in_details(widget):
+            continue
+        for text in widget_texts(widget):
+            plain_text = re.sub(r"<[^>]+>", "", text or "")
+            for name, pattern in patterns.items():
+                if pattern.search(plain_text):
+                    found.append(f"{name} in {type(widget).__name__}: {plain_text[:120]!r}")
+    return found
+
+
+@pytest.mark.parametrize("text, bad", [
+    ("Result of paper.wav — model lr2,creep-log", True),
+    ("RE", True),
+    ("3 ohm ± 5 %", True),
+    ("≥ 5 T*m", True),
+    ("Result of paper.wav — fitted with the lumped model with LR-2, creep", False),
+    ("Re", False),
+    ("3 Ω ± 5 %", False),
+    ("≥ 5 T·m", False),
+    ("Cms", False),
+])
+def test_the_code_word_patterns_catch_what_they_should(text, bad):
+    assert any(p.search(text) for p in code_words().values()) == bad
+
+
+QA_LIMITS = {"format": "linpar-limits/1", "name": "words", "parameters": {
+    "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
+    "LE": {"max": 2.0, "unit": "mH"},
+    "Bl": {"min": 5.0, "unit": "T*m"},
+    "fs": {"nominal": 70, "tolerance": 7, "unit": "Hz"}}}
+
+
+def test_the_qa_and_production_pages_speak_in_names_and_units(qtbot, window, recordings, tmp_path, archive_root):
+    import json
+
+    from analysis.archive import open_archive
+    from tests.production_helpers import small_measurement, unit
+    limits = tmp_path / "limits.json"
+    limits.write_text(json.dumps(QA_LIMITS), encoding="utf-8")
+    open_and_wait(qtbot, window, recordings["paper"])
+    qa = window.qa
+    assert qa.load_limits(limits) and qa.table.rowCount() == 4
+    qa_texts = [qa.source.text()] + [qa.table.item(r, c).text() for r in range(4) for c in range(4)]
+    assert "lr2" not in qa.source.text() and "fitted with" in qa.source.text()
+    assert {qa.table.item(r, 0).text() for r in range(4)} == {"Re", "Le", "Bl", "fs"}
+    assert {qa.table.item(r, 2).text() for r in range(4)} == {"3 Ω ± 5 %", "≤ 2 mH", "≥ 5 T·m", "70 ± 7 Hz"}
+    assert any(text.endswith(" Ω") for text in qa_texts) and any(text.endswith(" T·m") for text in qa_texts)
+    assert code_texts(qa) == []
+    # The Production page over units stored with the same limits: the statistics table, its tabs and plots.
+    (tmp_path / "unit").mkdir()
+    path, doc = small_measurement(tmp_path / "unit")
+    archive = open_archive(str(archive_root))          # the window's archive (conftest)
+    archive.store_limits(QA_LIMITS)
+    for i in range(6):
+        archive.store(path, unit(doc, RE=3.0 + 0.01 * i), {"station": "QA1", "serial": f"SN{i}", "driver": "W6",
+                                                           "measured_at": f"2024-05-01T10:0{i}:00Z"})
+    page = window.production
+    with qtbot.waitSignal(page.computed, timeout=ANALYSIS_TIMEOUT_MS):
+        window.pages.setCurrentWidget(page)
+    names = [page.stats_table.item(r, 0).text() for r in range(page.stats_table.rowCount())]
+    assert "Re" in names and "Le" in names and "RE" not in names
+    row = names.index("Re")
+    page.stats_table.selectRow(row)
+    assert page.parameter == "RE"                       # the statistics' key is kept behind the name
+    assert page.stats_table.item(row, 4).text() == "3 Ω ± 5 %" and page.stats_table.item(row, 2).text().endswith("Ω")
+    assert code_texts(page) == []
