@@ -30,6 +30,7 @@ from app.archive_overlay import CompareView
 from app.archive_table import ArchiveTable
 from app.archive_worker import ArchiveWorker
 from app.job_book import failure_text
+from app.job_controls import JobControls
 
 
 FILTER_DELAY_MS = 250           # typing a serial number should not list the archive once per key
@@ -61,10 +62,13 @@ class ArchivePage(QWidget):
         super().__init__(parent)
         self.settings = settings
         self.worker = ArchiveWorker(self)
-        self._jobs: dict[int, str] = {}      # job id -> what it does, for its failure's message
+        # A comparison or a rebuild the user asked for: what it does, a busy indicator and Cancel. Stores (after a
+        # measurement) and a server's listing run unseen: the page says how they went.
+        self.jobs = JobControls(self.worker, cancel_tip="Stop loading; the table shown stays", bar_width=120)
+        self.jobs.busy_changed.connect(lambda busy: self.rebuild_button.setEnabled(not busy))
+        self._jobs: dict[int, str] = {}      # job id -> what a background job does, for its failure's message
         self._storing: dict[int, Path] = {}  # job id -> the recording being stored
-        self._compare_job = None            # the ArchiveJob whose comparison will be shown
-        self._list_job = None               # the ArchiveJob listing a server (the newest asked for)
+        self._list_job = None               # the archive Job listing a server (the newest asked for)
         self._list_error = False
 
         self.root_label = QLabel()
@@ -111,8 +115,6 @@ class ArchivePage(QWidget):
         self.table.doubleClicked.connect(lambda _index: self.on_open())
         self.table.selectionModel().selectionChanged.connect(self.on_selection_changed)
         self.worker.stored.connect(self.on_stored)
-        self.worker.compared.connect(self.on_compared)
-        self.worker.rebuilt.connect(self.on_rebuilt)
         self.worker.listed.connect(self.on_listed)
         self.worker.failed.connect(self.on_failed)
         self.worker.cancelled.connect(self.on_cancelled)
@@ -125,6 +127,7 @@ class ArchivePage(QWidget):
         top.addWidget(self.root_label, 1)
         for button in (self.root_button, self.rebuild_button, self.refresh_button):
             top.addWidget(button)
+        top.addWidget(self.jobs)
         actions = QHBoxLayout()
         actions.addWidget(self.count_label, 1)
         actions.addWidget(self.selection_label)
@@ -157,9 +160,7 @@ class ArchivePage(QWidget):
         self.settings.qsettings.setValue(ROOT_KEY, str(path))
         self.settings.qsettings.sync()
         self._show_root()
-        if self._compare_job is not None:   # a comparison of the other archive still loading
-            self._compare_job.cancel()
-            self._compare_job = None
+        self.jobs.drop()                    # a comparison (or rebuild) of the other archive still running
         self.compare_view.clear()           # those were measurements of the other archive
         self.tabs.setCurrentWidget(self.list_tab)
         self.refresh_now()
@@ -313,18 +314,13 @@ class ArchivePage(QWidget):
             self.show_message(f"{len(entries)} measurements are selected, but at most {MAX_COMPARED} can be "
                               f"compared: deselect {len(entries) - MAX_COMPARED}.", "error")
             return
-        if self._compare_job is not None:
-            self._compare_job.cancel()      # replaced: its outcome would be dropped anyway
-        job = self.worker.compare(self.source, [e.id for e in entries])
-        self._jobs[job.id] = "compare"
-        self._compare_job = job
-        self.show_message(f"Loading {len(entries)} measurement{'s' if len(entries) != 1 else ''}…", "info")
+        self.clear_message()
+        # A comparison or rebuild still running is replaced: its outcome is dropped.
+        self.jobs.run(self.worker.compare(self.source, [e.id for e in entries]),
+                      f"Loading {len(entries)} measurement{'s' if len(entries) != 1 else ''}…", self.on_compared,
+                      lambda message: self.show_message(f"Cannot compare: {message}", "error"))
 
-    def on_compared(self, job: int, data) -> None:
-        self._jobs.pop(job, None)
-        if self._compare_job is None or job != self._compare_job.id:
-            return
-        self._compare_job = None
+    def on_compared(self, data) -> None:
         self.compare_view.set_data(data)
         self.tabs.setCurrentWidget(self.compare_view)
         if data.notes:
@@ -356,15 +352,14 @@ class ArchivePage(QWidget):
         self.stored.emit(stored.id, str(stored.recording))
 
     def on_rebuild(self) -> None:
-        self.rebuild_button.setEnabled(False)
-        job = self.worker.rebuild(self.source)
-        self._jobs[job.id] = "rebuild"
-        self.show_message("Sending this station's queue to the server…" if self.on_server else
-                          "Rebuilding the index from the measurement folders…", "info")
+        self.clear_message()
+        doing = "send the queue" if self.on_server else "rebuild the index"
+        self.jobs.run(self.worker.rebuild(self.source),
+                      "Sending this station's queue to the server…" if self.on_server else
+                      "Rebuilding the index from the measurement folders…", self.on_rebuilt,
+                      lambda message: self.show_message(f"Cannot {doing}: {message}", "error"))
 
-    def on_rebuilt(self, job: int, done) -> None:
-        self._jobs.pop(job, None)
-        self.rebuild_button.setEnabled(True)
+    def on_rebuilt(self, done) -> None:
         self.refresh_now()
         self.show_message(done.text[:1].upper() + done.text[1:], "note" if done.skipped else "info")
         self.rebuilt.emit(done.text)
@@ -375,21 +370,14 @@ class ArchivePage(QWidget):
             recording = self._storing.pop(job, Path())
             self.show_message(f"{recording.name} was not stored in the archive: {message}", "error")
             self.store_failed.emit(message, str(recording))
-        elif kind == "rebuild":
-            self.rebuild_button.setEnabled(True)
-            self.show_message(f"Cannot {'send the queue' if self.on_server else 'rebuild the index'}: {message}",
-                              "error")
-        elif kind == "list":
-            if self._list_job is not None and job == self._list_job.id:
-                self._list_job = None
-                self._list_failed(message)
-        elif self._compare_job is not None and job == self._compare_job.id:
-            self._compare_job = None
-            self.show_message(f"Cannot compare: {message}", "error")
+        elif kind == "list" and self._list_job is not None and job == self._list_job.id:
+            self._list_job = None
+            self._list_failed(message)
 
     def on_cancelled(self, job: int) -> None:
         self._jobs.pop(job, None)
         self._storing.pop(job, None)
 
     def shutdown(self, wait_ms: int) -> bool:
+        self.jobs.drop()
         return self.worker.shutdown(wait_ms)

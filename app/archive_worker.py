@@ -1,30 +1,23 @@
 """The archive's slow work off the GUI thread: storing a measurement, loading a comparison, rebuilding the index;
 and for an archive on a PostgreSQL server, listing and sending the station's queue (a server may be slow or gone).
 
-Built like app.workers: one long-lived ArchiveWorker (a QObject of the GUI
-thread) owns a one-thread QThreadPool, so a store and the rebuild that
-follows it run in the order asked. Each job opens its own archive
-(analysis.archive.open_archive of the page's source: its own connection,
-its own repair notes). What crosses to the GUI thread is
-frozen, or one line of text: every archive error (ArchiveError, SQLite,
-the file system, a results file that does not read) becomes that line.
+An ArchiveWorker is a JobRunner (app.job_book) with one thread, so a store
+and the rebuild that follows it run in the order asked. Each job opens its
+own archive (analysis.archive.open_archive of the page's source: its own
+connection, its own repair notes). What crosses to the GUI thread is frozen,
+or one line of text: every archive error (ArchiveError, SQLite, the file
+system, a results file that does not read) becomes that line.
 """
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from PySide6.QtCore import QObject, Signal
 
-from app.job_book import JobBook, failure_text
+from app.job_book import Job, JobRunner
 from instruments.measurement.raw_stream import raw_capture_path
-
-
-
-class ArchiveCancelled(Exception):
-    pass
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,62 +54,35 @@ def laser_stream_of(recording: Path) -> Path | None:
     return path if path.is_file() else None
 
 
-class ArchiveJob:
-    """One job in the pool thread: `work(job)` returns what the kind's signal carries."""
+class ArchiveWorker(JobRunner):
+    """A JobRunner with one result signal per kind of job; one thread, so a store and its rebuild keep order."""
 
-    def __init__(self, job: int, kind: str, root: Path, work: Callable[["ArchiveJob"], object],
-                 worker: "ArchiveWorker"):
-        self.id = job
-        self.kind = kind
-        self.root = root
-        self._work = work
-        self._worker = worker
-        # NB: set by the GUI thread, read between measurements by the pool thread.
-        self.cancel_event = threading.Event()
-
-    def cancel(self) -> None:
-        self.cancel_event.set()
-
-    def check(self) -> None:
-        if self.cancel_event.is_set():
-            raise ArchiveCancelled
-
-    def __call__(self) -> None:
-        worker = self._worker
-        try:
-            result = self._work(self)
-        except ArchiveCancelled:
-            worker.cancelled.emit(self.id)
-        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            from analysis.archive.backends import shown
-            worker.failed.emit(self.id, failure_text(exc, f"the archive's {self.kind} ({shown(str(self.root))})"))
-        else:
-            getattr(worker, self.kind).emit(self.id, result)
-
-
-class ArchiveWorker(QObject, JobBook):
     stored = Signal(int, object)        # job id, StoredMeasurement
     compared = Signal(int, object)      # job id, ComparisonData
     rebuilt = Signal(int, object)       # job id, RebuildDone
     listed = Signal(int, object)        # job id, Listed
-    failed = Signal(int, str)           # job id, a one-line message for the user
-    cancelled = Signal(int)             # job id
+    result_signals = ("stored", "compared", "rebuilt", "listed")
 
     def __init__(self, parent: QObject | None = None):
-        super().__init__(parent)
-        self._init_jobs(self, (self.stored, self.compared, self.rebuilt, self.listed, self.failed, self.cancelled),
-                        max_threads=1)
+        super().__init__(parent, max_threads=1)
 
-    def store(self, root: str | Path, recording: Path, result, meta: Mapping[str, Any]) -> ArchiveJob:
+    def result_signal(self, job: Job) -> str:
+        return job.kind
+
+    def _run(self, kind: str, root, work: Callable[[Job], object]) -> Job:
+        from analysis.archive.backends import shown
+        return self.run(kind, work, f"the archive's {kind} ({shown(str(root))})")
+
+    def store(self, root: str | Path, recording: Path, result, meta: Mapping[str, Any]) -> Job:
         """Store a recording file and its analysis.pipeline.AnalysisResult with `meta` (MeasurementMeta's keys)."""
         def work(job):
             from analysis.archive import open_archive
             archive = open_archive(str(root))
             mid = archive.store(recording, result, dict(meta), laser_stream=laser_stream_of(recording))
             return StoredMeasurement(mid, recording, tuple(archive.notes), archive.pending > 0)
-        return self._start(ArchiveJob(self._next_id(), "stored", root, work, self))
+        return self._run("stored", root, work)
 
-    def compare(self, root: str | Path, ids: list[str]) -> ArchiveJob:
+    def compare(self, root: str | Path, ids: list[str]) -> Job:
         """analysis.archive.compare of `ids`, with each one's stored curves for the overlay."""
         ids = list(ids)
 
@@ -131,9 +97,9 @@ class ArchiveWorker(QObject, JobBook):
                 dates.append(m.entry.measured_at)
                 curves.append(dict(m.result().curves))
             return ComparisonData(comparison, tuple(dates), tuple(curves), tuple(archive.notes))
-        return self._start(ArchiveJob(self._next_id(), "compared", root, work, self))
+        return self._run("compared", root, work)
 
-    def rebuild(self, root: str | Path) -> ArchiveJob:
+    def rebuild(self, root: str | Path) -> Job:
         """Rebuild a folder archive's index; for a server, send this station's queue (it has no index)."""
         def work(job):
             from analysis.archive import is_url, open_archive
@@ -143,12 +109,12 @@ class ArchiveWorker(QObject, JobBook):
                 return RebuildDone(f"queue sent: {report.describe()}", report.waiting)
             report = archive.rebuild()
             return RebuildDone(report.describe(), len(report.skipped))
-        return self._start(ArchiveJob(self._next_id(), "rebuilt", root, work, self))
+        return self._run("rebuilt", root, work)
 
-    def list(self, root: str | Path, flt) -> ArchiveJob:
+    def list(self, root: str | Path, flt) -> Job:
         """List an archive (on a server: the GUI thread must not wait for the network)."""
         def work(job):
             from analysis.archive import open_archive
             archive = open_archive(str(root))
             return Listed(tuple(archive.list(flt)), tuple(archive.notes))
-        return self._start(ArchiveJob(self._next_id(), "listed", root, work, self))
+        return self._run("listed", root, work)

@@ -1,11 +1,8 @@
 """The model lab's fits off the GUI thread: refits of one model, and diagnoses.
 
-Built like app.workers: one long-lived LabWorker (a QObject of the GUI
-thread) owns a QThreadPool and the signals; each job is a plain callable run
-by the pool, and every signal carries the job's id so the page can drop the
-outcome of a job it has replaced. What crosses to the GUI thread is frozen
-(LabFit, DiagnosisOutcome) and already holds everything the page draws: the
-parameter table, the dense model curves and the residual in words.
+A LabWorker is a JobRunner (app.job_book). What crosses to the GUI thread is
+frozen (LabFit, DiagnosisOutcome) and already holds everything the page
+draws: the parameter table, the dense model curves and the residual in words.
 """
 from __future__ import annotations
 
@@ -13,9 +10,6 @@ import concurrent.futures
 import dataclasses
 import threading
 from dataclasses import dataclass
-from typing import Callable
-
-from PySide6.QtCore import QObject, Signal
 
 from analysis import residuals
 from analysis.acceptance import Flag
@@ -23,7 +17,6 @@ from analysis.derived import parameter_table
 from analysis.diagnosis import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
 from analysis.diagnosis_words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
-from analysis.errors import is_user_error
 from analysis.sites import SiteResult
 from analysis.fit import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
@@ -31,7 +24,7 @@ from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from analysis.validity_fit import rejudged
 from app.result_curves import ResultCurves, result_curves
-from app.job_book import JobBook, failure_text
+from app.job_book import Job, JobRunner
 
 
 CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
@@ -161,104 +154,43 @@ class _CancellableExecutor:
         return _PollingFuture(self._pool.submit(fn, *args, **kwargs), self)
 
 
-class LabJob:
-    """A job of the lab; subclasses say what `run` computes and which signal carries it."""
-
-    kind = "job"
-
-    def __init__(self, job: int, worker: "LabWorker", base: AnalysisResult, data: FitData):
-        self.id = job
-        self._worker = worker
-        self.base = base
-        self.data = data
-        # NB: set by the GUI thread, read by the fit's iteration callback in the pool thread.
-        self.cancel_event = threading.Event()
-
-    def cancel(self) -> None:
-        self.cancel_event.set()
-
-    def run(self) -> None:
-        raise NotImplementedError
-
-    def __call__(self) -> None:
-        signals = self._worker
-        try:
-            self.run()
-        except (FitCancelled, DiagnosisCancelled):
-            signals.cancelled.emit(self.id)
-        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            if self.cancel_event.is_set() and is_user_error(exc):  # a cancelled fit may fail on its way out
-                signals.cancelled.emit(self.id)
-            else:
-                signals.failed.emit(self.id, failure_text(exc, f"the model lab's {self.kind}"))
+def _refit(job: Job, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabFit:
+    job.say(f"fitting {model.describe()}")
+    fit = fit_model(data, model, start=start, cancel=job.cancel_event)
+    job.check()
+    return lab_fit(base, fit)
 
 
-class RefitJob(LabJob):
-    kind = "refit"
-
-    def __init__(self, job, worker, base, data, model: Model, start: dict[str, float]):
-        super().__init__(job, worker, base, data)
-        self.model = model
-        self.start = start
-
-    def run(self) -> None:
-        self._worker.progress.emit(self.id, f"fitting {self.model.describe()}")
-        fit = fit_model(self.data, self.model, start=self.start, cancel=self.cancel_event)
-        if self.cancel_event.is_set():
-            raise FitCancelled("cancelled after the fit")
-        self._worker.refit_finished.emit(self.id, lab_fit(self.base, fit))
-
-
-class DiagnoseJob(LabJob):
+def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, follow: bool,
+              taken: CandidateRow | None) -> DiagnosisOutcome:
     """Rank the candidates from `start` (follow=False) or follow the greedy path from it (follow=True).
 
     `taken`, when known, is the candidate a previous ranking of `start` chose:
     the greedy path then goes on from it instead of ranking `start` again
     (it still counts as the path's first step, for the verdict).
     """
-
-    kind = "diagnosis"
-
-    def __init__(self, job, worker, base, data, start: FitResult, follow: bool, taken: CandidateRow | None = None):
-        super().__init__(job, worker, base, data)
-        self.start = start
-        self.follow = follow
-        self.taken = taken
-
-    def run(self) -> None:
-        begin = self.taken.fitted.fit if self.taken is not None else self.start
-        progress: Callable[[str], None] = lambda text: self._worker.progress.emit(self.id, text)
-        with fit_executor() as pool:
-            executor = None if pool is None else _CancellableExecutor(pool, self.cancel_event)
-            result = diagnose(self.data, begin.model, executor=executor, cancel=self.cancel_event,
-                              start_fit=begin, progress=progress, max_steps=MAX_STEPS, follow=self.follow)
-        if self.cancel_event.is_set():
-            raise DiagnosisCancelled("cancelled after the diagnosis")
-        if self.taken is not None:
-            t = self.taken
-            first = Step(self.start, (), residuals.describe(self.start),
-                         Candidate(t.action, t.effect, t.replaces, t.fitted.fit, t.delta_bic, t.error, t.flags))
-            result = dataclasses.replace(result, steps=(first,) + result.steps)
-        outcome = diagnosis_outcome(self.base, result, self.follow)
-        self._worker.diagnosis_finished.emit(self.id, outcome)
+    begin = taken.fitted.fit if taken is not None else start
+    with fit_executor() as pool:
+        executor = None if pool is None else _CancellableExecutor(pool, job.cancel_event)
+        result = diagnose(data, begin.model, executor=executor, cancel=job.cancel_event, start_fit=begin,
+                          progress=job.say, max_steps=MAX_STEPS, follow=follow)
+    job.check()
+    if taken is not None:
+        t = taken
+        first = Step(start, (), residuals.describe(start),
+                     Candidate(t.action, t.effect, t.replaces, t.fitted.fit, t.delta_bic, t.error, t.flags))
+        result = dataclasses.replace(result, steps=(first,) + result.steps)
+    return diagnosis_outcome(base, result, follow)
 
 
-class LabWorker(QObject, JobBook):
-    progress = Signal(int, str)                 # job id, what is being worked on
-    refit_finished = Signal(int, object)        # job id, LabFit
-    diagnosis_finished = Signal(int, object)    # job id, DiagnosisOutcome
-    failed = Signal(int, str)                   # job id, a one-line message for the user
-    cancelled = Signal(int)                     # job id
+class LabWorker(JobRunner):
+    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, DiagnosisCancelled)
 
-    def __init__(self, parent: QObject | None = None):
-        super().__init__(parent)
-        self._init_jobs(self, (self.refit_finished, self.diagnosis_finished, self.failed, self.cancelled))
-
-    def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabJob:
-        return self._start(RefitJob(self._next_id(), self, base, data, model, dict(start)))
+    def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> Job:
+        start = dict(start)
+        return self.run("refit", lambda job: _refit(job, base, data, model, start), "the model lab's refit")
 
     def diagnose(self, base: AnalysisResult, data: FitData, start: FitResult, follow: bool = False,
-                 taken: CandidateRow | None = None) -> LabJob:
-        return self._start(DiagnoseJob(self._next_id(), self, base, data, start, follow, taken))
-
-
+                 taken: CandidateRow | None = None) -> Job:
+        return self.run("diagnosis", lambda job: _diagnose(job, base, data, start, follow, taken),
+                        "the model lab's diagnosis")

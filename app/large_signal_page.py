@@ -1,26 +1,26 @@
 """The Large-signal page: Bl(x), Kms(x), Le(x) of a driver from recordings at large signal, with the coil's rest
 offset, the excursion limits and the distortion the model predicts against the distortion measured.
 
-The identification (analysis.large_signal, a few seconds per recording) runs
-in a pool thread; the page shows what it returns. It is reached from the
+The identification (analysis.large_signal, a few seconds per recording) is a
+job (app.job_book) shown by a JobControls; the page shows what it returns. It is reached from the
 Series page's level series ("Large-signal curves") or with its own button.
 """
 from __future__ import annotations
 
 import html
 import math
-import threading
 from pathlib import Path
 from typing import Sequence
 
 import numpy as np
-from PySide6.QtCore import QObject, Qt, QThreadPool, Signal
-from PySide6.QtWidgets import (QComboBox, QFileDialog, QGridLayout, QHBoxLayout, QLabel, QProgressBar, QPushButton,
-                               QSplitter, QVBoxLayout, QWidget)
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import (QComboBox, QFileDialog, QGridLayout, QHBoxLayout, QLabel, QPushButton, QSplitter,
+                               QVBoxLayout, QWidget)
 
 from analysis.large_signal import LargeSignalResult, large_signal
 from app.large_signal_plots import CurvePlot, DistortionPlot
-from app.job_book import failure_text
+from app.job_book import JobRunner, failure_text
+from app.job_controls import JobControls
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 SAVE_FILTER = "PDF report (*.pdf);;HTML report (*.html);;Curves as CSV (*.csv);;Curves as JSON (*.json)"
@@ -28,59 +28,23 @@ EMPTY_TEXT = ("No large-signal curves yet: choose recordings of one driver at la
               "the steps of a large-signal measurement).")
 
 
-class LargeSignalWorker(QObject):
-    """large_signal() in a pool thread. A cancelled identification finishes in the background (seconds) and its
-    result is dropped."""
-
-    finished = Signal(object)           # LargeSignalResult
-    failed = Signal(str)
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        # NB: set by the GUI thread, read by the pool thread when it is done.
-        self.cancel_event = threading.Event()
-
-    def start(self, paths: Sequence[Path]) -> None:
-        self.cancel_event = threading.Event()
-        cancel = self.cancel_event
-        self.pool.start(lambda: self._run(list(paths), cancel))
-
-    def cancel(self) -> None:
-        self.cancel_event.set()
-
-    def _run(self, paths: list[Path], cancel: threading.Event) -> None:
-        try:
-            result = large_signal(paths)
-        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            if not cancel.is_set():
-                self.failed.emit(failure_text(exc, "the large-signal identification"))
-            return
-        if cancel.is_set():
-            self.failed.emit("cancelled")
-        else:
-            self.finished.emit(result)
-
-
 class LargeSignalPage(QWidget):
     result_shown = Signal(object)       # LargeSignalResult, once on screen
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.worker = LargeSignalWorker(self)
+        # large_signal() cannot stop midway (seconds): a cancelled identification finishes in the background
+        # and its result is dropped (app.job_book).
+        self.worker = JobRunner(self, max_threads=1)
         self.result: LargeSignalResult | None = None
         self.choose_button = QPushButton("Choose recordings…")
         self.choose_button.setToolTip("Recordings of one driver at large signal, with the laser")
-        self.cancel_button = QPushButton("Cancel")
-        self.cancel_button.setEnabled(False)
+        self.jobs = JobControls(self.worker, cancel_tip="Stop the identification; the curves shown stay",
+                                bar_width=160)
+        self.jobs.busy_changed.connect(lambda busy: self.choose_button.setEnabled(not busy))
         self.save_button = QPushButton("Save report or curves…")
         self.save_button.setToolTip("The report as PDF or HTML, the curves as CSV or JSON")
         self.save_button.setEnabled(False)
-        self.progress = QProgressBar()
-        self.progress.setRange(0, 0)
-        self.progress.setMaximumWidth(160)
-        self.progress.setVisible(False)
         self.status = QLabel(EMPTY_TEXT)
         self.status.setWordWrap(True)
         self.summary = QLabel()
@@ -95,8 +59,9 @@ class LargeSignalPage(QWidget):
         self.level_choice = QComboBox()
         self.level_choice.setToolTip("The recording whose measured distortion the prediction is compared with")
         controls = QHBoxLayout()
-        for w in (self.choose_button, self.cancel_button, self.save_button, self.progress):
+        for w in (self.choose_button, self.save_button):
             controls.addWidget(w)
+        controls.addWidget(self.jobs, 1)
         controls.addWidget(self.status, 1)
         grid = QGridLayout()
         grid.addWidget(self.plots["Bl"], 0, 0)
@@ -116,11 +81,8 @@ class LargeSignalPage(QWidget):
         layout.addLayout(controls)
         layout.addWidget(splitter, 1)
         self.choose_button.clicked.connect(self.on_choose)
-        self.cancel_button.clicked.connect(self.on_cancel)
         self.save_button.clicked.connect(self.on_save)
         self.level_choice.currentIndexChanged.connect(self.on_level_chosen)
-        self.worker.finished.connect(self.on_finished)
-        self.worker.failed.connect(self.on_failed)
 
     # --- slots ----------------------------------------------------------------------------------------------------
 
@@ -131,23 +93,21 @@ class LargeSignalPage(QWidget):
 
     def analyse(self, paths: Sequence[Path]) -> None:
         stems = sorted({Path(p).with_suffix("") for p in paths})
-        self.choose_button.setEnabled(False)
-        self.cancel_button.setEnabled(True)
-        self.progress.setVisible(True)
-        self.status.setText(f"identifying the curves from {len(stems)} recording(s)…")
-        self.worker.start(stems)
-
-    def on_cancel(self) -> None:
-        self.worker.cancel()
-        self._idle("Cancelled: the curves shown (if any) are the previous ones.")
+        self.status.setText("")
+        job = self.worker.run("identification", lambda job: large_signal(stems),
+                              "the large-signal identification")
+        self.jobs.run(job, f"Identifying the curves from {len(stems)} recording(s)…", self.on_finished,
+                      lambda message: self.status.setText(f"Not identified: {message}"),
+                      lambda: self.status.setText("Cancelled: the curves shown (if any) are the previous ones."))
 
     def on_finished(self, result: LargeSignalResult) -> None:
-        self._idle(f"{len(result.fits)} recording(s) identified.")
+        self.status.setText(f"{len(result.fits)} recording(s) identified.")
         self.show_result(result)
 
-    def on_failed(self, message: str) -> None:
-        if message != "cancelled":
-            self._idle(f"Not identified: {message}")
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel the identification; one that cannot stop in time finishes in the background, unheard."""
+        self.jobs.drop()
+        return self.worker.shutdown(wait_ms)
 
     def on_save(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save the large-signal report or curves", "", SAVE_FILTER)
@@ -211,12 +171,6 @@ class LargeSignalPage(QWidget):
         self.summary.setText(summary_html(result))
         self.save_button.setEnabled(True)
         self.result_shown.emit(result)
-
-    def _idle(self, message: str) -> None:
-        self.choose_button.setEnabled(True)
-        self.cancel_button.setEnabled(False)
-        self.progress.setVisible(False)
-        self.status.setText(message)
 
 
 def summary_html(result: LargeSignalResult) -> str:

@@ -5,12 +5,12 @@ import time
 from pathlib import Path
 
 from PySide6.QtCore import QTimer, Signal, Slot
-from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton,
-                               QTabWidget)
+from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTabWidget
 
 from app import style
 from app.archive_page import ArchivePage
 from app.job_book import failure_text
+from app.job_controls import JobControls
 from app.large_signal_page import LargeSignalPage
 from app.menus import Menus
 from app.model_lab import ModelLab
@@ -22,7 +22,7 @@ from app.results_view import ResultsView
 from app.settings import Settings
 from app.staged_fanout import StagedFanOut
 from app.wizard import MeasureWizard
-from app.workers import AnalysisJob, AnalysisOutcome, AnalysisWorker
+from app.workers import AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
@@ -53,7 +53,6 @@ class MainWindow(QMainWindow):
         super().__init__(parent)
         self.settings = settings or Settings()
         self.worker = AnalysisWorker(self)
-        self.job: AnalysisJob | None = None     # the analysis whose outcome will be shown
         self._started_at = 0.0
         self.setWindowTitle("linpar")
         self.setWindowIcon(style.app_icon())
@@ -97,10 +96,6 @@ class MainWindow(QMainWindow):
 
         self._build_menus()
         self._build_status_bar()
-        self.worker.progress.connect(self.on_progress)
-        self.worker.finished.connect(self.on_finished)
-        self.worker.failed.connect(self.on_failed)
-        self.worker.cancelled.connect(self.on_cancelled)
         self._restore_window()
 
     # -- construction ------------------------------------------------------
@@ -114,15 +109,12 @@ class MainWindow(QMainWindow):
         bar = self.statusBar()
         self.status_label = QLabel("No recording loaded")
         bar.addWidget(self.status_label, 1)
-        self.progress = QProgressBar()
-        self.progress.setRange(0, 0)         # the fit reports no fraction: a busy indicator
-        self.progress.setMaximumWidth(160)
-        self.cancel_button = QPushButton("Cancel")
-        self.cancel_button.setToolTip("Stop the analysis; the results shown so far stay")
-        self.cancel_button.clicked.connect(self.on_cancel)
-        for widget in (self.progress, self.cancel_button):
-            bar.addPermanentWidget(widget)
-            widget.hide()
+        # The analysis of an opened recording: its stage, a busy indicator and Cancel.
+        self.jobs = JobControls(self.worker, cancel_tip="Stop the analysis; the results shown so far stay",
+                                bar_width=160)
+        self.jobs.busy_changed.connect(lambda busy: self.results.set_busy(self.jobs.text.text()) if busy
+                                       else self.results.set_idle())
+        bar.addPermanentWidget(self.jobs)
 
     def _restore_window(self) -> None:
         geometry, state = self.settings.window_geometry()
@@ -147,7 +139,7 @@ class MainWindow(QMainWindow):
     # -- opening and analysing ---------------------------------------------
     @property
     def busy(self) -> bool:
-        return self.job is not None
+        return self.jobs.busy
 
     @Slot(list)
     def on_large_signal_requested(self, paths: list) -> None:
@@ -163,32 +155,15 @@ class MainWindow(QMainWindow):
 
     def open_path(self, path: str | Path) -> None:
         """Analyse `path` in a worker thread; a running analysis is cancelled and its outcome ignored."""
-        if self.job is not None:
-            self.job.cancel()
         path = Path(path)
         self._started_at = time.monotonic()
-        self.job = self.worker.start(path)
-        self._set_busy(True, f"Analysing {path.name}…")
+        self.status_label.setText("")            # the job controls beside it say what is being done
+        self.jobs.run(self.worker.start(path), f"Analysing {path.name}…", self.on_finished,
+                      lambda message: self.on_failed(path, message), self.on_cancelled)
         self.pages.setCurrentWidget(self.results)
         self.analysis_started.emit(str(path))
 
-    def _take(self, job: int) -> AnalysisJob | None:
-        """The current job if `job` is it (and forget it); None for an outcome to drop."""
-        if self.job is None or self.job.id != job:
-            return None
-        current, self.job = self.job, None
-        self._set_busy(False)
-        return current
-
-    @Slot(int, str)
-    def on_progress(self, job: int, stage: str) -> None:
-        if self.job is not None and self.job.id == job:
-            self.status_label.setText(stage[:1].upper() + stage[1:] + "…")
-
-    @Slot(int, object)
-    def on_finished(self, job: int, outcome: AnalysisOutcome) -> None:
-        if self._take(job) is None:
-            return
+    def on_finished(self, outcome: AnalysisOutcome) -> None:
         elapsed = time.monotonic() - self._started_at
         self.results.show_outcome(outcome)
         self.settings.add_recent_file(outcome.path)
@@ -199,41 +174,19 @@ class MainWindow(QMainWindow):
         self.status_label.setText(f"Loaded {outcome.path} — {model}, analysed in {elapsed:.2g} s")
         self.result_pages.after(lambda: self.analysis_shown.emit(outcome))
 
-    @Slot(int, str)
-    def on_failed(self, job: int, message: str) -> None:
-        current = self._take(job)
-        if current is None:
-            return
+    def on_failed(self, path: Path, message: str) -> None:
         shown = self.results.result
         still = f"; still showing {shown.source.name}" if shown is not None and shown.source else ""
-        self.status_label.setText(f"Could not analyse {current.path.name}{still}")
-        if not current.path.exists():          # a recent file that has gone: do not offer it again
-            self.settings.remove_recent_file(str(current.path.resolve()))
+        self.status_label.setText(f"Could not analyse {path.name}{still}")
+        if not path.exists():          # a recent file that has gone: do not offer it again
+            self.settings.remove_recent_file(str(path.resolve()))
             self._rebuild_recent_menu()
-        self.show_error(f"Cannot analyse {current.path.name}", message)
+        self.show_error(f"Cannot analyse {path.name}", message)
         self.analysis_failed.emit(message)
 
-    @Slot(int)
-    def on_cancelled(self, job: int) -> None:
-        if self._take(job) is None:
-            return
+    def on_cancelled(self) -> None:
         self.status_label.setText("Analysis cancelled")
         self.analysis_cancelled.emit()
-
-    @Slot()
-    def on_cancel(self) -> None:
-        if self.job is not None:
-            self.job.cancel()
-            self.status_label.setText("Cancelling…")
-
-    def _set_busy(self, busy: bool, text: str = "") -> None:
-        self.progress.setVisible(busy)
-        self.cancel_button.setVisible(busy)
-        if busy:
-            self.status_label.setText(text)
-            self.results.set_busy(text)
-        else:
-            self.results.set_idle()
 
     def show_error(self, title: str, message: str) -> None:
         """The message only: tracebacks go to the log, never to the user."""
@@ -247,9 +200,7 @@ class MainWindow(QMainWindow):
         In the next turn of the event loop: the wizard's own page updates first, so the two do not add
         up to one long stall of the GUI (the Results page takes ~30 ms to show it, the lab as much again).
         """
-        if self.job is not None:            # an opened file still being analysed would replace it: drop that
-            self.job.cancel()
-            self._take(self.job.id)
+        self.jobs.drop()                    # an opened file still being analysed would replace it: drop that
         QTimer.singleShot(0, lambda: self._show_measured(outcome))
 
     def _show_measured(self, outcome) -> None:
@@ -384,7 +335,7 @@ class MainWindow(QMainWindow):
         self.qa.shutdown(CLOSE_WAIT_MS)
         self.archive.shutdown(CLOSE_WAIT_MS)
         self.production.shutdown(CLOSE_WAIT_MS)
-        self.series.worker.cancel()
-        self.series.worker.pool.waitForDone(CLOSE_WAIT_MS)
+        self.series.shutdown(CLOSE_WAIT_MS)
+        self.large_signal.shutdown(CLOSE_WAIT_MS)
         self.settings.save_window(self.saveGeometry(), self.saveState())
         super().closeEvent(event)

@@ -15,8 +15,7 @@ import html
 from pathlib import Path
 
 from PySide6.QtCore import Qt, Signal, Slot
-from PySide6.QtWidgets import (QHBoxLayout, QLabel, QProgressBar, QPushButton, QSplitter, QStackedWidget,
-                               QTabWidget, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
 
 from analysis import acceptance, residuals
 from analysis.derived import parameter_table
@@ -24,8 +23,8 @@ from analysis.errors import LinparError
 from analysis.fit import FitData
 from analysis.fit_words import fit_headline
 from analysis.pipeline import AnalysisResult
-from app.lab_worker import DiagnosisOutcome, LabFit, LabJob, LabWorker
-from app.layout_room import keep_room_when_hidden
+from app.job_controls import JobControls
+from app.lab_worker import DiagnosisOutcome, LabFit, LabWorker
 from app.model_lab_candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab_catalogue import EffectCatalogue
 from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
@@ -52,7 +51,6 @@ class ModelLab(QWidget):
         self.base: AnalysisResult | None = None     # the recording as the Results page analysed it
         self.data: FitData | None = None
         self.versions: list[LabVersion] = []
-        self.job: LabJob | None = None              # the job whose outcome will be shown
         self.diagnosis: DiagnosisOutcome | None = None
         self.diagnosis_version = 0                  # the version the shown candidates are one move from
         self.new_effect_dialog = None               # the "New effect…" dialog while it is open
@@ -68,17 +66,14 @@ class ModelLab(QWidget):
         self.status_label = QLabel()
         self.status_label.setWordWrap(True)
         self.status_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
-        self.progress = QProgressBar()
-        self.progress.setRange(0, 0)          # fits report no fraction: a busy indicator
-        self.progress.setMaximumWidth(120)
-        self.cancel_button = QPushButton("Cancel")
-        self.cancel_button.setToolTip("Stop the refit or diagnosis; the current version stays")
+        # The refit or diagnosis running: what it does, a busy indicator and Cancel.
+        self.jobs = JobControls(self.worker, cancel_tip="Stop the refit or diagnosis; the current version stays",
+                                bar_width=120)
+        self.jobs.busy_changed.connect(lambda _busy: self._update_buttons())
         header = QHBoxLayout()
         header.addWidget(self.model_label, 3)
         header.addWidget(self.status_label, 1)
-        header.addWidget(self.progress)
-        header.addWidget(self.cancel_button)
-        keep_room_when_hidden(self.progress, self.cancel_button)
+        header.addWidget(self.jobs, 1)
 
         self.catalogue = EffectCatalogue()
         self.residual_panel = ResidualPanel()
@@ -127,13 +122,7 @@ class ModelLab(QWidget):
         self.candidates.apply_button.clicked.connect(self.on_apply)
         self.candidates.follow_button.clicked.connect(self.on_follow)
         self.candidates.selected_changed.connect(self.on_candidate_selected)
-        self.cancel_button.clicked.connect(self.on_cancel)
-        self.worker.progress.connect(self.on_progress)
-        self.worker.refit_finished.connect(self.on_refit_finished)
-        self.worker.diagnosis_finished.connect(self.on_diagnosis_finished)
-        self.worker.failed.connect(self.on_failed)
-        self.worker.cancelled.connect(self.on_cancelled)
-        self._set_busy(False)
+        self._update_buttons()
 
     # -- state -------------------------------------------------------------
     @property
@@ -142,7 +131,7 @@ class ModelLab(QWidget):
 
     @property
     def busy(self) -> bool:
-        return self.job is not None
+        return self.jobs.busy
 
     @Slot(object)
     def set_result(self, result: AnalysisResult) -> None:
@@ -151,7 +140,7 @@ class ModelLab(QWidget):
             # The same recording: the Results page shows one of our versions, or Sd was edited.
             self._sync_sd(result.sd_m2)
             return
-        self._drop_job()
+        self.jobs.drop()
         if result.fit is None:          # a broken measurement: nothing the lab could start from
             self.base, self.data, self.versions = None, None, []
             self.empty.setText(f"Nothing to model: {result.not_fitted}")
@@ -173,7 +162,7 @@ class ModelLab(QWidget):
 
     def shutdown(self, wait_ms: int) -> bool:
         """Cancel the lab's work and wait for it; True when it stopped in time."""
-        self.job = None
+        self.jobs.drop()
         return self.worker.shutdown(wait_ms)
 
     def _sync_sd(self, sd_m2: float | None) -> None:
@@ -230,13 +219,6 @@ class ModelLab(QWidget):
         descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
         self.parameter_table.set_parameters(result.parameters, descriptions, result.sd_m2)
 
-    def _set_busy(self, busy: bool, text: str = "") -> None:
-        self.progress.setVisible(busy)
-        self.cancel_button.setVisible(busy)
-        if text:
-            self.status_label.setText(text)
-        self._update_buttons()
-
     def _update_buttons(self) -> None:
         ready = self.current is not None and not self.busy
         self.candidates.diagnose_button.setEnabled(ready)
@@ -249,19 +231,9 @@ class ModelLab(QWidget):
         self.candidates.apply_button.setToolTip(refusal or APPLY_TIP)
 
     # -- jobs --------------------------------------------------------------
-    def _drop_job(self) -> None:
-        """Cancel the running job and ignore whatever it still reports."""
-        if self.job is not None:
-            self.job.cancel()
-            self.job = None
-            self._set_busy(False)
-
-    def _take(self, job: int) -> LabJob | None:
-        if self.job is None or self.job.id != job:
-            return None
-        current, self.job = self.job, None
-        self._set_busy(False)
-        return current
+    def _run(self, job, text: str, finished) -> None:
+        self.status_label.setText("")           # the job controls say what is being done
+        self.jobs.run(job, text, finished, self.on_failed, self.on_cancelled)
 
     @Slot(tuple)
     def on_selection_changed(self, checked: tuple) -> None:
@@ -275,11 +247,11 @@ class ModelLab(QWidget):
             self.catalogue.set_checked(current.effect_ids)
             self.status_label.setText(f"Cannot build that model: {exc}")
             return
-        self._drop_job()         # a newer choice replaces a refit or diagnosis still running
+        self.jobs.drop()         # a newer choice replaces a refit or diagnosis still running
         if model.effect_ids == current.effect_ids:
             return
-        self.job = self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values)
-        self._set_busy(True, f"Refitting {model.describe()} ({move_text(current, model)})…")
+        self._run(self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values),
+                  f"Refitting: {move_text(current, model)}…", self.on_refit_finished)
 
     @Slot()
     def on_new_effect(self) -> None:
@@ -301,8 +273,8 @@ class ModelLab(QWidget):
     def on_diagnose(self) -> None:
         if self.current is None or self.busy:
             return
-        self.job = self.worker.diagnose(self.base, self.data, self.current.fitted.fit)
-        self._set_busy(True, f"Diagnosing version {self.current.number}…")
+        self._run(self.worker.diagnose(self.base, self.data, self.current.fitted.fit),
+                  f"Diagnosing version {self.current.number}…", self.on_diagnosis_finished)
 
     @Slot()
     def on_follow(self) -> None:
@@ -311,8 +283,9 @@ class ModelLab(QWidget):
         taken = None
         if self.diagnosis is not None and self.diagnosis_version == self.current.number:
             taken = self.diagnosis.chosen     # ranked already: the path goes on from the one it would take
-        self.job = self.worker.diagnose(self.base, self.data, self.current.fitted.fit, follow=True, taken=taken)
-        self._set_busy(True, f"Following the greedy path from version {self.current.number}…")
+        self._run(self.worker.diagnose(self.base, self.data, self.current.fitted.fit, follow=True, taken=taken),
+                  f"Following the greedy path from version {self.current.number}…",
+                  lambda outcome: self.on_diagnosis_finished(outcome, follow=True))
 
     @Slot()
     def on_apply(self) -> None:
@@ -332,32 +305,14 @@ class ModelLab(QWidget):
             self.catalogue.show_effect(row.effect.id)     # the whole catalogue entry of the candidate
         self._update_buttons()
 
-    @Slot()
-    def on_cancel(self) -> None:
-        if self.job is not None:
-            self.job.cancel()
-            self.status_label.setText("Cancelling…")
-
-    # -- the worker's signals ------------------------------------------------
-    @Slot(int, str)
-    def on_progress(self, job: int, text: str) -> None:
-        if self.job is not None and self.job.id == job:
-            self.status_label.setText(text[:1].upper() + text[1:] + "…")
-
-    @Slot(int, object)
-    def on_refit_finished(self, job: int, fitted: LabFit) -> None:
-        if self._take(job) is None:
-            return
+    # -- the jobs' outcomes ------------------------------------------------
+    def on_refit_finished(self, fitted: LabFit) -> None:
         old = self.current
         self._add_version(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
         self.status_label.setText(f"Refitted: reduced χ² {chi2_text(old.fitted.fit.chi2_red_by_channel())} → "
                                   f"{chi2_text(fitted.fit.chi2_red_by_channel())}")
 
-    @Slot(int, object)
-    def on_diagnosis_finished(self, job: int, outcome: DiagnosisOutcome) -> None:
-        finished = self._take(job)
-        if finished is None:
-            return
+    def on_diagnosis_finished(self, outcome: DiagnosisOutcome, follow: bool = False) -> None:
         start = self.current.number
         for step, fitted in enumerate(outcome.path, start=1):
             previous = self.current.fitted.fit.model
@@ -371,7 +326,7 @@ class ModelLab(QWidget):
             self.views.setCurrentWidget(self.site_panel)     # the misfit left: where it belongs
         if outcome.path:
             self.status_label.setText(f"Greedy path: {len(outcome.path)} step(s), now version {self.current.number}")
-        elif getattr(finished, "follow", False):
+        elif follow:
             self.status_label.setText("The greedy path stops at once: no candidate explains the misfit it removes")
         else:
             self.status_label.setText(f"Diagnosed version {self.current.number}: {len(outcome.candidates)} "
@@ -379,18 +334,12 @@ class ModelLab(QWidget):
         self._update_buttons()
         self.diagnosis_shown.emit(outcome)
 
-    @Slot(int, str)
-    def on_failed(self, job: int, message: str) -> None:
-        if self._take(job) is None:
-            return
+    def on_failed(self, message: str) -> None:
         self.catalogue.set_checked(self.current.fitted.fit.model.effect_ids)
         self.status_label.setText(f"Failed: {message}; still version {self.current.number}")
         self.job_failed.emit(message)
 
-    @Slot(int)
-    def on_cancelled(self, job: int) -> None:
-        if self._take(job) is None:
-            return
+    def on_cancelled(self) -> None:
         self.catalogue.set_checked(self.current.fitted.fit.model.effect_ids)
         self.status_label.setText(f"Cancelled: still version {self.current.number}")
         self.job_cancelled.emit()

@@ -23,6 +23,7 @@ from analysis.archive.backends import shown
 from app import style
 from app.archive_filter import NO_DATE, date_edit
 from app.archive_page import archive_source
+from app.job_controls import JobControls
 from app.parameter_table import display_name
 from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit
 from app.production_worker import ProductionRequest, ProductionWorker
@@ -70,8 +71,8 @@ class ProductionPage(QWidget):
         super().__init__(parent)
         self.settings = settings
         self.worker = ProductionWorker(self)
+        self.jobs = JobControls(self.worker, cancel_tip="Stop computing; the statistics shown stay", bar_width=120)
         self.data = None
-        self._job: int | None = None
         self.parameter: str | None = None
 
         self.source_label = QLabel()
@@ -112,8 +113,6 @@ class ProductionPage(QWidget):
         self.refresh_button.clicked.connect(self.refresh)
         self.export_button.clicked.connect(self.on_export)
         self.stats_table.itemSelectionChanged.connect(self.on_parameter_chosen)
-        self.worker.computed.connect(self.on_computed)
-        self.worker.failed.connect(self.on_failed)
         self.export_button.setEnabled(False)
 
     def _build_layout(self) -> None:
@@ -129,6 +128,7 @@ class ProductionPage(QWidget):
         top.addWidget(self.baseline_spin)
         top.addWidget(self.refresh_button)
         top.addWidget(self.export_button)
+        top.addWidget(self.jobs)
         filters = QHBoxLayout()
         for label, widget in (("Measured from", self.since_edit), ("to", self.until_edit), ("", self.station_combo),
                               ("", self.driver_combo)):
@@ -170,9 +170,10 @@ class ProductionPage(QWidget):
         self.filter_timer.stop()
         request = self.request()
         self.source_label.setText(shown(request.source))
-        self._job = self.worker.start(request)
-        self.summary.setText("Reading the archive and computing…")
-        return self._job
+        job = self.worker.start(request)
+        self.jobs.run(job, "Reading the archive and computing…", self.on_computed, self.on_failed,
+                      lambda: self.summary.setText("Cancelled: the statistics shown are the previous ones."))
+        return job.id
 
     def showEvent(self, event) -> None:
         super().showEvent(event)
@@ -184,18 +185,12 @@ class ProductionPage(QWidget):
         self.message.setVisible(bool(text))
 
     # -- showing -----------------------------------------------------------------------------
-    def on_failed(self, job: int, message: str) -> None:
-        if job != self._job:
-            return
-        self._job = None
+    def on_failed(self, message: str) -> None:
         self.summary.setText("")
         self._say(f"Cannot compute the production statistics of {shown(self.request().source)}: {message}")
         self.failed.emit(message)
 
-    def on_computed(self, job: int, data) -> None:
-        if job != self._job:
-            return
-        self._job = None
+    def on_computed(self, data) -> None:
         self.data = data
         self._say("; ".join(data.notes), "note") if data.notes else self.message.hide()
         self._offer(self.station_combo, data.population.stations)

@@ -14,19 +14,19 @@ from __future__ import annotations
 
 import html
 import importlib.util
-import threading
 from pathlib import Path
 from typing import Mapping
 
-from PySide6.QtCore import QObject, QSettings, Qt, QThreadPool, Signal
+from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxLayout, QHeaderView, QLabel,
-                               QProgressBar, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+                               QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.pipeline import AnalysisResult
 from app.fit_quality import model_words
+from app.job_book import Job, JobRunner
+from app.job_controls import JobControls
 from app.parameter_table import display_name, value_with_unit
 from app.traffic_light import CHANNELS, ChannelLight, TrafficLight
-from app.job_book import failure_text
 
 
 LIMITS_MODULE, REPORT_MODULE = "analysis.limits", "analysis.report"
@@ -69,44 +69,23 @@ def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str
     return "pass", "every parameter within its limits" + doubt
 
 
-class ReportWorker(QObject):
-    """Renders and writes one report at a time in a pool thread (matplotlib takes a second or two)."""
+def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> str:
+    """Render and write one report (matplotlib takes a second or two); what was written.
 
-    finished = Signal(int, str)         # job id, what was written
-    failed = Signal(int, str)
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        self._next = 0
-
-    def start(self, result: AnalysisResult, path: Path, cancel: threading.Event, limits=None) -> int:
-        """limits: the analysis.limits.Limits the page shows, for the report's QA section (None: none)."""
-        self._next += 1
-        job = self._next
-        self.pool.start(lambda: self._run(job, result, path, cancel, limits))
-        return job
-
-    def _run(self, job: int, result: AnalysisResult, path: Path, cancel: threading.Event, limits) -> None:
-        try:
-            from analysis.archive.results import (StoredResult, calibration_of, header_of_recording,
-                                                  results_document)
-            from analysis.recording import read_recording
-            from analysis.report import build_report, write_report
-            recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
-            stored = StoredResult.from_json(results_document(result, recording))
-            # The header a report of the same recording has from the command line or the archive.
-            header = header_of_recording(recording) if recording is not None else {}
-            calibration = calibration_of(recording) if recording is not None else {}
-            content = build_report(stored, header, None, calibration, limits)
-            if cancel.is_set():
-                return
-            kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
-            written = write_report(content, **kind)
-            self.finished.emit(job, ", ".join(str(p) for p in written))
-        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            self.failed.emit(job, failure_text(exc, f"writing the report {path.name}"))
+    limits: the analysis.limits.Limits the page shows, for the report's QA section (None: none).
+    """
+    from analysis.archive.results import StoredResult, calibration_of, header_of_recording, results_document
+    from analysis.recording import read_recording
+    from analysis.report import build_report, write_report
+    recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
+    stored = StoredResult.from_json(results_document(result, recording))
+    # The header a report of the same recording has from the command line or the archive.
+    header = header_of_recording(recording) if recording is not None else {}
+    calibration = calibration_of(recording) if recording is not None else {}
+    content = build_report(stored, header, None, calibration, limits)
+    job.check()                     # cancelled: nothing written
+    kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
+    return ", ".join(str(p) for p in write_report(content, **kind))
 
 
 class QAView(QWidget):
@@ -120,11 +99,7 @@ class QAView(QWidget):
         self.limits = None
         self.verdicts: tuple = ()
         self.verdict = "none"
-        self._job: int | None = None
-        self._cancel = threading.Event()
-        self.worker = ReportWorker(self)
-        self.worker.finished.connect(self.on_report_written)
-        self.worker.failed.connect(self.on_report_failed)
+        self.worker = JobRunner(self, max_threads=1)     # one report at a time
 
         self.source = QLabel("No result yet: measure a driver, or open a recording.")
         self.source.setWordWrap(True)
@@ -152,16 +127,13 @@ class QAView(QWidget):
         self.export_button = QPushButton("Export report…")
         self.export_label = QLabel()
         self.export_label.setWordWrap(True)
-        self.export_progress = QProgressBar()
-        self.export_progress.setRange(0, 0)
-        self.export_progress.setMaximumWidth(160)
-        self.export_cancel = QPushButton("Cancel")
+        self.export_jobs = JobControls(self.worker, cancel_tip="Stop writing the report: nothing is written",
+                                       bar_width=160)
+        self.export_jobs.busy_changed.connect(lambda _busy: self._update_export())
         self._build_layout()
 
         self.load_button.clicked.connect(self.on_load_limits)
         self.export_button.clicked.connect(self.on_export)
-        self.export_cancel.clicked.connect(self.on_cancel_export)
-        self._set_exporting(False)
         self._restore_limits()
         self.refresh()
 
@@ -190,8 +162,7 @@ class QAView(QWidget):
         report_box = QGroupBox("Report")
         report_layout = QHBoxLayout(report_box)
         report_layout.addWidget(self.export_button)
-        report_layout.addWidget(self.export_progress)
-        report_layout.addWidget(self.export_cancel)
+        report_layout.addWidget(self.export_jobs)
         report_layout.addWidget(self.export_label, 1)
         right = QVBoxLayout()
         right.addWidget(limits_box, 1)
@@ -203,7 +174,7 @@ class QAView(QWidget):
     # -- input -------------------------------------------------------------------
     def set_result(self, result: AnalysisResult | None) -> None:
         self.result = result
-        if self._job is None:
+        if not self.export_jobs.busy:
             self.export_label.setText("")          # "Written ..." was about the previous result
         self.refresh()
 
@@ -319,7 +290,7 @@ class QAView(QWidget):
             self.export_button.setToolTip(NO_REPORT)
             self.export_label.setText(NO_REPORT)
             return
-        exporting = self._job is not None
+        exporting = self.export_jobs.busy
         self.export_button.setEnabled(self.result is not None and not exporting)
         if exporting:
             return
@@ -329,11 +300,6 @@ class QAView(QWidget):
             self.export_label.setText("A PDF or HTML report of this result: parameters, validity, plots"
                                       + (", and the QA verdict against the loaded limits." if self.limits is not None
                                          else "."))
-
-    def _set_exporting(self, exporting: bool) -> None:
-        self.export_progress.setVisible(exporting)
-        self.export_cancel.setVisible(exporting)
-        self._update_export()
 
     def on_load_limits(self) -> None:
         start = str(Path(self.settings.value(LIMITS_KEY, "")).parent) if self.settings is not None else ""
@@ -351,33 +317,18 @@ class QAView(QWidget):
             self.export_to(Path(path))
 
     def export_to(self, path: Path) -> None:
-        self._cancel = threading.Event()
-        # Limits are frozen dataclasses: handing the loaded ones to the pool thread is safe.
-        self._job = self.worker.start(self.result, path, self._cancel, self.limits)
-        self.export_label.setText(f"Writing {path.name}…")
-        self._set_exporting(True)
+        result, limits = self.result, self.limits   # frozen dataclasses: safe to hand to the pool thread
+        job = self.worker.run("report", lambda job: write_report_file(job, result, path, limits),
+                              f"writing the report {path.name}")
+        self.export_label.setText("")
+        self.export_jobs.run(job, f"Writing {path.name}…", self.on_report_written,
+                             lambda message: self.export_label.setText(f"Could not write the report: {message}"),
+                             lambda: self.export_label.setText("Export cancelled: nothing written."))
 
-    def on_cancel_export(self) -> None:
-        self._cancel.set()
-        self._job = None
-        self.export_label.setText("Export cancelled: nothing written.")
-        self._set_exporting(False)
-
-    def on_report_written(self, job: int, written: str) -> None:
-        if job != self._job:
-            return
-        self._job = None
-        self._set_exporting(False)
+    def on_report_written(self, written: str) -> None:
         self.export_label.setText(f"Written: {written}")
         self.report_written.emit(written)
 
-    def on_report_failed(self, job: int, message: str) -> None:
-        if job != self._job:
-            return
-        self._job = None
-        self._set_exporting(False)
-        self.export_label.setText(f"Could not write the report: {message}")
-
     def shutdown(self, wait_ms: int) -> bool:
-        self._cancel.set()
-        return self.worker.pool.waitForDone(wait_ms)
+        self.export_jobs.drop()
+        return self.worker.shutdown(wait_ms)

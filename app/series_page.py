@@ -6,77 +6,41 @@ Two questions a lab asks of a set of recordings:
 - Level series (Table II and Fig. 14): the same driver at rising levels:
   the parameters against peak excursion.
 
-Each set is analysed by a pool thread (one recording after the other); the
-page only shows what analysis.repeatability and analysis.level_series return.
+Each set is analysed by a job (app.job_book, one recording after the other)
+shown by the panel's JobControls; the page only shows what
+analysis.repeatability and analysis.level_series return.
 """
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 from typing import Callable, Sequence
 
-from PySide6.QtCore import QObject, QThreadPool, Signal
-from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QHBoxLayout, QLabel, QProgressBar, QPushButton,
-                               QTableWidget, QTableWidgetItem, QTabWidget, QVBoxLayout, QWidget)
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QHBoxLayout, QLabel, QPushButton, QTableWidget,
+                               QTableWidgetItem, QTabWidget, QVBoxLayout, QWidget)
 
 from analysis.level_series import level_series
 from analysis.pipeline import analyze_path, require_fit
 from analysis.repeatability import Spread, repeatability
+from app.job_book import Job, JobRunner
+from app.job_controls import JobControls
 from app.level_series_view import LevelSeriesView
-from app.job_book import failure_text
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 
 
-class SeriesCancelled(Exception):
-    pass
-
-
-class SeriesWorker(QObject):
-    """Runs one set at a time in a pool thread; signals carry the kind ("repeatability" or "levels")."""
-
-    progress = Signal(str, int, int)        # kind, done, total
-    finished = Signal(str, object)          # kind, result
-    failed = Signal(str, str)               # kind, message
-
-    def __init__(self, parent=None):
-        super().__init__(parent)
-        self.pool = QThreadPool(self)
-        self.pool.setMaxThreadCount(1)
-        # NB: set by the GUI thread, read by the pool thread between recordings.
-        self.cancel_event = threading.Event()
-
-    def start(self, kind: str, paths: Sequence[Path]) -> None:
-        self.cancel_event = threading.Event()
-        cancel = self.cancel_event
-        self.pool.start(lambda: self._run(kind, list(paths), cancel))
-
-    def cancel(self) -> None:
-        self.cancel_event.set()
-
-    def _analysed(self, kind: str, paths: list[Path], cancel: threading.Event) -> list:
-        results = []
-        for done, path in enumerate(paths):
-            if cancel.is_set():
-                raise SeriesCancelled()
-            self.progress.emit(kind, done, len(paths))
-            result = analyze_path(path)
-            require_fit(result, f"be one of the {kind} results")
-            results.append(result)
-        return results
-
-    def _run(self, kind: str, paths: list[Path], cancel: threading.Event) -> None:
-        try:
-            results = self._analysed(kind, paths, cancel)
-            if kind == "repeatability":
-                outcome = (repeatability([r.parameters for r in results]), len(results))
-            else:
-                outcome = level_series(results)
-            self.finished.emit(kind, outcome)
-        except SeriesCancelled:
-            self.failed.emit(kind, "cancelled")
-        except Exception as exc:  # noqa: BLE001 - the job runner is the GUI's error boundary (job_book)
-            self.failed.emit(kind, failure_text(exc, f"the {kind} analysis"))
+def analysed_set(job: Job, kind: str, paths: list[Path]):
+    """The set analysed one recording after the other (a cancel is heard between them), then its spread."""
+    results = []
+    for done, path in enumerate(paths):
+        job.check()
+        job.progress(done / len(paths), f"analysing recording {done + 1} of {len(paths)}")
+        result = analyze_path(path)
+        require_fit(result, f"be one of the {kind} results")
+        results.append(result)
+    if kind == "repeatability":
+        return repeatability([r.parameters for r in results]), len(results)
+    return level_series(results)
 
 
 class RepeatabilityTable(QTableWidget):
@@ -103,41 +67,23 @@ class RepeatabilityTable(QTableWidget):
 
 
 class _SetPanel(QWidget):
-    """A button to choose recordings, a progress line, and the result widget below."""
+    """A button to choose recordings, the job's progress and Cancel, a status line, and the result widget below."""
 
-    def __init__(self, title: str, hint: str, result: QWidget, choose: Callable[[], None], cancel: Callable[[], None]):
+    def __init__(self, title: str, hint: str, result: QWidget, choose: Callable[[], None], worker: JobRunner):
         super().__init__()
         self.choose_button = QPushButton(title)
         self.choose_button.clicked.connect(choose)
-        self.cancel_button = QPushButton("Cancel")
-        self.cancel_button.clicked.connect(cancel)
-        self.cancel_button.setEnabled(False)
-        self.progress = QProgressBar()
-        self.progress.setVisible(False)
+        self.jobs = JobControls(worker, cancel_tip="Stop the analysis of the set; the result shown stays")
+        self.jobs.busy_changed.connect(lambda busy: self.choose_button.setEnabled(not busy))
         self.status = QLabel(hint)
         self.status.setWordWrap(True)
         row = QHBoxLayout()
-        for w in (self.choose_button, self.cancel_button, self.progress):
-            row.addWidget(w)
-        row.addStretch(1)
+        row.addWidget(self.choose_button)
+        row.addWidget(self.jobs, 1)
         layout = QVBoxLayout(self)
         layout.addLayout(row)
         layout.addWidget(self.status)
         layout.addWidget(result, 1)
-
-    def busy(self, done: int, total: int) -> None:
-        self.choose_button.setEnabled(False)
-        self.cancel_button.setEnabled(True)
-        self.progress.setVisible(True)
-        self.progress.setRange(0, total)
-        self.progress.setValue(done)
-        self.status.setText(f"analysing recording {done + 1} of {total}…")
-
-    def idle(self, message: str) -> None:
-        self.choose_button.setEnabled(True)
-        self.cancel_button.setEnabled(False)
-        self.progress.setVisible(False)
-        self.status.setText(message)
 
 
 class SeriesPage(QTabWidget):
@@ -145,10 +91,13 @@ class SeriesPage(QTabWidget):
 
     # The level series' recordings, for the Large-signal page (the drift's reason: Bl(x), Kms(x), Le(x)).
     large_signal_requested = Signal(list)
+    analysis_started = Signal(str)          # kind ("repeatability" or "levels")
+    analysed = Signal(str)                  # kind, once its result is on the page
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.worker = SeriesWorker(self)
+        # One set at a time per page, one thread: a set's recordings are analysed one after the other.
+        self.worker = JobRunner(self, max_threads=1)
         self.level_paths: list[Path] = []
         self.repeat_table = RepeatabilityTable()
         self.levels_view = LevelSeriesView()
@@ -156,23 +105,20 @@ class SeriesPage(QTabWidget):
             "repeatability": _SetPanel("Choose repeated recordings…",
                                        "The same driver measured several times (remounted between): mean, standard "
                                        "deviation and percent per parameter.",
-                                       self.repeat_table, lambda: self.on_choose("repeatability"), self.worker.cancel),
+                                       self.repeat_table, lambda: self.on_choose("repeatability"), self.worker),
             "levels": _SetPanel("Choose recordings at rising levels…",
                                 "The same driver at rising drive levels: the parameters and fs against peak "
                                 "excursion.",
-                                self.levels_view, lambda: self.on_choose("levels"), self.worker.cancel),
+                                self.levels_view, lambda: self.on_choose("levels"), self.worker),
         }
         self.large_signal_button = QPushButton("Large-signal curves of these recordings…")
         self.large_signal_button.setToolTip("Bl(x), Kms(x) and Le(x) behind the drift, the coil's rest offset and the "
                                             "excursion limits, on the Large-signal page")
         self.large_signal_button.setEnabled(False)
         self.large_signal_button.clicked.connect(lambda: self.large_signal_requested.emit(list(self.level_paths)))
-        self.panels["levels"].layout().itemAt(0).layout().insertWidget(2, self.large_signal_button)
+        self.panels["levels"].layout().itemAt(0).layout().insertWidget(1, self.large_signal_button)
         self.addTab(self.panels["repeatability"], "Repeatability")
         self.addTab(self.panels["levels"], "Level series")
-        self.worker.progress.connect(self.on_progress)
-        self.worker.finished.connect(self.on_finished)
-        self.worker.failed.connect(self.on_failed)
 
     def on_choose(self, kind: str) -> None:
         paths, _ = QFileDialog.getOpenFileNames(self, "Choose recordings", "", RECORDING_FILTER)
@@ -181,27 +127,33 @@ class SeriesPage(QTabWidget):
 
     def analyse(self, kind: str, paths: Sequence[Path]) -> None:
         stems = sorted({p.with_suffix("") for p in paths})
+        panel = self.panels[kind]
         if len(stems) < 2:
-            self.panels[kind].idle("Choose at least two recordings: a spread needs more than one.")
+            panel.status.setText("Choose at least two recordings: a spread needs more than one.")
             return
-        self.panels[kind].busy(0, len(stems))
         if kind == "levels":
             self.level_paths = list(stems)
             self.large_signal_button.setEnabled(False)
-        self.worker.start(kind, stems)
-
-    def on_progress(self, kind: str, done: int, total: int) -> None:
-        self.panels[kind].busy(done, total)
+        job = self.worker.run(kind, lambda job: analysed_set(job, kind, stems), f"the {kind} analysis")
+        panel.status.setText("")
+        panel.jobs.run(job, f"Analysing {len(stems)} recordings…", lambda outcome: self.on_finished(kind, outcome),
+                       lambda message: panel.status.setText(f"Not analysed: {message}"),
+                       lambda: panel.status.setText("Cancelled: the result shown (if any) is the previous one."))
+        self.analysis_started.emit(kind)
 
     def on_finished(self, kind: str, outcome) -> None:
         if kind == "repeatability":
             spreads, n = outcome
             self.repeat_table.set_spreads(spreads)
-            self.panels[kind].idle(f"{n} recordings analysed.")
+            self.panels[kind].status.setText(f"{n} recordings analysed.")
         else:
             self.levels_view.set_series(outcome)
-            self.panels[kind].idle(f"{len(outcome.levels)} levels analysed.")
+            self.panels[kind].status.setText(f"{len(outcome.levels)} levels analysed.")
             self.large_signal_button.setEnabled(True)
+        self.analysed.emit(kind)
 
-    def on_failed(self, kind: str, message: str) -> None:
-        self.panels[kind].idle(f"Not analysed: {message}")
+    def shutdown(self, wait_ms: int) -> bool:
+        """Cancel the set being analysed and wait for it; whatever it says later is dropped."""
+        for panel in self.panels.values():
+            panel.jobs.drop()
+        return self.worker.shutdown(wait_ms)

@@ -217,7 +217,7 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
     on_finished = finished.append
     on_failed = lambda job, message: failed.append(message)      # noqa: E731
     wizard.measurement_finished.connect(on_finished)
-    page.jobs.session.failed.connect(on_failed)
+    page.jobs.runner.failed.connect(on_failed)
     paints_before, frames_before = len(page.panels.paint_times), page.panels.frames_received
     with StallMeter() as meter:
         page.start_button.click()
@@ -232,7 +232,7 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
         ok = _wait(app, lambda: finished or failed)
         _wait(app, lambda: False, 0.3)          # the hand-off to the Results page, the Model lab and QA
     wizard.measurement_finished.disconnect(on_finished)
-    page.jobs.session.failed.disconnect(on_failed)
+    page.jobs.runner.failed.disconnect(on_failed)
     if not ok or failed:
         return {"failed": failed[0] if failed else "timed out"}
     frames = page.panels.frames_received - frames_before - sent[0]

@@ -12,7 +12,8 @@ from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox
 from app import style
 from app.grid_axis import show_grid
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
-from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
+from app.job_controls import JobControls
+from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.calibration import Corrections, CorrectionsError
 from app.wizard.hardware import RIG, SIMULATOR
 

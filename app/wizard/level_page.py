@@ -7,7 +7,8 @@ from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QDoubleSpinBox, QFo
                                QHeaderView, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout)
 
 from app.live_panels import LivePanels
-from app.wizard.base import ERROR_COLOUR, OK_COLOUR, JobControls, WizardPage, coloured, rich_label
+from app.job_controls import JobControls
+from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.plans import TEMPLATES
 
 PROBE_COLUMNS = ("Level\n(V rms)", "Weakest SNR\n(dB)", "Noise + distortion\nover the floor (dB)",

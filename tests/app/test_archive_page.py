@@ -188,7 +188,7 @@ def test_more_than_eight_selected_is_a_message_not_a_crash(qtbot, window, archiv
     assert "9 selected: at most 8" in page.selection_label.text()
     page.compare_button.click()
     assert "9 measurements are selected, but at most 8" in page.message.text() and page.message.isVisible()
-    assert page._compare_job is None and page.compare_view.table.rowCount() == 0
+    assert not page.jobs.busy and page.compare_view.table.rowCount() == 0
     assert page.tabs.currentWidget() is page.list_tab
 
 

@@ -54,14 +54,14 @@ def test_the_measurement_shows_its_work_on_the_click(qtbot, window, settings, tm
 def test_opening_a_recording_and_diagnosing_show_their_work_on_the_click(qtbot, window, recordings):
     with qtbot.waitSignal(window.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS):
         window.open_path(recordings["paper"])
-        _shows_work(window.progress, window.cancel_button, window.status_label.text())
+        _shows_work(window.jobs.progress, window.jobs.cancel_button, window.jobs.text.text())
     lab = window.model_lab
     window.pages.setCurrentWidget(lab)
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
-    _shows_work(lab.progress, lab.cancel_button, lab.status_label.text())
+    _shows_work(lab.jobs.progress, lab.jobs.cancel_button, lab.jobs.text.text())
     assert not lab.candidates.diagnose_button.isEnabled()
     with qtbot.waitSignal(lab.job_cancelled, timeout=ANALYSIS_TIMEOUT_MS):
-        qtbot.mouseClick(lab.cancel_button, Qt.LeftButton)
+        qtbot.mouseClick(lab.jobs.cancel_button, Qt.LeftButton)
 
 
 def test_series_and_large_signal_analyses_show_their_work_at_once(qtbot, window, recordings):
@@ -70,13 +70,13 @@ def test_series_and_large_signal_analyses_show_their_work_at_once(qtbot, window,
     series.analyse("repeatability", paths)
     panel = series.panels["repeatability"]
     window.pages.setCurrentWidget(series)
-    _shows_work(panel.progress, panel.cancel_button, panel.status.text())
-    qtbot.mouseClick(panel.cancel_button, Qt.LeftButton)
+    _shows_work(panel.jobs.progress, panel.jobs.cancel_button, panel.jobs.text.text())
+    qtbot.mouseClick(panel.jobs.cancel_button, Qt.LeftButton)
     large = window.large_signal
     window.pages.setCurrentWidget(large)
     large.analyse(paths)
-    _shows_work(large.progress, large.cancel_button, large.status.text())
-    qtbot.mouseClick(large.cancel_button, Qt.LeftButton)
+    _shows_work(large.jobs.progress, large.jobs.cancel_button, large.jobs.text.text())
+    qtbot.mouseClick(large.jobs.cancel_button, Qt.LeftButton)
     # The workers' threads end before the window goes: a thread emitting into a deleted page raises.
     assert series.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)
     assert large.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)

@@ -54,12 +54,12 @@ def test_cancel_stops_the_analysis_and_the_gui_stays_responsive(qtbot, window, r
     monkeypatch.setattr(app.workers, "analyze_recording", blocked)
     window.open_path(recordings["paper"])
     qtbot.waitUntil(started.is_set, timeout=10_000)
-    assert window.busy and window.cancel_button.isVisible() and window.progress.isVisible()
+    assert window.busy and window.jobs.cancel_button.isVisible() and window.jobs.progress.isVisible()
     window.pages.setCurrentIndex(0)                 # the event loop runs while the worker is busy
     assert window.pages.currentIndex() == 0
     with qtbot.waitSignal(window.analysis_cancelled, timeout=10_000):
-        qtbot.mouseClick(window.cancel_button, Qt.LeftButton)
-    assert not window.busy and not window.cancel_button.isVisible()
+        qtbot.mouseClick(window.jobs.cancel_button, Qt.LeftButton)
+    assert not window.busy and not window.jobs.cancel_button.isVisible()
     assert "cancelled" in window.status_label.text().lower()
     assert window.results.result is None
 

@@ -215,11 +215,11 @@ def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
     monkeypatch.setattr(app.lab_worker, "fit_model", blocked)
     lab.catalogue.item("creep-log").setCheckState(0, Qt.Checked)
     qtbot.waitUntil(started.is_set, timeout=10_000)
-    assert lab.busy and lab.cancel_button.isVisible() and lab.progress.isVisible()
+    assert lab.busy and lab.jobs.cancel_button.isVisible() and lab.jobs.progress.isVisible()
     assert not lab.candidates.diagnose_button.isEnabled()
     with qtbot.waitSignal(lab.job_cancelled, timeout=10_000):
-        qtbot.mouseClick(lab.cancel_button, Qt.LeftButton)
-    assert not lab.busy and not lab.cancel_button.isVisible()
+        qtbot.mouseClick(lab.jobs.cancel_button, Qt.LeftButton)
+    assert not lab.busy and not lab.jobs.cancel_button.isVisible()
     assert len(lab.versions) == 1 and lab.catalogue.checked() == ("lr2",)
     assert "cancelled" in lab.status_label.text().lower()
 
@@ -243,7 +243,7 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: bool(calls), timeout=10_000)
     with qtbot.waitSignal(lab.job_cancelled, timeout=10_000):
-        qtbot.mouseClick(lab.cancel_button, Qt.LeftButton)
+        qtbot.mouseClick(lab.jobs.cancel_button, Qt.LeftButton)
     assert len(calls) <= 2 < len(analysis.diagnosis.candidate_models(lab.current.fitted.fit.model))
     assert lab.candidates.table.rowCount() == 0 and len(lab.versions) == 1
     assert lab.candidates.diagnose_button.isEnabled()

@@ -143,10 +143,10 @@ def test_the_report_is_written_off_the_gui_thread(qtbot, window, recordings, tmp
     target = tmp_path / "paper-report.html"
     with qtbot.waitSignal(qa.report_written, timeout=60_000) as written:
         qa.export_to(target)
-        assert not qa.export_progress.isHidden() and not qa.export_cancel.isHidden()
+        assert not qa.export_jobs.progress.isHidden() and not qa.export_jobs.cancel_button.isHidden()
     assert str(target) in written.args[0]
     assert target.exists() and "paper" in target.read_text(encoding="utf-8").lower()
-    assert qa.export_progress.isHidden()
+    assert qa.export_jobs.progress.isHidden()
     assert "Written" in qa.export_label.text()
 
 
@@ -157,9 +157,9 @@ def test_a_cancelled_export_writes_nothing(qtbot, window, recordings, tmp_path):
     qa = window.qa
     target = tmp_path / "cancelled.pdf"
     qa.export_to(target)
-    qa.export_cancel.click()
+    with qtbot.waitSignal(qa.export_jobs.busy_changed, timeout=60_000):
+        qa.export_jobs.cancel_button.click()
     assert "cancelled" in qa.export_label.text()
-    qa.worker.pool.waitForDone(60_000)
     assert not target.exists()
 
 
