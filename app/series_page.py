@@ -22,9 +22,11 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QHBoxLayout, QLab
 from analysis.level_series import level_series
 from analysis.pipeline import analyze_path, require_fit
 from analysis.repeatability import Spread, repeatability
+from analysis.report.numbers import pretty_unit
 from app.job_book import Job, JobRunner
 from app.job_controls import JobControls
 from app.level_series_view import LevelSeriesView
+from app.parameter_table import display_name
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 
@@ -59,8 +61,9 @@ class RepeatabilityTable(QTableWidget):
 
             def shown(x, digits=5):
                 return "n/a" if x is None else f"{x * scale:.{digits}g}"
-            cells = (s.name, shown(s.mean), shown(s.std, 2), "" if s.percent is None else f"{s.percent:.2g}",
-                     shown(s.mean_fit_std, 2), s.display_unit, str(s.n))
+            unit = "" if s.display_unit in ("1", "-") else pretty_unit(s.display_unit)
+            cells = (display_name(s.name), shown(s.mean), shown(s.std, 2),
+                     "" if s.percent is None else f"{s.percent:.2g}", shown(s.mean_fit_std, 2), unit, str(s.n))
             for col, text in enumerate(cells):
                 self.setItem(row, col, QTableWidgetItem(text))
         self.resizeColumnsToContents()

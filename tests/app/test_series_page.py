@@ -22,8 +22,8 @@ def test_repeatability_of_three_recordings_shows_mean_and_spread(qtbot, page, tm
         page.analyse("repeatability", paths)
     table = page.repeat_table
     rows = {table.item(r, 0).text(): r for r in range(table.rowCount())}
-    assert float(table.item(rows["RE"], 1).text()) == pytest.approx(3.02, rel=1e-3)
-    assert table.item(rows["RE"], 6).text() == "3"
+    assert float(table.item(rows["Re"], 1).text()) == pytest.approx(3.02, rel=1e-3)      # the customary name
+    assert table.item(rows["Re"], 5).text() == "Ω" and table.item(rows["Re"], 6).text() == "3"
     assert float(table.item(rows["Bl"], 2).text()) > 0          # a spread over seeds, not zero
     assert "3 recordings" in page.panels["repeatability"].status.text()
 
