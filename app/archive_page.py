@@ -125,9 +125,9 @@ class ArchivePage(QWidget):
         top = QHBoxLayout()
         top.addWidget(QLabel("<b>Archive</b>"))
         top.addWidget(self.root_label, 1)
+        top.addWidget(self.jobs)
         for button in (self.root_button, self.rebuild_button, self.refresh_button):
             top.addWidget(button)
-        top.addWidget(self.jobs)
         actions = QHBoxLayout()
         actions.addWidget(self.count_label, 1)
         actions.addWidget(self.selection_label)

@@ -61,7 +61,7 @@ class LargeSignalPage(QWidget):
         controls = QHBoxLayout()
         for w in (self.choose_button, self.save_button):
             controls.addWidget(w)
-        controls.addWidget(self.jobs, 1)
+        controls.addWidget(self.jobs)
         controls.addWidget(self.status, 1)
         grid = QGridLayout()
         grid.addWidget(self.plots["Bl"], 0, 0)

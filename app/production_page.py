@@ -124,11 +124,11 @@ class ProductionPage(QWidget):
         top = QHBoxLayout()
         top.addWidget(QLabel("<b>Production</b>"))
         top.addWidget(self.source_label, 1)
+        top.addWidget(self.jobs)
         top.addWidget(QLabel("Baseline"))
         top.addWidget(self.baseline_spin)
         top.addWidget(self.refresh_button)
         top.addWidget(self.export_button)
-        top.addWidget(self.jobs)
         filters = QHBoxLayout()
         for label, widget in (("Measured from", self.since_edit), ("to", self.until_edit), ("", self.station_combo),
                               ("", self.driver_combo)):
