@@ -2,8 +2,9 @@
 offset, the excursion limits and the distortion the model predicts against the distortion measured.
 
 The identification (analysis.large_signal, a few seconds per recording) is a
-job (app.job_book) shown by a JobControls; the page shows what it returns. It is reached from the
-Series page's level series ("Large-signal curves") or with its own button.
+job (app.job_book) shown by a JobControls; the page shows what it returns.
+It is reached from the Series page's level series ("Large-signal curves")
+or with its own button.
 """
 from __future__ import annotations
 

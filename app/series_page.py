@@ -94,12 +94,10 @@ class SeriesPage(QTabWidget):
 
     # The level series' recordings, for the Large-signal page (the drift's reason: Bl(x), Kms(x), Le(x)).
     large_signal_requested = Signal(list)
-    analysis_started = Signal(str)          # kind ("repeatability" or "levels")
-    analysed = Signal(str)                  # kind, once its result is on the page
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        # One set at a time per page, one thread: a set's recordings are analysed one after the other.
+        # One thread: a set's recordings are analysed one after the other, and a second set waits for the first.
         self.worker = JobRunner(self, max_threads=1)
         self.level_paths: list[Path] = []
         self.repeat_table = RepeatabilityTable()
@@ -142,7 +140,6 @@ class SeriesPage(QTabWidget):
         panel.jobs.run(job, f"Analysing {len(stems)} recordings…", lambda outcome: self.on_finished(kind, outcome),
                        lambda message: panel.status.setText(f"Not analysed: {message}"),
                        lambda: panel.status.setText("Cancelled: the result shown (if any) is the previous one."))
-        self.analysis_started.emit(kind)
 
     def on_finished(self, kind: str, outcome) -> None:
         if kind == "repeatability":
@@ -153,7 +150,6 @@ class SeriesPage(QTabWidget):
             self.levels_view.set_series(outcome)
             self.panels[kind].status.setText(f"{len(outcome.levels)} levels analysed.")
             self.large_signal_button.setEnabled(True)
-        self.analysed.emit(kind)
 
     def shutdown(self, wait_ms: int) -> bool:
         """Cancel the set being analysed and wait for it; whatever it says later is dropped."""
