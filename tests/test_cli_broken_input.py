@@ -95,7 +95,7 @@ def test_a_silent_voltage_is_reported_exported_and_archived_as_judged(capsys, re
     code, out, _ = run(capsys, "report", recordings["silent-voltage"], "--html", tmp_path / "r.html",
                        "--limits", limits)
     html = (tmp_path / "r.html").read_text(encoding="utf-8")
-    assert code == 0 and "QA: FAIL: measurement invalid: voltage" in out and "[no-signal]" in out
+    assert code == 0 and "QA: FAIL — measurement invalid: voltage" in out and "[no-signal]" in out
     assert "the unit itself was not judged" in out
     assert "QA: FAIL</span> measurement invalid" in html and "<b>no-signal</b>" in html
     assert "check that the amplifier is on" in html

@@ -89,7 +89,7 @@ def run_report(args: argparse.Namespace) -> int:
     content = build_report(stored, header, settings, calibration, limits)
     written = write_report(content, args.pdf, args.html)
     if content.qa is not None:
-        print(f"QA: {content.qa.headline}: {content.qa.why} (limits {content.qa.file})")
+        print(f"QA: {content.qa.headline} — {content.qa.why} (limits {content.qa.file})")
     _say_written(written)
     return 0
 
