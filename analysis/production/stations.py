@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.production.student_t import t_two_sided
+
 ALPHA = 0.01
 MIN_UNITS = 2
 
@@ -68,11 +70,6 @@ class StationComparison:
                 "alpha": ALPHA}
 
 
-def _t_two_sided(t: float, df: float) -> float:
-    from scipy.special import stdtr      # scipy.special alone: scipy.stats would add a second to `qa stats`
-    return float(2.0 * stdtr(df, -abs(t)))
-
-
 def welch(a: np.ndarray, b: np.ndarray) -> tuple[float, float | None, float | None, float | None]:
     """(mean(a) - mean(b), t, degrees of freedom, two-sided p); None where no spread makes t undefined."""
     offset = float(a.mean() - b.mean())
@@ -81,7 +78,7 @@ def welch(a: np.ndarray, b: np.ndarray) -> tuple[float, float | None, float | No
         return offset, None, None, None
     t = offset / math.sqrt(va + vb)
     df = (va + vb) ** 2 / (va ** 2 / (a.size - 1) + vb ** 2 / (b.size - 1))
-    return offset, t, df, _t_two_sided(t, df)
+    return offset, t, df, t_two_sided(t, df)
 
 
 @dataclass(frozen=True)
