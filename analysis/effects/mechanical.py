@@ -9,7 +9,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import j1, struve
 
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.lumped import C_SOUND, RHO, resonance_frequency
@@ -27,6 +26,7 @@ def piston_radiation_impedance(w: np.ndarray, a: float) -> np.ndarray:
     R1(x) = 1 - 2*J1(x)/x, X1(x) = 2*H1(x)/x (J1 Bessel, H1 Struve, both of order one); Beranek,
     'Acoustics', ch. 5; Kinsler et al., 'Fundamentals of Acoustics', sec. 7.5.
     """
+    from scipy.special import j1     # here, not at the top: `qa stats` reads these effects' units, not their model
     x = np.maximum(2.0 * np.asarray(w, dtype=float) * a / C_SOUND, 1e-12)
     return RHO * C_SOUND * np.pi * a * a * ((1.0 - 2.0 * j1(x) / x) + 1j * (4.0 * x / (3.0 * np.pi) + _x1_excess(x)))
 
@@ -39,6 +39,7 @@ _TABLE_X = (1e-2, 3e3, 20000)
 
 @functools.cache
 def _x1_excess_table() -> tuple[np.ndarray, np.ndarray]:
+    from scipy.special import struve
     x = np.geomspace(*_TABLE_X)
     return np.log(x), 2.0 * struve(1, x) / x - 4.0 * x / (3.0 * np.pi)
 
@@ -51,6 +52,7 @@ def _x1_excess(x: np.ndarray) -> np.ndarray:
     out[small] = 4.0 / np.pi * (-x[small] ** 3 / 45.0 + x[small] ** 5 / 1575.0)
     large = x > _TABLE_X[1]
     if large.any():
+        from scipy.special import struve
         out[large] = 2.0 * struve(1, x[large]) / x[large] - 4.0 * x[large] / (3.0 * np.pi)
     return out
 
