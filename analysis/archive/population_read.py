@@ -6,7 +6,10 @@ that alone. So the key parameters are also columns of the measurement's own
 row (analysis.archive.schema.value_column, written with it): one statement
 gives one row per unit, without joining the 1.2 million parameter rows or
 grouping, and the numbers go into arrays a column at a time. PostgreSQL sends
-its rows in binary (the doubles as they are). One statement: one snapshot.
+each row's numbers packed in one bytea, the doubles as they are (float8send,
+big-endian), which numpy reads in one go: 100,000 rows of 12 numbers as 1.2
+million Python floats and tuples cost a tenth of a second more. One
+statement: one snapshot.
 
 Both order the units by (measured_at, id): oldest first, ties broken the same
 way every time. Values are exact: binary doubles on PostgreSQL, the REAL
@@ -59,11 +62,24 @@ def empty_population(names=None, with_stds: bool = True) -> Population:
     return _population([()] * len(HEADS), {n: () for n in names}, {n: () for n in names} if with_stds else {})
 
 
+def _number_columns(names, with_stds: bool) -> list[str]:
+    return [c for n in names for c in ((value_column(n), std_column(n)) if with_stds else (value_column(n),))]
+
+
 def population_sql(names, with_stds: bool, where: str) -> str:
     """One row per unit, oldest first: HEADS, then each name's value (and std) from the measurement's own
     columns (schema.value_column): no join, no grouping."""
-    numbers = [c for n in names for c in ((value_column(n), std_column(n)) if with_stds else (value_column(n),))]
+    numbers = _number_columns(names, with_stds)
     return f"SELECT {', '.join(f'm.{c}' for c in (*HEADS, *numbers))} FROM measurements m{where} ORDER BY {ORDER}"
+
+
+def packed_population_sql(names, with_stds: bool, where: str) -> str:
+    """population_sql for PostgreSQL with the numbers of a row in one bytea: each double's 8 bytes as
+    float8send gives them (big-endian), NaN for NULL (|| of a NULL would make the whole row's NULL)."""
+    numbers = _number_columns(names, with_stds)
+    packed = " || ".join(f"float8send(coalesce(m.{c}, 'NaN'))" for c in numbers)
+    return (f"SELECT {', '.join(f'm.{c}' for c in HEADS)}{', ' + packed if packed else ''} FROM measurements m"
+            f"{where} ORDER BY {ORDER}")
 
 
 def read_sqlite(conn, selection: Selection, names=None, with_stds: bool = True) -> Population:
@@ -77,8 +93,8 @@ def read_postgres(conn, selection: Selection, names=None, with_stds: bool = True
     """The population from the server (a psycopg connection, search_path linpar): one statement, binary rows."""
     names = checked_names(names)
     where, args = where_clause(selection, "%s")
-    rows = conn.cursor(binary=True).execute(population_sql(names, with_stds, where), args).fetchall()
-    return _from_rows(rows, names, with_stds)
+    rows = conn.cursor(binary=True).execute(packed_population_sql(names, with_stds, where), args).fetchall()
+    return _from_packed_rows(rows, names, with_stds)
 
 
 def _from_rows(rows, names, with_stds: bool) -> Population:
@@ -90,4 +106,19 @@ def _from_rows(rows, names, with_stds: bool) -> Population:
         values[name] = finite_or_nan(np.array(next(numbers), dtype=float))     # None (no row, NULL): NaN
         if with_stds:
             stds[name] = finite_or_nan(np.array(next(numbers), dtype=float))
+    return _population(by_column[:len(HEADS)], values, stds)
+
+
+def _from_packed_rows(rows, names, with_stds: bool) -> Population:
+    """Rows of HEADS then one bytea of the numbers (packed_population_sql) -> a Population."""
+    per_row = len(names) * (2 if with_stds else 1)
+    by_column = list(zip(*rows)) if rows else [()] * (len(HEADS) + 1)
+    numbers = (np.frombuffer(b"".join(by_column[len(HEADS)]), dtype=">f8").reshape(len(rows), per_row)
+               if per_row else np.empty((len(rows), 0)))
+    columns = iter(numbers.T)
+    values, stds = {}, {}
+    for name in names:
+        values[name] = finite_or_nan(next(columns))        # a copy in native byte order
+        if with_stds:
+            stds[name] = finite_or_nan(next(columns))
     return _population(by_column[:len(HEADS)], values, stds)

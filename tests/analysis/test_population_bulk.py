@@ -159,3 +159,22 @@ def test_an_archive_of_the_previous_schema_is_migrated_with_its_key_parameter_co
     new = archive.population()
     assert len(new) == 40 and np.isnan(new.values["Bl"]).sum() == 1 and np.isnan(new.values["Qts"]).sum() == 1
     _same_population(new, old)
+
+
+def test_some_parameters_and_an_empty_selection_read_alike(archive_and_connection, measured):
+    """The numbers of a row are read by position (PostgreSQL packs them in one bytea): a subset of the
+    parameters, with and without their standard deviations, and a selection of no unit."""
+    archive, _connect, _mark = archive_and_connection
+    _store_population(archive, measured)
+    every = archive.population()
+    for with_stds in (True, False):
+        some = archive.population(names=("Qts", "fs"), with_stds=with_stds)
+        assert list(some.values) == ["Qts", "fs"] and list(some.stds) == (["Qts", "fs"] if with_stds else [])
+        for name in ("Qts", "fs"):
+            assert np.array_equal(some.values[name], every.values[name], equal_nan=True), name
+            if with_stds:
+                assert np.array_equal(some.stds[name], every.stds[name], equal_nan=True), name
+    nobody = archive.population(Selection(stations=("nobody",)).checked())
+    assert len(nobody) == 0 and nobody.ids == ()
+    assert all(v.shape == (0,) for v in (*nobody.values.values(), *nobody.stds.values()))
+    assert set(nobody.values) == set(KEY_PARAMETERS)
