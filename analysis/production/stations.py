@@ -93,7 +93,7 @@ class StationCodes:
     def of(cls, stations) -> "StationCodes":
         names = tuple(sorted(set(stations)))
         index = {s: i for i, s in enumerate(names)}
-        return cls(names, np.fromiter((index[s] for s in stations), dtype=np.intp, count=len(stations)))
+        return cls(names, np.fromiter(map(index.__getitem__, stations), dtype=np.intp, count=len(stations)))
 
     def subset(self, chosen: np.ndarray) -> "StationCodes":
         return StationCodes(self.names, self.codes[chosen])

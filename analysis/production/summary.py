@@ -104,8 +104,12 @@ def _counts(population) -> tuple[np.ndarray, dict, dict, dict]:
         verdicts[verdict or UNJUDGED] += n
         if version is not None:
             by_version.setdefault(version, Counter())[verdict] += n
-    keep = np.fromiter((reasons[pair] is None for pair in zip(population.validity, population.verdicts)),
-                       dtype=bool, count=len(population))
+    if not excluded:            # the usual case: every unit counts, no need to look at each one
+        keep = np.ones(len(population), dtype=bool)
+    else:
+        kept = {pair: reason is None for pair, reason in reasons.items()}
+        keep = np.fromiter(map(kept.__getitem__, zip(population.validity, population.verdicts)), dtype=bool,
+                           count=len(population))
     return keep, dict(excluded), dict(verdicts), {k: dict(v) for k, v in sorted(by_version.items())}
 
 
@@ -118,6 +122,7 @@ def production_stats(population, limits_version=None, baseline: int = DEFAULT_BA
     units = parameter_units()
     stations = StationCodes.of(population.stations)
     ids = np.asarray(population.ids, dtype=object)
+    every_id = tuple(population.ids)
     out = {}
     for name in (names or population.values):
         raw = population.values.get(name, np.array([]))
@@ -130,7 +135,8 @@ def production_stats(population, limits_version=None, baseline: int = DEFAULT_BA
         limit = limits.get(name)
         low, high = (limit.low, limit.high) if limit is not None else (None, None)
         si, display, scale = units.get(name, ("", "", 1.0))
-        out[name] = ParameterStats(name, si, display, scale, tuple(ids[use]), capability(x, low, high),
+        counted = every_id if x.size == ids.size else tuple(ids[use])      # usually every unit, for every parameter
+        out[name] = ParameterStats(name, si, display, scale, counted, capability(x, low, high),
                                    control_chart(x, baseline), _histogram(x, low, high),
                                    compare_station_codes(x, stations.subset(use)), limit.text if limit else None)
     return ProductionStats(selection, len(population), excluded, limits_version, verdicts, by_version, out)
