@@ -161,3 +161,30 @@ def test_production_stats_leave_out_what_judges_nothing_and_say_why():
     named = next(d for d in doc if d["first"] == alarm.triggers[0] and d["rule"] == alarm.rule)
     assert named["title"] and named["measurements"] == [fs.ids[i] for i in alarm.points]
     assert fs.display_unit == "Hz" and fs.histogram[1].sum() == 298
+
+
+def test_the_statistics_import_no_scipy():
+    """`qa stats` over 100,000 units must take about a second, and importing scipy.special alone took 0.1-0.3 s
+    of it: the statistics (stations' t tests included) and the units of the limits need no scipy."""
+    import subprocess
+    import sys
+    code = """if True:
+        import sys
+        import numpy as np
+        from analysis.archive.pg import PostgresArchive
+        from analysis.archive.population import Population
+        from analysis.limits import parameter_units
+        from analysis.production import production_stats
+        n = 60
+        x = tuple(70.0 + np.sin(np.arange(n)) + (np.arange(n) % 3 == 1) * 0.5)
+        population = Population(tuple(f"20240501-{i:06d}-abcdef" for i in range(n)), ("2024-05-01T00:00:00Z",) * n,
+                                tuple("QA%d" % (i % 3) for i in range(n)), ("W6",) * n, ("SN",) * n, ("ana",) * n,
+                                ("green",) * n, (None,) * n, (None,) * n, {"fs": x}, {})
+        stats = production_stats(population)
+        assert stats.parameters["fs"].stations.pairs[0].p is not None
+        assert parameter_units()["fs"][0] == "Hz"
+        print(sorted(m for m in sys.modules if m.split(".")[0] == "scipy"))
+    """
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == "[]"
