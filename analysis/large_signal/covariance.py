@@ -30,8 +30,9 @@ from analysis.large_signal.solve import Solution, solve_normal
 NOISE_BLOCK_HZ = 400.0     # wider than the displacement's band, which spreads the current's noise
 
 
-def covariance(fit: FitState, orders: Orders, nu: Nuisance, sol: Solution) -> np.ndarray:
-    """The coefficients' covariance (module doc), searched parameters included."""
+def covariance(fit: FitState, orders: Orders, nu: Nuisance, sol: Solution) -> tuple[np.ndarray, list[float]]:
+    """The coefficients' covariance (module doc), searched parameters included; and each recording's laser
+    delay's 1-sigma, s (0 where no delay was searched), from the same matrix."""
     names = orders.names()
     p = len(names)
     sensitivities = _sensitivities(fit, orders, nu, sol.theta)
@@ -63,7 +64,13 @@ def covariance(fit: FitState, orders: Orders, nu: Nuisance, sol: Solution) -> np
             meat += (weighted.conj().T @ (weighted * (misfit / 2.0)[:, None])).real
     _, inverse = solve_normal(gram, np.zeros(p + q), noise_gram if fit.corrections else None,
                               np.zeros(p + q))
-    return (inverse @ meat @ inverse)[:p, :p]
+    full = inverse @ meat @ inverse
+    delayed = [k for k, d in enumerate(fit.data) if d.laser_delay_possible]
+    first = q - len(delayed)            # the delays' columns come after tau2's (and lambda's)
+    delay_std = [0.0] * len(fit.data)
+    for j, k in enumerate(delayed):
+        delay_std[k] = float(np.sqrt(max(full[p + first + j, p + first + j], 0.0)))
+    return full[:p, :p], delay_std
 
 def _sensitivities(fit: FitState, orders: Orders, nu: Nuisance, theta: np.ndarray) -> list:
     """Per recording, ([electrical], [mechanical]) d(Phi theta)/d(parameter) of every searched parameter."""

@@ -85,7 +85,7 @@ def recording_fit(model: LargeSignalModel, data: RecordingData, offset_m: float,
     s = 2j * np.pi * np.arange(n // 2 + 1) * data.bin_width
     measured = {"current": data.i, "displacement": _delayed(data.x, s, delay_s)}
     simulated = {"current": sim.current, "displacement": sim.displacement}
-    tops = {"current": int(data.electrical_bins[-1]), "displacement": int(data.mechanical_bins[-1])}
+    tops = {"current": int(data.excited_bins[-1]), "displacement": int(data.mechanical_bins[-1])}
     channels = {}
     for name in CHANNELS:
         channels[name] = _channel_fit(name, measured[name], simulated[name], data.excited_bins, tops[name],
@@ -139,7 +139,7 @@ def multitone_prediction(model: LargeSignalModel, data: RecordingData, level_rms
     out = {"level_rms_v": level_rms_v, "peak_displacement_m": float(np.max(np.abs(sim.displacement -
                                                                                    sim.displacement.mean())))}
     excited = data.excited_bins
-    for name, y, top in (("current", sim.current, data.electrical_bins[-1]),
+    for name, y, top in (("current", sim.current, data.excited_bins[-1]),
                          ("displacement", sim.displacement, data.mechanical_bins[-1])):
         spectrum = np.abs(np.fft.rfft(y)) ** 2
         lines = np.arange(excited[0], top + 1)

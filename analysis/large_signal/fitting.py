@@ -21,7 +21,9 @@ from analysis.large_signal.solve import Block, Solution, solution, solve, solve_
 from analysis.large_signal.weights import misfit_variance, noise_variance
 
 DELAY_LIMIT_S = 1e-3
-DELAY_SCAN_S = 25e-6
+DELAY_GRID_S = 50e-6       # the coarse scan's step: the valleys of chi^2 are ~280 us wide (1.76 kHz's period / 2)
+DELAY_SCAN_S = 25e-6       # the step by which the search walks downhill to a bracket
+DELAY_TOLERANCE_S = 2e-7
 LAMBDA_MAX = 0.8
 TAU2_RANGE_S = (1e-6, 1e-2)
 # How closely the searches pin tau2 (in log10) and lambda. The coefficients' covariance (covariance.py) holds
@@ -171,8 +173,9 @@ class FitState:
         theta[free] = solve(blocks).theta
         return theta
 
-    def update_weights(self, orders: Orders, nu: Nuisance, theta: np.ndarray) -> None:
-        """Each line's weight: 2 / (its noise + the misfit the model leaves around it), see misfit_variance."""
+    def update_weights(self, orders: Orders, nu: Nuisance, theta: np.ndarray, misfit: bool = True) -> None:
+        """Each line's weight: 2 / (its noise + the misfit the model leaves around it), see misfit_variance;
+        2 / its noise alone without ``misfit``."""
         names = orders.names()
         weights, misfits, periods = [], [], []
         for k, d in enumerate(self.data):
@@ -184,6 +187,8 @@ class FitState:
             mean_e, mean_m = stacked(self.mean_cols[k], names, nu)
             misfit_e = misfit_variance(self.mean_cols[k].target_e - mean_e @ theta, noise_e, d.electrical_bins)
             misfit_m = misfit_variance(-(mean_m @ theta), noise_m, d.mechanical_bins)
+            if not misfit:
+                misfit_e, misfit_m = np.zeros_like(noise_e), np.zeros_like(noise_m)
             # Each real and imaginary part carries half of a line's complex variance.
             weights.append((2.0 / (noise_e + misfit_e), 2.0 / (noise_m + misfit_m)))
             misfits.append((misfit_e, misfit_m))
@@ -246,26 +251,40 @@ class FitState:
                 along("lam", (0.0, _lambda_limit(self.data, nu.ws)), LAMBDA_TOLERANCE, False)
         return nu if orders.creep else dataclasses.replace(nu, lam=0.0)
 
-    def fit_delays(self, orders: Orders, nu: Nuisance, coarse: bool) -> None:
-        """Each serial laser's delay: chi^2 against the delay is not unimodal over +-1 ms (the lines of x
-        turn through whole cycles), so a coarse scan first (``coarse``), then a bounded Brent search within a
-        step of the best."""
-        for k, d in enumerate(self.data):
-            if not d.laser_delay_possible:
-                continue
+    @property
+    def has_laser_delays(self) -> bool:
+        return any(d.laser_delay_possible for d in self.data)
 
-            def chi2(delay):
-                self.delays[k] = float(delay)
-                self.rebuild(k)
-                return self.solve(orders, nu).chi2
-            centre = self.delays[k]
-            if coarse:
-                grid = np.arange(-DELAY_LIMIT_S, DELAY_LIMIT_S + DELAY_SCAN_S / 2, DELAY_SCAN_S)
-                centre = float(grid[int(np.argmin([chi2(t) for t in grid]))])
-            best = scipy.optimize.minimize_scalar(chi2, bounds=(centre - DELAY_SCAN_S, centre + DELAY_SCAN_S),
-                                                  method="bounded", options={"xatol": 2e-7})
-            self.delays[k] = float(best.x)
+    def scan_delays(self, orders: Orders, nu: Nuisance) -> None:
+        """Each serial laser's delay to the least chi^2 on a grid over +-DELAY_LIMIT_S (DELAY_GRID_S apart):
+        chi^2 against the delay is not unimodal over that range (the lines of x turn through whole cycles), so
+        the grid finds the valley that refine_delays then searches."""
+        grid = np.arange(-DELAY_LIMIT_S, DELAY_LIMIT_S + DELAY_GRID_S / 2, DELAY_GRID_S)
+        for k in self._delayed():
+            chi2 = self._chi2_at_delay(k, orders, nu)
+            self.delays[k] = float(grid[int(np.argmin([chi2(t) for t in grid]))])
             self.rebuild(k)
+
+    def refine_delays(self, orders: Orders, nu: Nuisance) -> float:
+        """Each serial laser's delay to the least chi^2 of the valley it is in (_valley_minimum); the largest
+        change, s."""
+        moved = 0.0
+        for k in self._delayed():
+            before = self.delays[k]
+            self.delays[k] = _valley_minimum(self._chi2_at_delay(k, orders, nu), before)
+            self.rebuild(k)
+            moved = max(moved, abs(self.delays[k] - before))
+        return moved
+
+    def _delayed(self) -> list[int]:
+        return [k for k, d in enumerate(self.data) if d.laser_delay_possible]
+
+    def _chi2_at_delay(self, k: int, orders: Orders, nu: Nuisance):
+        def chi2(delay: float) -> float:
+            self.delays[k] = float(delay)
+            self.rebuild(k)
+            return self.solve(orders, nu).chi2
+        return chi2
 
     def fit_offsets(self, orders: Orders, nu: Nuisance, theta: np.ndarray) -> None:
         """Each recording's rest position from its static force balance (module doc); its 1-sigma from the
@@ -319,6 +338,33 @@ def static_force(x: np.ndarray, i: np.ndarray, names, theta: np.ndarray, x_scale
                 v = np.fft.irfft(np.fft.rfft(x, axis=-1) * s, n, axis=-1)
             f -= value * v**3
     return f
+
+
+def _valley_minimum(chi2, start: float) -> float:
+    """The least chi^2 of the valley ``start`` lies in: downhill a scan step at a time until a step either side
+    is higher (a true bracket, so the bounded Brent search inside it cannot stop on an edge: held to one step
+    around the scan's best, it did, and the coefficients took up the phase error left), then Brent to
+    DELAY_TOLERANCE_S. Within +-DELAY_LIMIT_S: a minimum on that limit is reported as such (delay_at_limit)."""
+    def at(t: float) -> float:
+        return chi2(float(np.clip(t, -DELAY_LIMIT_S, DELAY_LIMIT_S)))
+    centre, here = start, at(start)
+    for _ in range(int(2 * DELAY_LIMIT_S / DELAY_SCAN_S) + 1):
+        low, high = max(centre - DELAY_SCAN_S, -DELAY_LIMIT_S), min(centre + DELAY_SCAN_S, DELAY_LIMIT_S)
+        below, above = at(low), at(high)
+        if below < here and below <= above and low < centre:
+            centre, here = low, below
+        elif above < here and high > centre:
+            centre, here = high, above
+        else:
+            break
+    best = scipy.optimize.minimize_scalar(chi2, bounds=(low, high), method="bounded",
+                                          options={"xatol": DELAY_TOLERANCE_S})
+    return float(best.x) if best.fun <= here else centre
+
+
+def delay_at_limit(delay_s: float) -> bool:
+    """Whether a searched delay sits on the search's limit (the true one may lie beyond it)."""
+    return abs(delay_s) > DELAY_LIMIT_S - 2 * DELAY_TOLERANCE_S
 
 
 def _lambda_limit(data: Sequence[RecordingData], ws: float) -> float:

@@ -23,7 +23,8 @@ The weights come from the scatter between periods (solve.py): a first
 solution from the electrical equation alone (weights from the voltage's and
 the current's own noise), then the mechanical one with Bl(x) from it, then
 every line's weight from the per-period error of that solution, refined
-twice. The orders are then chosen by BIC (each term's order in turn, twice
+twice, and on until the laser delays settle (_settle; a serial laser's
+delays first scanned with the weights of the noise alone). The orders are then chosen by BIC (each term's order in turn, twice
 over), among 0 .. max_order for Bl, Kms and Le, 0 .. 4 for L2(x), and with or
 without Le(i), Rms(v) and creep: a term is kept where the data support it.
 """
@@ -38,13 +39,15 @@ import numpy as np
 from analysis.large_signal.columns import ELECTRICAL, Nuisance, Orders
 from analysis.large_signal.covariance import covariance
 from analysis.large_signal.data import LargeSignalError, RecordingData
-from analysis.large_signal.fitting import FitState
+from analysis.large_signal.fitting import FitState, delay_at_limit
 from analysis.large_signal.solve import Solution, solve
 
 MAX_ORDER = 6
 HIGHEST_ORDER = 8          # what --order may ask for: beyond, the powers of x are too alike to tell apart
 MAX_L2_ORDER = 4
 _REFINEMENTS = 2
+_MAX_PASSES = 8
+DELAY_SETTLED_S = 1e-6       # a laser delay that moves less in a pass has settled (~0.2 degree at 1.76 kHz)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -61,10 +64,15 @@ class Identification:
     offsets: tuple[float, ...]      # m, added to each recording's measured x (the rest position)
     offsets_std: tuple[float, ...]
     delays: tuple[float, ...]       # s, the laser's delay taken out of each recording
+    delays_std: tuple[float, ...]   # s, their 1-sigma (0 where none was searched), scaled as cov
     data: tuple[RecordingData, ...]
     weights: tuple[tuple[np.ndarray, np.ndarray], ...]
     bic_table: tuple[tuple[str, float], ...]     # the orders tried and their BIC, for the report
     voltage_residual_percent: tuple[float, ...]  # the electrical equation's rms misfit re the voltage, per recording
+
+    def delay_at_limit(self, k: int) -> bool:
+        """Whether recording k's laser delay sits on the search's limit (the true one may lie beyond it)."""
+        return self.data[k].laser_delay_possible and delay_at_limit(self.delays[k])
 
     def value(self, name: str, power: int = 0) -> float:
         return float(self.theta[self.names.index((name, power))]) if (name, power) in self.names else 0.0
@@ -89,23 +97,43 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
     nu = Nuisance()
     theta = fit.mechanical_start(top, nu, solve(fit.blocks(top, nu, only=ELECTRICAL)).theta)
     nu = _with_ws(nu, top, theta)
-    for refinement in range(_REFINEMENTS):
-        fit.update_weights(top, nu, theta)
-        nu = fit.nuisance(top, nu)          # first: tau2 far off would pull the delay with it
-        fit.fit_delays(top, nu, coarse=refinement == 0)
-        fit.fit_offsets(top, nu, fit.solve(top, nu).theta)
+    if fit.has_laser_delays:
+        # The coarse scan weighs each line by its noise alone: with the misfit of the zero-delay start counted
+        # as noise, the lines that tell the delay would weigh least, and the scan's minima stayed near 0
+        # (25-60 us short on the JACK rig, Kms(0) then up to +1.2 %).
+        fit.update_weights(top, nu, theta, misfit=False)
+        nu = fit.nuisance(top, nu)
+        fit.scan_delays(top, nu)
         theta = fit.solve(top, nu).theta
-        nu = _with_ws(nu, top, theta)
+    nu, theta = _settle(fit, top, nu, theta, _REFINEMENTS)
     orders, table = _select_orders(fit, top, nu)
     nu = nu if orders.creep else dataclasses.replace(nu, lam=0.0)
-    fit.update_weights(orders, nu, fit.solve(orders, nu).theta)
-    nu = fit.nuisance(orders, nu)
-    fit.fit_offsets(orders, nu, fit.solve(orders, nu).theta)
+    nu, _ = _settle(fit, orders, nu, fit.solve(orders, nu).theta, 1, new_ws=False)
     final = fit.solve(orders, nu)
-    cov = covariance(fit, orders, nu, final) * max(final.chi2_red, 1.0)
-    return Identification(orders, tuple(orders.names()), final.theta, cov, final, nu, fit.x_scale,
-                          tuple(fit.offsets), tuple(fit.offsets_std), tuple(fit.delays), tuple(fit.data),
+    cov, delays_std = covariance(fit, orders, nu, final)
+    scale = max(final.chi2_red, 1.0)
+    return Identification(orders, tuple(orders.names()), final.theta, cov * scale, final, nu, fit.x_scale,
+                          tuple(fit.offsets), tuple(fit.offsets_std), tuple(fit.delays),
+                          tuple(std * np.sqrt(scale) for std in delays_std), tuple(fit.data),
                           tuple(fit.weights), tuple(table), tuple(fit.voltage_residual_percent(orders, nu, final.theta)))
+
+
+def _settle(fit: FitState, orders: Orders, nu: Nuisance, theta: np.ndarray, passes: int,
+            new_ws: bool = True) -> tuple[Nuisance, np.ndarray]:
+    """Weights, tau2 and lambda, laser delays, rest offsets and coefficients in turn: ``passes`` times, then on
+    while a laser delay still moves (each depends on the others: a delay read with weights from another delay
+    stops short of its own), at most _MAX_PASSES."""
+    for done in range(1, _MAX_PASSES + 1):
+        fit.update_weights(orders, nu, theta)
+        nu = fit.nuisance(orders, nu)       # first: tau2 far off would pull the delay with it
+        moved = fit.refine_delays(orders, nu)
+        fit.fit_offsets(orders, nu, fit.solve(orders, nu).theta)
+        theta = fit.solve(orders, nu).theta
+        if new_ws:
+            nu = _with_ws(nu, orders, theta)
+        if done >= passes and moved < DELAY_SETTLED_S:
+            break
+    return nu, theta
 
 
 def describe_orders(orders: Orders) -> str:

@@ -21,6 +21,7 @@ import numpy as np
 from analysis.large_signal.data import LargeSignalError, recording_data
 from analysis.large_signal.distortion import RecordingFit, harmonics, intermodulation, multitone_prediction, \
     recording_fit
+from analysis.large_signal.fitting import DELAY_LIMIT_S
 from analysis.large_signal.identify import MAX_ORDER, Identification, describe_orders, identify
 from analysis.large_signal.limits import Derived, LimitThresholds, derived
 from analysis.large_signal.model import LargeSignalModel, model_of
@@ -77,6 +78,8 @@ class LargeSignalResult:
             entry = fit.as_json()
             entry.update({"offset_m": ident.offsets[k], "offset_std_m": _finite(ident.offsets_std[k]),
                           "laser_delay_s": ident.delays[k],
+                          "laser_delay_std_s": ident.delays_std[k] if ident.data[k].laser_delay_possible else None,
+                          "laser_delay_at_limit": ident.delay_at_limit(k),
                           "peak_displacement_m": _peak(ident, k)})
             recordings.append(entry)
         return {
@@ -165,6 +168,11 @@ def _flags(model: LargeSignalModel, ident: Identification, limits: Derived, fits
                          f"{limit.side} side): measure at a higher level to find it")
     if limits.offset_at_edge:
         flags.append("Bl(x) has its maximum at an edge of the measured range: the offset is a bound, not a value")
+    for k, d in enumerate(ident.data):
+        if ident.delay_at_limit(k):
+            flags.append(f"{d.label}: the laser's delay reached the search's limit ({ident.delays[k] * 1e6:+.0f} us, "
+                         f"at most {DELAY_LIMIT_S * 1e6:.0f} us either way): the laser and the audio are not aligned "
+                         f"and the curves are wrong; check the laser's link and measure again")
     for fit in fits:
         if fit.failed:
             flags.append(f"{fit.label}: {fit.failed}")

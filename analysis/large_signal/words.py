@@ -55,11 +55,13 @@ def format_large_signal(result: LargeSignalResult) -> str:
     lines += ["", "terms the data support besides the curves: " + (", ".join(terms) or "none")]
     chi2 = ident.solution.chi2_by_equation
     lines.append("fit: reduced chi^2 " + ", ".join(f"{eq} {c / max(n, 1):.2f}" for eq, (c, n) in chi2.items()))
-    for fit in result.fits:
+    for k, fit in enumerate(result.fits):
         if fit.failed:
             lines.append(f"  {fit.label}: {fit.failed}")
             continue
         parts = []
+        if ident.data[k].laser_delay_possible:
+            parts.append(f"laser delay {concise(ident.delays[k] * 1e6, ident.delays_std[k] * 1e6)} us")
         for channel in fit.channels.values():
             if math.isfinite(channel.measured_db):
                 parts.append(f"{channel.channel} distortion {channel.measured_db:.1f} dB measured, "

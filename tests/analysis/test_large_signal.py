@@ -137,7 +137,12 @@ def test_an_unknown_rest_position_and_a_late_laser_are_found():
                            extra={"displacement_max_hz": 1760.0})
     result = large_signal([laser])
     ident = result.identification
-    assert ident.delays[0] == pytest.approx(80e-6, abs=5e-6)
+    assert ident.delays[0] == pytest.approx(80e-6, abs=1e-6)
+    assert 0 < ident.delays_std[0] < 1e-7 and not ident.delay_at_limit(0)     # ~2 ns: the lines are sharp
+    # The electrical equation stops at the laser's band too: beyond it, the back-EMF Bl(x) v is not measured.
+    assert ident.data[0].electrical_bins[-1] == ident.data[0].mechanical_bins[-1] < ident.data[0].excited_bins[-1]
+    recording = result.as_json()["validity"]["recordings"][0]
+    assert recording["laser_delay_std_s"] == ident.delays_std[0] and recording["laser_delay_at_limit"] is False
     shift = float(block.displacement[2 * n:].mean())          # what the mean removal took away
     assert ident.offsets[0] == pytest.approx(shift, abs=2e-6)         # x = x_measured + offset
     assert result.derived.offset_m == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
