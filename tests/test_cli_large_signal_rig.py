@@ -56,11 +56,6 @@ def test_the_plan_runs_on_the_nonlinear_rig_and_its_steps_are_identified(plan_on
     assert set(curves) >= {"Bl", "Kms", "Le"}
 
 
-@pytest.mark.xfail(strict=False, reason=(
-    "known defect, issue 18 open: with the serial laser the identification's laser-delay search can settle "
-    "25-60 us short (weights from a zero-delay first pass, a Brent range of +-25 us), and the shared "
-    "coefficients absorb the phase: Kms(0) +0.15 .. +1.18 % over 5 plans on the JACK rig "
-    "(docs/large-signal.md, known limits)"))
 def test_bl0_and_kms0_on_the_jack_rig_come_within_1_percent(plan_on_the_rig):
     code, out, err, _ = plan_on_the_rig
     assert code == 0, err
@@ -68,5 +63,7 @@ def test_bl0_and_kms0_on_the_jack_rig_come_within_1_percent(plan_on_the_rig):
     bl0, kms0 = curves["Bl"]["coefficients"][0], curves["Kms"]["coefficients"][0]
     assert bl0 == pytest.approx(5.23, rel=0.01)
     assert kms0 == pytest.approx(5.23**2 / 11.75e-3, rel=0.01)
+    for recording in json.loads(out)["large_signal"]["validity"]["recordings"]:
+        assert not recording["laser_delay_at_limit"] and 0 < recording["laser_delay_std_s"] < 5e-6
     # Bl(x) / Bl(0) = 1 - 0.03 x - 0.01 x^2 (x in mm): its slope at rest, -0.03 per mm
     assert curves["Bl"]["coefficients"][1] / bl0 == pytest.approx(-30.0, rel=0.15)
