@@ -39,7 +39,7 @@ import numpy as np
 from analysis.large_signal.columns import ELECTRICAL, Nuisance, Orders
 from analysis.large_signal.covariance import covariance
 from analysis.large_signal.data import LargeSignalError, RecordingData
-from analysis.large_signal.fitting import FitState, delay_at_limit
+from analysis.large_signal.fitting import DELAY_TOLERANCE_S, FitState, delay_at_limit
 from analysis.large_signal.solve import Solution, solve
 
 MAX_ORDER = 6
@@ -64,7 +64,7 @@ class Identification:
     offsets: tuple[float, ...]      # m, added to each recording's measured x (the rest position)
     offsets_std: tuple[float, ...]
     delays: tuple[float, ...]       # s, the laser's delay taken out of each recording
-    delays_std: tuple[float, ...]   # s, their 1-sigma (0 where none was searched), scaled as cov
+    delays_std: tuple[float, ...]   # s, their 1-sigma (0 where none was searched): the noise's and the search's
     data: tuple[RecordingData, ...]
     weights: tuple[tuple[np.ndarray, np.ndarray], ...]
     bic_table: tuple[tuple[str, float], ...]     # the orders tried and their BIC, for the report
@@ -114,8 +114,17 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
     scale = max(final.chi2_red, 1.0)
     return Identification(orders, tuple(orders.names()), final.theta, cov * scale, final, nu, fit.x_scale,
                           tuple(fit.offsets), tuple(fit.offsets_std), tuple(fit.delays),
-                          tuple(std * np.sqrt(scale) for std in delays_std), tuple(fit.data),
+                          tuple(_delay_std(std * np.sqrt(scale), d) for std, d in zip(delays_std, fit.data)),
+                          tuple(fit.data),
                           tuple(fit.weights), tuple(table), tuple(fit.voltage_residual_percent(orders, nu, final.theta)))
+
+
+def _delay_std(statistical: float, data: RecordingData) -> float:
+    """A searched delay's 1-sigma: the noise's (a few ns with sharp lines) and the search's resolution (Brent to
+    DELAY_TOLERANCE_S, taken as uniform) in quadrature."""
+    if not data.laser_delay_possible:
+        return 0.0
+    return float(np.hypot(statistical, DELAY_TOLERANCE_S / np.sqrt(3.0)))
 
 
 def _settle(fit: FitState, orders: Orders, nu: Nuisance, theta: np.ndarray, passes: int,

@@ -138,7 +138,8 @@ def test_an_unknown_rest_position_and_a_late_laser_are_found():
     result = large_signal([laser])
     ident = result.identification
     assert ident.delays[0] == pytest.approx(80e-6, abs=1e-6)
-    assert 0 < ident.delays_std[0] < 1e-7 and not ident.delay_at_limit(0)     # ~2 ns: the lines are sharp
+    # Its 1-sigma is the search's resolution (0.2 us / sqrt 3): the noise's own is ~2 ns, the lines are sharp.
+    assert 1e-7 < ident.delays_std[0] < 2e-7 and not ident.delay_at_limit(0)
     # The electrical equation stops at the laser's band too: beyond it, the back-EMF Bl(x) v is not measured.
     assert ident.data[0].electrical_bins[-1] == ident.data[0].mechanical_bins[-1] < ident.data[0].excited_bins[-1]
     recording = result.as_json()["validity"]["recordings"][0]
