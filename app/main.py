@@ -77,6 +77,8 @@ def run_gui(path: str | None = None) -> int:
     QApplication.setOrganizationName(ORGANIZATION)
     QApplication.setApplicationName(APPLICATION)
     app = QApplication.instance() or QApplication(sys.argv[:1])
+    from app.gui_gc import collect_in_gui_thread
+    collect_in_gui_thread()               # a worker thread must never free a Qt object (app/gui_gc.py)
     from app.style import app_icon
     app.setWindowIcon(app_icon())         # dialogs and the task bar too (on Linux the desktop entry names it)
     problems = _load_user_effects()

@@ -44,6 +44,8 @@ def run(workdir: Path) -> list[Row]:
     from PySide6.QtWidgets import QApplication
 
     app = QApplication.instance() or QApplication(["gui-bench"])
+    from app.gui_gc import collect_in_gui_thread
+    collect_in_gui_thread()               # as the workstation runs (app/gui_gc.py)
     from app.main_window import MainWindow
     from app.settings import Settings
 
