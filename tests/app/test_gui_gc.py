@@ -22,9 +22,10 @@ def test_a_qt_cycle_made_in_the_gui_thread_is_not_freed_by_a_worker_thread(qapp,
     holder.me = holder          # a cycle: only the cycle collector frees it
     del holder
 
-    def allocate_a_lot():      # far past every threshold: automatic collection would run here
-        junk = [[i] for i in range(200_000)]
-        del junk
+    kept = []
+
+    def allocate_a_lot():      # far past every threshold (kept alive): automatic collection would run here
+        kept.append([[i] for i in range(200_000)])
     worker = threading.Thread(target=allocate_a_lot, name="worker")
     worker.start()
     worker.join()
