@@ -89,6 +89,9 @@ class Job:
 
     def __call__(self) -> None:
         runner = self._runner
+        if self.cancelled:      # cancelled while it waited for a thread (a one-thread runner's queue): not run
+            runner.send("cancelled", self.id)
+            return
         try:
             result = self._work(self)
         except runner.cancel_errors:

@@ -42,6 +42,7 @@ class JobControls(QWidget):
         layout.addWidget(self.cancel_button)
         keep_room_when_hidden(self.progress, self.cancel_button)
         self._callbacks: dict[str, Callable] = {}
+        self._stops_midway = True
         runner.progress.connect(self.on_progress)
         runner.frame_ready.connect(self.on_frame)
         for name in runner.result_signals:
@@ -56,11 +57,15 @@ class JobControls(QWidget):
 
     def run(self, job: Job, text: str, finished: Callable[[object], None],
             failed: Callable[[str], None], cancelled: Callable[[], None] | None = None,
-            frame: Callable[[object], None] | None = None) -> None:
-        """Show `job` (a running one is cancelled: its outcome is dropped) and call back when it ends."""
+            frame: Callable[[object], None] | None = None, stops_midway: bool = True) -> None:
+        """Show `job` (a running one is cancelled: its outcome is dropped) and call back when it ends.
+
+        `stops_midway=False`: the work does not look at its cancel flag (one long fit), so Cancel lets the page
+        go at once and the late outcome is dropped, instead of "Cancelling…" until the work ends."""
         if self.job is not None:
             self.job.cancel()
         self.job = job
+        self._stops_midway = stops_midway
         self._callbacks = {"finished": finished, "failed": failed, "cancelled": cancelled, "frame": frame}
         self.progress.setValue(0)
         self.progress.setRange(0, 0)          # busy until the job reports a fraction
@@ -118,7 +123,13 @@ class JobControls(QWidget):
                 callback()
 
     def on_cancel(self) -> None:
-        if self.job is not None:
-            self.job.cancel()
-            self.cancel_button.setEnabled(False)
-            self.text.setText("Cancelling…")
+        if self.job is None:
+            return
+        self.job.cancel()
+        if not self._stops_midway:
+            callback = self._end().get("cancelled")
+            if callback:
+                callback()
+            return
+        self.cancel_button.setEnabled(False)
+        self.text.setText("Cancelling…")

@@ -99,7 +99,8 @@ class LargeSignalPage(QWidget):
                               "the large-signal identification")
         self.jobs.run(job, f"Identifying the curves from {len(stems)} recording(s)…", self.on_finished,
                       lambda message: self.status.setText(f"Not identified: {message}"),
-                      lambda: self.status.setText("Cancelled: the curves shown (if any) are the previous ones."))
+                      lambda: self.status.setText("Cancelled: the curves shown (if any) are the previous ones."),
+                      stops_midway=False)       # the identification cannot stop midway: let the page go now
 
     def on_finished(self, result: LargeSignalResult) -> None:
         self.status.setText(f"{len(result.fits)} recording(s) identified.")

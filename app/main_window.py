@@ -329,13 +329,10 @@ class MainWindow(QMainWindow):
 
     # -- closing -----------------------------------------------------------
     def closeEvent(self, event) -> None:
-        self.worker.shutdown(CLOSE_WAIT_MS)
-        self.model_lab.shutdown(CLOSE_WAIT_MS)
-        self.wizard.shutdown(CLOSE_WAIT_MS)
-        self.qa.shutdown(CLOSE_WAIT_MS)
-        self.archive.shutdown(CLOSE_WAIT_MS)
-        self.production.shutdown(CLOSE_WAIT_MS)
-        self.series.shutdown(CLOSE_WAIT_MS)
-        self.large_signal.shutdown(CLOSE_WAIT_MS)
+        # One deadline for all: a job that cannot stop midway (a large-signal fit) costs the close at most once.
+        deadline = time.monotonic() + CLOSE_WAIT_MS / 1000
+        for part in (self.worker, self.model_lab, self.wizard, self.qa, self.archive, self.production, self.series,
+                     self.large_signal):
+            part.shutdown(max(0, int(1000 * (deadline - time.monotonic()))))
         self.settings.save_window(self.saveGeometry(), self.saveState())
         super().closeEvent(event)

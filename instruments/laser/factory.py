@@ -7,6 +7,7 @@ The models are the subpackages of instruments.laser that define ``MODEL``
 from __future__ import annotations
 
 import pkgutil
+import threading
 from dataclasses import dataclass, field
 from importlib import import_module
 from typing import Any, Mapping
@@ -18,6 +19,8 @@ DEFAULT_MODEL = "ild1420"
 
 _models: dict[str, LaserModel] = {}
 _searched = False      # the subpackages are looked through once, on first use
+_search_lock = threading.Lock()     # NB: a measurement thread and the GUI may both ask first
+_unloadable: dict[str, str] = {}    # subpackage -> why it did not import (named when a model is unknown)
 
 
 @dataclass(frozen=True)
@@ -39,15 +42,21 @@ class LaserSpec:
 def laser_models() -> dict[str, LaserModel]:
     """Every known model by name: the subpackages' MODELs and any registered."""
     global _searched
-    if not _searched:
-        _searched = True
-        package = import_module("instruments.laser")
-        for info in pkgutil.iter_modules(package.__path__):
-            if info.ispkg:
-                model = getattr(import_module(f"instruments.laser.{info.name}"), "MODEL", None)
-                if isinstance(model, LaserModel):
-                    _models.setdefault(model.name, model)
-    return dict(_models)
+    with _search_lock:
+        if not _searched:
+            package = import_module("instruments.laser")
+            for info in pkgutil.iter_modules(package.__path__):
+                if info.ispkg:
+                    try:
+                        module = import_module(f"instruments.laser.{info.name}")
+                    except ImportError as exc:      # one model's missing library must not hide the others
+                        _unloadable[info.name] = str(exc)
+                        continue
+                    model = getattr(module, "MODEL", None)
+                    if isinstance(model, LaserModel):
+                        _models.setdefault(model.name, model)
+            _searched = True
+        return dict(_models)
 
 
 def register_laser_model(model: LaserModel) -> None:
@@ -59,7 +68,8 @@ def register_laser_model(model: LaserModel) -> None:
 def laser_model(name: str) -> LaserModel:
     models = laser_models()
     if name not in models:
-        raise LaserError(f"unknown laser model {name!r}; known: {', '.join(sorted(models)) or 'none'}")
+        unloadable = "".join(f"; {package} did not load: {why}" for package, why in sorted(_unloadable.items()))
+        raise LaserError(f"unknown laser model {name!r}; known: {', '.join(sorted(models)) or 'none'}{unloadable}")
     return models[name]
 
 

@@ -49,3 +49,27 @@ def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, 
         qtbot.wait(50)
     assert release.is_set(), "the window and its runners were deleted"
     assert raised == [] and in_slots == []
+
+
+def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(qtbot, monkeypatch, tmp_path):
+    """The identification cannot stop midway: Cancel frees the page now, the result that comes later is dropped."""
+    release = threading.Event()
+    late = object()
+
+    def slow(stems):
+        release.wait(10)
+        return late
+    monkeypatch.setattr(app.large_signal_page, "large_signal", slow)
+    page = app.large_signal_page.LargeSignalPage()
+    qtbot.addWidget(page)
+    finished = []
+    monkeypatch.setattr(page, "on_finished", finished.append)
+    page.analyse([tmp_path / "x.wav"])
+    qtbot.waitUntil(lambda: not page.choose_button.isEnabled())
+    page.jobs.cancel_button.click()
+    assert page.choose_button.isEnabled() and not page.jobs.busy
+    assert "Cancelled" in page.status.text()
+    release.set()
+    with qtbot.waitSignal(page.worker.cancelled, timeout=10_000):
+        pass
+    assert finished == []
