@@ -58,11 +58,34 @@ def test_a_measurement_on_the_in_process_simulator_is_analysed_and_stored(report
     assert set(errors) == {"RE", "Bl", "CMES"} and all(abs(e) < 0.01 for e in errors.values()), errors
 
 
-def test_the_journal_lock_excludes_others_and_dies_with_its_holder(report):
+def test_the_journal_lock_excludes_others_and_dies_with_its_holder_on_the_fallback(report):
     found = _step(report, "journal_lock")
     assert found["held_by_me"] and found["second_refused"] and found["free_after_release"]
     assert found["other_said"] == "held" and found["held_by_other"]
     assert found["free_after_kill"]         # a crashed measurement's journal is offered for recovery
+
+
+def test_the_native_lock_is_freed_when_its_holder_is_killed(tmp_path):
+    """The probe above gets filelock's lock-file fallback (fcntl blocked); here the system's own lock (flock)."""
+    import signal
+    import time
+    from analysis import file_lock
+    path = tmp_path / "journal.lock"
+    holder = subprocess.Popen([sys.executable, "-c", "import sys, time; from analysis import file_lock; "
+                               f"lock = file_lock.take({str(path)!r}); print('held', flush=True); time.sleep(60)"],
+                              cwd=ROOT, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        assert file_lock.held(path)
+        holder.send_signal(signal.SIGKILL)
+        holder.wait(10)
+        deadline = time.monotonic() + 5
+        while file_lock.held(path) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not file_lock.held(path)
+    finally:
+        holder.kill()
+        holder.wait()
 
 
 def test_off_linux_the_rig_commands_say_so_in_one_line(capsys, monkeypatch):
