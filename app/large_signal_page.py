@@ -22,6 +22,7 @@ from analysis.large_signal import LargeSignalResult, large_signal
 from app.large_signal_plots import CurvePlot, DistortionPlot
 from app.job_book import JobRunner, failure_text
 from app.job_controls import JobControls
+from app.style import VALIDITY_COLOURS
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 SAVE_FILTER = "PDF report (*.pdf);;HTML report (*.html);;Curves as CSV (*.csv);;Curves as JSON (*.json)"
@@ -204,8 +205,16 @@ def summary_html(result: LargeSignalResult) -> str:
                  if not f.failed and math.isfinite(f.channels["current"].explained_percent)]
     if explained:
         quality += f"; it explains {min(explained):.0f} % or more of the current's distortion"
+    if result.verdict == "red":
+        quality = ("not to be judged by its chi², whose weights count the misfit as noise: the laser's delay was "
+                   "not found")
     parts = [f"<p><b>Coil:</b> {html.escape(derived.coil_advice())}</p>", f"<table>{table}</table>",
              f"<p><b>Fit:</b> {html.escape(quality)}.</p>"]
+    if result.verdict == "red":
+        # Above the numbers: a laser delay not found leaves curves that are not a measurement (trust.py).
+        background, text = VALIDITY_COLOURS["red"]
+        parts.insert(0, f'<p style="background:{background}; color:{text}"><b>Not to be trusted:</b> the laser\'s '
+                        "delay was not found; the values below are not a measurement (see below).</p>")
     if result.flags:
         parts.append("<p><b>To read with care:</b></p><ul>" +
                      "".join(f"<li>{html.escape(flag)}</li>" for flag in result.flags) + "</ul>")

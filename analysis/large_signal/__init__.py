@@ -8,6 +8,7 @@ with the laser, the coil's rest offset and the excursion limits (physics.md sect
     curves.py       a curve with its band and range                 limits.py    offset, asymmetry, X_Bl, X_C, X_L
     simulate.py     the model's periodic steady state               distortion.py  residuals, predictions
     result.py       everything for one driver, and its JSON         words.py     the text a technician reads
+    trust.py        whether a serial laser's delay was found (red when not)
 """
 from analysis.large_signal.data import LargeSignalError
 from analysis.large_signal.limits import LimitThresholds

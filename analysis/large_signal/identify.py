@@ -69,6 +69,7 @@ class Identification:
     weights: tuple[tuple[np.ndarray, np.ndarray], ...]
     bic_table: tuple[tuple[str, float], ...]     # the orders tried and their BIC, for the report
     voltage_residual_percent: tuple[float, ...]  # the electrical equation's rms misfit re the voltage, per recording
+    noise_chi2_red: tuple[dict, ...]  # per recording, equation -> mean |residual|^2 / its noise alone (noise_misfit)
 
     def delay_at_limit(self, k: int) -> bool:
         """Whether recording k's laser delay sits on the search's limit (the true one may lie beyond it)."""
@@ -116,7 +117,9 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
                           tuple(fit.offsets), tuple(fit.offsets_std), tuple(fit.delays),
                           tuple(_delay_std(std * np.sqrt(scale), d) for std, d in zip(delays_std, fit.data)),
                           tuple(fit.data),
-                          tuple(fit.weights), tuple(table), tuple(fit.voltage_residual_percent(orders, nu, final.theta)))
+                          tuple(fit.weights), tuple(table),
+                          tuple(fit.voltage_residual_percent(orders, nu, final.theta)),
+                          tuple(fit.noise_misfit(orders, nu, final.theta)))
 
 
 def _delay_std(statistical: float, data: RecordingData) -> float:

@@ -21,12 +21,12 @@ import numpy as np
 from analysis.large_signal.data import LargeSignalError, recording_data
 from analysis.large_signal.distortion import RecordingFit, harmonics, intermodulation, multitone_prediction, \
     recording_fit
-from analysis.large_signal.fitting import DELAY_LIMIT_S
 from analysis.large_signal.identify import MAX_ORDER, Identification, describe_orders, identify
 from analysis.large_signal.limits import Derived, LimitThresholds, derived
 from analysis.large_signal.model import LargeSignalModel, model_of
 from analysis.large_signal.simulate import SimulationDiverged
 from analysis.large_signal.stepping import VOLTAGE_DISTORTION_DB, clipped_inputs, distortion_db
+from analysis.large_signal.trust import delay_not_found, delays_found, verdict
 from analysis.recording import Recording, read_recording
 from analysis.session import recording_header
 
@@ -57,6 +57,11 @@ class LargeSignalResult:
     driver: dict
     header: dict = field(default_factory=dict)     # traceability (analysis.session) of the first recording
 
+    @property
+    def verdict(self) -> str:
+        """red: not to be trusted (a laser delay not found, trust.py); yellow: flags to read; green: none."""
+        return verdict(self.identification, self.flags)
+
     def as_json(self) -> dict:
         ident, model = self.identification, self.model
         chi2 = {eq: value / max(n, 1) for eq, (value, n) in ident.solution.chi2_by_equation.items()}
@@ -74,12 +79,15 @@ class LargeSignalResult:
         parameters["L2"] = {"value": model.L20, "std": None}
         parameters["tau2"] = {"value": model.tau2, "std": None}
         recordings = []
+        found = delays_found(ident)
         for k, fit in enumerate(self.fits):
             entry = fit.as_json()
             entry.update({"offset_m": ident.offsets[k], "offset_std_m": _finite(ident.offsets_std[k]),
                           "laser_delay_s": ident.delays[k],
                           "laser_delay_std_s": ident.delays_std[k] if ident.data[k].laser_delay_possible else None,
                           "laser_delay_at_limit": ident.delay_at_limit(k),
+                          "laser_delay_found": found[k],
+                          "noise_chi2_red": dict(ident.noise_chi2_red[k]),
                           "peak_displacement_m": _peak(ident, k)})
             recordings.append(entry)
         return {
@@ -92,7 +100,8 @@ class LargeSignalResult:
                       "n_data": ident.solution.n_data, "n_parameters": ident.solution.n_params,
                       "orders": {"Bl": orders.bl, "Kms": orders.kms, "Le": orders.le, "L2": orders.l2},
                       "description": describe_orders(orders), "terms": terms, "parameters": parameters},
-            "validity": {"x_range_m": list(model.x_range), "recordings": recordings, "flags": list(self.flags)},
+            "validity": {"verdict": self.verdict, "x_range_m": list(model.x_range), "recordings": recordings,
+                         "flags": list(self.flags)},
             "distortion": {"predictions": list(self.predictions)},
             "thresholds": {"bl_ratio": self.thresholds.bl_ratio,
                            "compliance_ratio": self.thresholds.compliance_ratio,
@@ -146,7 +155,8 @@ def _prediction(model: LargeSignalModel, data, p: Prediction) -> dict:
 
 
 def _flags(model: LargeSignalModel, ident: Identification, limits: Derived, fits) -> list[str]:
-    flags = []
+    # First: a laser delay not found makes every other line moot (the curves are not a measurement).
+    flags = [reason for reason in (delay_not_found(ident, k) for k in range(len(ident.data))) if reason]
     lo, hi = model.x_range
     if ident.solution.chi2_red > CHI2_RED_DOUBTFUL:
         flags.append(f"the model leaves a misfit {ident.solution.chi2_red:.1f} times the noise: the curves are "
@@ -168,11 +178,6 @@ def _flags(model: LargeSignalModel, ident: Identification, limits: Derived, fits
                          f"{limit.side} side): measure at a higher level to find it")
     if limits.offset_at_edge:
         flags.append("Bl(x) has its maximum at an edge of the measured range: the offset is a bound, not a value")
-    for k, d in enumerate(ident.data):
-        if ident.delay_at_limit(k):
-            flags.append(f"{d.label}: the laser's delay reached the search's limit ({ident.delays[k] * 1e6:+.0f} us, "
-                         f"at most {DELAY_LIMIT_S * 1e6:.0f} us either way): the laser and the audio are not aligned "
-                         f"and the curves are wrong; check the laser's link and measure again")
     for fit in fits:
         if fit.failed:
             flags.append(f"{fit.label}: {fit.failed}")

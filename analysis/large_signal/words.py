@@ -20,6 +20,10 @@ def format_large_signal(result: LargeSignalResult) -> str:
     lines = [f"large-signal parameters of {name}, from {len(result.fits)} recording(s); "
              f"x measured from {lo * 1e3:+.2f} to {hi * 1e3:+.2f} mm (positive: outwards)",
              f"curves (orders chosen by BIC): {describe_orders(ident.orders)}", ""]
+    if result.verdict == "red":
+        # Before any number: a result whose laser delay was not found is not a measurement (trust.py).
+        lines += ["NOT TO BE TRUSTED: the laser's delay was not found; the values below are not a measurement "
+                  "(see the first lines under \"to read with care\")", ""]
     bl, kms, le = model.Bl, model.Kms, model.Le
     lines.append("at rest:  Bl(0) " + _value(bl, 0.0, 1.0, "T·m") + "   Kms(0) " + _value(kms, 0.0, 1e-3, "N/mm")
                  + "   Le(0) " + _value(le, 0.0, 1e3, "mH"))
@@ -55,6 +59,10 @@ def format_large_signal(result: LargeSignalResult) -> str:
     lines += ["", "terms the data support besides the curves: " + (", ".join(terms) or "none")]
     chi2 = ident.solution.chi2_by_equation
     lines.append("fit: reduced chi^2 " + ", ".join(f"{eq} {c / max(n, 1):.2f}" for eq, (c, n) in chi2.items()))
+    # The weights count a misfit as noise (weights.misfit_variance); against the noise alone it shows (trust.py).
+    alone = {eq: max(r[eq] for r in ident.noise_chi2_red) for eq in ident.noise_chi2_red[0]}
+    lines.append("     against the lines' noise alone (largest of the recordings): "
+                 + ", ".join(f"{eq} {value:.3g}" for eq, value in alone.items()))
     for k, fit in enumerate(result.fits):
         if fit.failed:
             lines.append(f"  {fit.label}: {fit.failed}")

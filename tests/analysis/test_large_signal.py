@@ -16,6 +16,7 @@ import pytest
 from analysis.large_signal import LargeSignalError, LimitThresholds, Prediction, large_signal
 from analysis.large_signal.data import recording_data
 from analysis.large_signal.distortion import harmonics, recording_fit
+from analysis.large_signal.words import format_large_signal
 from analysis.recording import make_recording
 from tests.large_signal_truth import (KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, clean_periods, inner,
                                       known_driver, noisy_recording, relative_errors)
@@ -121,20 +122,27 @@ def test_the_distortion_predicted_at_a_second_level_is_the_simulators_within_1_d
         assert channel.explained_percent > 90.0
 
 
-def test_an_unknown_rest_position_and_a_late_laser_are_found():
-    """As the serial laser gives it: the displacement's mean removed (the cone's shift under drive is lost with
-    it) and 80 us late; the sidecar marks the laser's band."""
+def serial_laser_recording(delay_s: float):
+    """The known driver at 8 V as the serial laser gives it: the displacement's mean removed (the cone's shift
+    under drive is lost with it) and ``delay_s`` late; the sidecar marks the laser's band."""
     driver = known_driver(8192)
     block, mt = clean_periods(driver, 8.0, 4)
     rec = noisy_recording(block, mt)
     n = mt.period_samples
     s = 2j * np.pi * np.fft.rfftfreq(n, 1 / 48000)
     x = rec.signal("displacement").reshape(-1, n)
-    late = np.fft.irfft(np.fft.rfft(x, axis=1) * np.exp(-s * 80e-6), n, axis=1).ravel()
+    late = np.fft.irfft(np.fft.rfft(x, axis=1) * np.exp(-s * delay_s), n, axis=1).ravel()
     late -= late[2 * n:].mean()
     signals = {"voltage": rec.signal("voltage"), "current": rec.signal("current"), "displacement": late}
     laser = make_recording(48000, signals, n, 2, rec.excited_bins, driver=dict(rec.driver),
                            extra={"displacement_max_hz": 1760.0})
+    return driver, block, laser
+
+
+def test_an_unknown_rest_position_and_a_late_laser_are_found():
+    """The serial laser 80 us late, its mean removed: both found, and the result trusted."""
+    driver, block, laser = serial_laser_recording(80e-6)
+    n = laser.period_samples
     result = large_signal([laser])
     ident = result.identification
     assert ident.delays[0] == pytest.approx(80e-6, abs=1e-6)
@@ -144,11 +152,32 @@ def test_an_unknown_rest_position_and_a_late_laser_are_found():
     assert ident.data[0].electrical_bins[-1] == ident.data[0].mechanical_bins[-1] < ident.data[0].excited_bins[-1]
     recording = result.as_json()["validity"]["recordings"][0]
     assert recording["laser_delay_std_s"] == ident.delays_std[0] and recording["laser_delay_at_limit"] is False
+    # Found: the model leaves the noise (~1 against the lines' noise alone), and nothing says otherwise.
+    assert recording["laser_delay_found"] is True and result.verdict != "red"
+    assert recording["noise_chi2_red"]["electrical"] < 3.0 and ident.voltage_residual_percent[0] < 1.0
+    assert "NOT TO BE TRUSTED" not in format_large_signal(result)
     shift = float(block.displacement[2 * n:].mean())          # what the mean removal took away
     assert ident.offsets[0] == pytest.approx(shift, abs=2e-6)         # x = x_measured + offset
     assert result.derived.offset_m == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
     x = inner(result.model.x_range)
     assert np.max(np.abs(result.model.Bl(x) / driver.bl(x) - 1.0)) < 0.03
+
+
+def test_a_laser_delay_not_found_makes_the_result_red_where_the_user_reads_it():
+    """The serial laser 4 ms late, beyond the +-1 ms search: the search settles in a wrong valley inside its range
+    (~+390 us, not on the limit) and Bl(0) comes out ~0, which must never read as a measurement. The weighted
+    chi^2 stays below 1 (its weights count the misfit as noise); against the noise alone the electrical equation
+    misses the voltage by ~1e9 times it (trust.py)."""
+    _, _, laser = serial_laser_recording(4e-3)
+    result = large_signal([laser])
+    ident = result.identification
+    assert not ident.delay_at_limit(0) and ident.solution.chi2_red < 2.0     # before: no delay flag, no misfit flag
+    assert ident.voltage_residual_percent[0] > 50.0 and ident.noise_chi2_red[0]["electrical"] > 1e4
+    assert result.verdict == "red"
+    assert "the laser's delay was not found" in result.flags[0] and "measure again" in result.flags[0]
+    validity = result.as_json()["validity"]
+    assert validity["verdict"] == "red" and validity["recordings"][0]["laser_delay_found"] is False
+    assert "NOT TO BE TRUSTED" in format_large_signal(result)
 
 
 def test_the_json_is_the_contract_with_polynomials_ascending_in_metres(known):

@@ -57,6 +57,25 @@ def test_the_known_polynomials_come_back_through_the_rig_with_the_serial_laser(t
     assert result.derived.offset_m == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
     assert result.derived.limits["X_Bl"].value == pytest.approx(KNOWN_X_BL_M, abs=1e-4)
     assert result.identification.data[0].laser_delay_possible
+    # The laser's delay found (no link latency): the result is not red (analysis/large_signal/trust.py).
+    assert result.verdict != "red" and result.as_json()["validity"]["recordings"][0]["laser_delay_found"] is True
+
+
+@pytest.mark.slow
+def test_a_laser_link_latency_beyond_the_delay_search_makes_the_result_red(tmp_path):
+    """2 ms between the laser's reading and its arrival, beyond the +-1 ms delay search: the search settles in a
+    wrong valley or on its limit and Bl(0) comes out ~0. The result must say it is not to be trusted."""
+    rig = InProcessRig(known_driver(8192), "serial", ppm=40.0, start_latency_s=0.02, link_latency_s=2e-3,
+                       calibration=LARGE_SIGNAL_CHAIN)
+    try:
+        outcome = run_measurement(plan(period=8192, level_v_rms=KNOWN_LEVEL_V), rig.audio, rig.laser, tmp_path,
+                                  name="m", analyse=False)
+    finally:
+        rig.close()
+    result = large_signal([outcome.recording_path])
+    assert result.verdict == "red", (result.identification.delays, result.flags)
+    assert "the laser's delay was not found" in result.flags[0]
+    assert result.as_json()["validity"]["recordings"][0]["laser_delay_found"] is False
 
 
 def test_the_plan_steps_up_to_the_excursion_limit_and_keeps_every_step(tmp_path):
