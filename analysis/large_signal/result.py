@@ -26,7 +26,7 @@ from analysis.large_signal.limits import Derived, LimitThresholds, derived
 from analysis.large_signal.model import LargeSignalModel, model_of
 from analysis.large_signal.simulate import SimulationDiverged
 from analysis.large_signal.stepping import VOLTAGE_DISTORTION_DB, clipped_inputs, distortion_db
-from analysis.large_signal.trust import delay_not_found, delays_found, verdict
+from analysis.large_signal.trust import delay_doubtful, delay_not_found, delays_found, verdict
 from analysis.recording import Recording, read_recording
 from analysis.session import recording_header
 
@@ -157,6 +157,7 @@ def _prediction(model: LargeSignalModel, data, p: Prediction) -> dict:
 def _flags(model: LargeSignalModel, ident: Identification, limits: Derived, fits) -> list[str]:
     # First: a laser delay not found makes every other line moot (the curves are not a measurement).
     flags = [reason for reason in (delay_not_found(ident, k) for k in range(len(ident.data))) if reason]
+    flags += [reason for reason in (delay_doubtful(ident, k) for k in range(len(ident.data))) if reason]
     lo, hi = model.x_range
     if ident.solution.chi2_red > CHI2_RED_DOUBTFUL:
         flags.append(f"the model leaves a misfit {ident.solution.chi2_red:.1f} times the noise: the curves are "

@@ -1,6 +1,7 @@
 """Whether a large-signal identification can be trusted at all: the serial laser's delay found or not.
 
     delay_not_found(ident, k) -> the reason (one line), or None
+    delay_doubtful(ident, k) -> the reason for a smaller misfit (a flag to read), or None
     verdict(ident, flags) -> "red" | "yellow" | "green"
 
 A serial laser's delay is searched over +-1 ms (fitting.py). Beyond it the
@@ -14,7 +15,10 @@ unexplained. Against the lines' noise alone that misfit is ~1e9 times the
 noise and ~100 % of the voltage, where a delay found leaves ~1 and 0.1-0.2 %
 (14 JACK plans, the in-process rig at 0 and 0.5 ms; docs/large-signal.md).
 Both are asked: significant (not the noise) and large (not a driver's
-physics the polynomials miss by a few %).
+physics the polynomials miss by a few %). A smaller misfit, still far above
+the noise, is a doubt (a flag, yellow): at 1 ms two delays stopped near
+the limit (+995, +987 us, ~100 us short) left 1.9 % of the voltage at 2.5e5
+times its noise; but a driver's own physics can leave that much too.
 """
 from __future__ import annotations
 
@@ -24,6 +28,7 @@ from analysis.large_signal.identify import Identification
 
 VOLTAGE_MISFIT_UNTRUSTED_PERCENT = 10.0    # the electrical equation's rms misfit, % of the voltage's rms
 NOISE_CHI2_UNTRUSTED = 100.0                # the same misfit's power over the lines' noise alone
+VOLTAGE_MISFIT_DOUBTFUL_PERCENT = 1.0       # a delay found leaves 0.1-0.2 % (docs/large-signal.md)
 
 
 def delay_not_found(ident: Identification, k: int) -> str | None:
@@ -41,6 +46,19 @@ def delay_not_found(ident: Identification, k: int) -> str | None:
     if misfit > VOLTAGE_MISFIT_UNTRUSTED_PERCENT and noise > NOISE_CHI2_UNTRUSTED:
         return (f"{label}: the laser's delay was not found: at the best delay ({delay_us:+.0f} us) the electrical "
                 f"equation misses {misfit:.0f} % of the voltage, {noise:.2g} times its noise: {remedy}")
+    return None
+
+
+def delay_doubtful(ident: Identification, k: int) -> str | None:
+    """Why recording k's laser delay may be off, when it was not found wrong outright (None: no doubt)."""
+    if not ident.data[k].laser_delay_possible or delay_not_found(ident, k):
+        return None
+    misfit = ident.voltage_residual_percent[k]
+    noise = ident.noise_chi2_red[k][ELECTRICAL]
+    if misfit > VOLTAGE_MISFIT_DOUBTFUL_PERCENT and noise > NOISE_CHI2_UNTRUSTED:
+        return (f"{ident.data[k].label}: the electrical equation misses {misfit:.1f} % of the voltage, {noise:.2g} "
+                f"times its noise, at the laser's delay found ({ident.delays[k] * 1e6:+.0f} us): the delay may be "
+                f"off (or the driver has physics the model lacks); check the laser's latency")
     return None
 
 

@@ -8,6 +8,7 @@ samples and the bench's sensor noise.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import numpy as np
@@ -16,6 +17,7 @@ import pytest
 from analysis.large_signal import LargeSignalError, LimitThresholds, Prediction, large_signal
 from analysis.large_signal.data import recording_data
 from analysis.large_signal.distortion import harmonics, recording_fit
+from analysis.large_signal.trust import delay_doubtful, delay_not_found
 from analysis.large_signal.words import format_large_signal
 from analysis.recording import make_recording
 from tests.large_signal_truth import (KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, clean_periods, inner,
@@ -156,6 +158,15 @@ def test_an_unknown_rest_position_and_a_late_laser_are_found():
     assert recording["laser_delay_found"] is True and result.verdict != "red"
     assert recording["noise_chi2_red"]["electrical"] < 3.0 and ident.voltage_residual_percent[0] < 1.0
     assert "NOT TO BE TRUSTED" not in format_large_signal(result)
+    assert delay_not_found(ident, 0) is None and delay_doubtful(ident, 0) is None
+    # The rule on the misfits the in-process rig left at 1 and 2 ms link latency (docs/large-signal.md): 1.9 % of
+    # the voltage at 2.5e5 times the noise (a delay ~100 us short) a doubt, 44 % at 1.8e8 times not found.
+    short = dataclasses.replace(ident, voltage_residual_percent=(1.9,),
+                                noise_chi2_red=({"electrical": 2.5e5, "mechanical": 1.0},))
+    assert delay_not_found(short, 0) is None and "the delay may be off" in delay_doubtful(short, 0)
+    wrong = dataclasses.replace(short, voltage_residual_percent=(44.0,),
+                                noise_chi2_red=({"electrical": 1.8e8, "mechanical": 1.0},))
+    assert "the laser's delay was not found" in delay_not_found(wrong, 0) and delay_doubtful(wrong, 0) is None
     shift = float(block.displacement[2 * n:].mean())          # what the mean removal took away
     assert ident.offsets[0] == pytest.approx(shift, abs=2e-6)         # x = x_measured + offset
     assert result.derived.offset_m == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
