@@ -12,7 +12,6 @@ from importlib import import_module
 from typing import Callable
 
 
-
 @dataclass(frozen=True)
 class Exporter:
     """One export format of a measurement's result (analysis.archive.results.StoredResult).
