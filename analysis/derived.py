@@ -43,11 +43,19 @@ class ParameterValue:
     display_scale: float       # display = SI * scale
     reason: str | None = None  # why value is None
     fitted: bool = False
+    # The two parts of `std` (the total the user reads, sqrt(noise^2 + model^2)): the noise's, and how far
+    # the value moves between the models the data cannot tell apart. None: not estimated.
+    std_noise: float | None = None
+    std_model: float | None = None
 
     def as_json(self) -> dict:
         if self.value is None:
             return {"value": None, "reason": self.reason, "unit": self.unit}
         out = {"value": self.value, "std": self.std, "unit": self.unit}
+        if self.std_noise is not None:
+            out["std_noise"] = self.std_noise
+        if self.std_model is not None:
+            out["std_model"] = self.std_model
         return out
 
 
