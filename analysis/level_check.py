@@ -34,7 +34,7 @@ from typing import Callable
 
 from analysis.recording import Recording
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity import Validity, assess
+from analysis.validity.assessment import Validity, assess
 
 DEFAULT_STEP = 1.6
 DEFAULT_X_LIMIT_M = 0.5e-3

@@ -31,7 +31,7 @@ from analysis.effects import Effect
 from analysis.errors import LinparError
 from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording, require_fit
 from analysis.recording import Recording
-from analysis.validity_findings import DISTORTION_HIGH
+from analysis.validity.findings import DISTORTION_HIGH
 
 # The columns of the paper's Table II (and this module's), in order.
 TABLE_PARAMETERS = ("fs", "Mms", "Cms", "Kms", "Bl", "Rms", "RE", "Qts", "lambda")

@@ -251,13 +251,13 @@ def verdict_of(verdicts) -> str:
 
 
 def _blocker(validity: Mapping | str) -> tuple[str, str] | None:
-    from analysis.validity_fit import qa_blocker
+    from analysis.validity.fit import qa_blocker
     return qa_blocker({"overall": validity} if isinstance(validity, str) else validity)
 
 
 def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
     """The QA verdict as JSON: "pass", "fail", "invalid" when the measurement itself is red (shown as FAIL), or
-    "not judged" when the model does not describe it (analysis.validity_fit.qa_blocker; `validity`: the result's
+    "not judged" when the model does not describe it (analysis.validity.fit.qa_blocker; `validity`: the result's
     validity, or its overall light alone).
 
     A red measurement's parameters are worthless (physics.md section 5): none
@@ -283,7 +283,7 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
         mark = "pass" if v.passed else "FAIL"
         lines.append(f"  {limit.name:<14}{shown:>18}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))
-    from analysis.validity_fit import VERDICT_HEADLINES
+    from analysis.validity.fit import VERDICT_HEADLINES
     why = f" — {doc['why']}" if doc.get("why") else ""
     lines.append(f"QA: {VERDICT_HEADLINES[doc['verdict']]}{why}")
     return "\n".join(lines)

@@ -15,7 +15,7 @@ same periods. A frame shows, in dB re 1 V, 1 A or 1 m (20 log10 of the
 amplitude, DB_FLOOR for zero): the signal lines (excited bins), the noise floor
 at every bin (sqrt(var_mean)), and the noise + distortion lines (|mean| at the
 unexcited bins). Its traffic lights are the validity rules that apply to one
-frame (analysis.validity_spectral: no signal, SNR, distortion, displacement
+frame (analysis.validity.spectral: no signal, SNR, distortion, displacement
 band); drift and the capture's counts are judged on the whole recording.
 Before the second period there is no noise estimate: noise is NaN and the
 lights are "unknown".
@@ -35,8 +35,8 @@ from analysis.excursion import peak_of_period
 from analysis.recording import UNITS
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity_findings import Finding, worst
-from analysis.validity_spectral import SIGNALS, distortion_bands, spectral_checks
+from analysis.validity.findings import Finding, worst
+from analysis.validity.spectral import SIGNALS, distortion_bands, spectral_checks
 
 UNKNOWN = "unknown"
 DB_FLOOR = -400.0

@@ -1,6 +1,6 @@
 """From a recording to the full parameter table: spectra, judged channels, fit, derived parameters.
 
-A broken measurement is judged, not refused (analysis.validity_fit): the
+A broken measurement is judged, not refused (analysis.validity.fit): the
 channels are judged first; a silent or copied voltage or current leaves the
 impedance nothing to fit, and the result then carries its validity with
 every parameter "not measured" and why (`fit` is None); a silent
@@ -29,9 +29,9 @@ from analysis.model import Model, ModelError
 from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.startvalues import StartValueError, start_context
-from analysis.validity import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
-from analysis.validity_findings import DRIFT
-from analysis.validity_fit import FitChannels, fit_channels, misfit_findings
+from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
+from analysis.validity.findings import DRIFT
+from analysis.validity.fit import FitChannels, fit_channels, misfit_findings
 
 
 # Displacement lines below which Hx carries too little to fit Bl (and a delay) from.

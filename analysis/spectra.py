@@ -176,7 +176,7 @@ def displacement_noise_factor(recording: Recording) -> float:
     gaps = capture.get("laser_gaps") if isinstance(capture, dict) else None
     if gaps is None:
         return 1.0
-    from analysis.validity_capture import CaptureInfoError, LaserGapInfo
+    from analysis.validity.capture import CaptureInfoError, LaserGapInfo
     try:
         factor = LaserGapInfo.from_json(gaps).noise_factor
     except CaptureInfoError as exc:

@@ -63,13 +63,13 @@ laser_gap_growth_yellow = 0.10, laser_gap_growth_red = 0.5, laser_gap_unseen_red
 copy_residual_red = 1e-4
     A channel whose excited lines are those of another times one complex
     gain, to 1 % in amplitude (1e-4 in power), is a copy of it: two inputs on
-    one sense (analysis.validity_wiring). The motional branch alone moves |Z|
+    one sense (analysis.validity.wiring). The motional branch alone moves |Z|
     by a factor of 2 or more, so no driver comes near; a resistor does.
 misfit_yellow_chi2_red = 100
     A reduced chi^2 of 100 on a fitted channel is a misfit ten times the
     noise on every line: the model does not describe the measurement, and
     the parameters carry an error their (Birge-scaled) uncertainties only
-    guess at (analysis.validity_fit). Yellow, and QA does not judge it.
+    guess at (analysis.validity.fit). Yellow, and QA does not judge it.
 drift_*
     Line spectra of the first and the last drift_periods periods compared.
     A drift of 0.5 % is above the paper's repeatability (yellow), 2 % is a

@@ -22,7 +22,7 @@ from analysis.fit import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
-from analysis.validity_fit import rejudged
+from analysis.validity.fit import rejudged
 from app.result_curves import ResultCurves, result_curves
 from app.job_book import Job, JobRunner
 

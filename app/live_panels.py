@@ -43,7 +43,7 @@ DOT_HEIGHT = 0.015          # of the y range: ~2 pixels on a panel 150 pixels ta
 # Thousands of unexcited bins per channel cost ~100 ms a repaint (with the GIL held: the audio thread waits);
 # a plot ~1000 pixels wide cannot show more than a few hundred columns anyway. So the noise floor and the
 # noise + distortion are reduced to DISPLAY_BUCKETS log-spaced buckets, each the power mean of its bins: what
-# the validity check compares band by band (analysis.validity_spectral). Noise alone puts the two on top of
+# the validity check compares band by band (analysis.validity.spectral). Noise alone puts the two on top of
 # each other; one product 30 dB over the floor among ten bins still stands 20 dB out.
 DISPLAY_BUCKETS = 300
 LEGEND = (f"<span style='color:{SIGNAL_COLOUR}'>●</span> signal lines &nbsp; "

@@ -8,7 +8,7 @@ says why, rather than pretending.
 
 A red measurement FAILS the test, with a reason that says it is the
 measurement that is broken (measure again; the unit itself was not judged);
-one the model does not describe is NOT JUDGED (analysis.validity_fit).
+one the model does not describe is NOT JUDGED (analysis.validity.fit).
 """
 from __future__ import annotations
 
@@ -54,8 +54,8 @@ def display(value: float | None, parameter) -> str:
 
 
 def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str, str]:
-    """(verdict, why): the measurement's validity first (analysis.validity_fit.qa_blocker), then the limits."""
-    from analysis.validity_fit import qa_blocker
+    """(verdict, why): the measurement's validity first (analysis.validity.fit.qa_blocker), then the limits."""
+    from analysis.validity.fit import qa_blocker
     validity = {"overall": validity} if isinstance(validity, str) else validity
     validity_overall = str(validity.get("overall", "unknown"))
     blocker = qa_blocker(validity)
@@ -243,7 +243,7 @@ class QAView(QWidget):
         self.verdicts = self.limits.judge(self.result.parameters)
         # Parameters of an invalid measurement, or of a model that does not describe it, are worthless
         # (physics.md section 5): no parameter is judged against its limit (the verdict says why).
-        from analysis.validity_fit import qa_blocker
+        from analysis.validity.fit import qa_blocker
         invalid = qa_blocker(self.result.validity) is not None
         self.table.setRowCount(len(self.verdicts))
         for row, v in enumerate(self.verdicts):
@@ -273,7 +273,7 @@ class QAView(QWidget):
         else:
             verdict, why = qa_verdict(self.result.validity, limits_verdict)
         from analysis.report.qa import VERDICT_COLOURS
-        from analysis.validity_fit import VERDICT_HEADLINES
+        from analysis.validity.fit import VERDICT_HEADLINES
         background, text = VERDICT_COLOURS.get(verdict, NO_VERDICT)
         title = VERDICT_HEADLINES.get(verdict, "NO VERDICT")
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "

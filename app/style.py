@@ -17,7 +17,7 @@ RESIDUAL_IMAG = "#e08a00"
 GUIDE = "#8c8c8c"
 MISSING_TEXT = "#8c8c8c"
 
-# Validity lights (result.validity["overall"], analysis/validity.py) -> (background, text) colours.
+# Validity lights (result.validity["overall"], analysis/validity/assessment.py) -> (background, text) colours.
 VALIDITY_COLOURS = {
     "green": ("#d8f0d8", "#1b5e20"),
     "yellow": ("#fff1c9", "#7a5300"),

@@ -17,7 +17,7 @@ def run(workdir: Path) -> list[Row]:
     from analysis.live import LiveAccumulator
     from analysis.recording import read_recording
     from analysis.spectra import estimate_spectra
-    from analysis.validity import assess
+    from analysis.validity.assessment import assess
 
     rec = read_recording(standard_recording(workdir))
     signals = ("voltage", "current", "displacement")

@@ -68,7 +68,7 @@ def _settings_of(recording, result) -> dict:
 def results_document(result, recording=None) -> dict:
     """The JSON document of an analysis.pipeline.AnalysisResult (and of its recording's settings).
 
-    A result with nothing fitted (a broken measurement: analysis.validity_fit) is kept too, so that it can
+    A result with nothing fitted (a broken measurement: analysis.validity.fit) is kept too, so that it can
     be archived, reported and exported as judged: its parameters are "not measured" with the reason, its
     model has no effects and says why under "not_fitted", and it has no curves.
     """

@@ -2,7 +2,7 @@
 
 Numbers are shown in the unit the limits file uses for that parameter, so
 the operator reads them against the file as written. The verdict is the QA
-page's (analysis.validity_fit.qa_blocker): a red measurement FAILS with the
+page's (analysis.validity.fit.qa_blocker): a red measurement FAILS with the
 reason that the measurement is broken (measure again; the unit itself was
 not judged), one the model does not describe is NOT JUDGED (find the model).
 Either way no parameter is judged against its limit.
@@ -14,7 +14,7 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue
 from analysis.report.numbers import format_number, pretty_unit
-from analysis.validity_fit import INVALID, NOT_JUDGED, VERDICT_HEADLINES, qa_blocker
+from analysis.validity.fit import INVALID, NOT_JUDGED, VERDICT_HEADLINES, qa_blocker
 
 # (background, text) of the verdict banner, also the QA page's: an invalid measurement is a FAIL, in red.
 VERDICT_COLOURS = {"pass": ("#d8f0d8", "#1b5e20"), "fail": ("#f8d4d4", "#8e1b1b"), INVALID: ("#f8d4d4", "#8e1b1b"),

@@ -71,7 +71,7 @@ class CaptureStats:
         return d
 
     def capture_info(self) -> dict[str, Any]:
-        """The recording sidecar's "capture" object (analysis.validity_capture.CaptureInfo).
+        """The recording sidecar's "capture" object (analysis.validity.capture.CaptureInfo).
 
         Dropouts and xruns are those inside the kept periods: always none,
         since a period with a gap is dropped and an xrun discards every period
@@ -108,7 +108,7 @@ class CapturedSignals:
     def to_recording(self, excited_bins=None, driver: Mapping | None = None):
         """An analysis Recording of these periods (no settle left in them).
 
-        The sidecar gets "capture" (what analysis.validity reads) and
+        The sidecar gets "capture" (what analysis.validity.assessment reads) and
         "audio_capture" (every count of CaptureStats, for the report).
         """
         from analysis.recording import make_recording

@@ -110,7 +110,7 @@ class LaserCounts:
     gaps: LaserGaps | None = None
 
     def capture_json(self) -> dict:
-        """The laser's part of the sidecar's "capture" object (analysis.validity_capture). Lost and forged
+        """The laser's part of the sidecar's "capture" object (analysis.validity.capture). Lost and forged
         measurements are missing data like the error codes (laser_gaps), not dropouts of the sound card."""
         out = {"laser_samples": self.samples, "laser_error_counts": {str(c): n for c, n in
                                                                      sorted(self.errors_by_code.items())},

@@ -63,7 +63,7 @@ class LaserGaps:
     unseen_s: float         # the longest stretch of the period measured in no period, s
 
     def capture_json(self) -> dict:
-        """The sidecar's capture.laser_gaps (analysis.validity_capture.LaserGapInfo); a noise factor that
+        """The sidecar's capture.laser_gaps (analysis.validity.capture.LaserGapInfo); a noise factor that
         cannot be known (no point of the period measured twice) is null."""
         factor = self.noise_factor if np.isfinite(self.noise_factor) else None
         return {"samples": self.samples, "periods": self.periods, "of_periods": self.of_periods,

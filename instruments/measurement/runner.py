@@ -21,7 +21,7 @@ data are. Trailing periods that hold the inputs' digital silence (what
 capture() keeps while it makes sure its inputs went dead) are left out.
 
 The sidecar gets, besides the recording format's keys: "capture" (what
-analysis.validity reads, with the laser's error counts and out-of-range
+analysis.validity.assessment reads, with the laser's error counts and out-of-range
 share), "audio_capture" (every count of the capture), "measurement" (the
 plan, the devices, how it ended), and for the serial laser
 "displacement_max_hz" and "laser_alignment" (alignment.py).

@@ -4,7 +4,7 @@ Every function returns a Recording of the paper's driver (resources/drivers/
 paper.json) measured on a `Bench` (48 kHz, periods of 16,384 samples, 8
 averaged, 0.3 V RMS: ~0.15 mm peak, small signal) with one thing wrong. What
 the capture saw is put where the measurement runner puts it: the sidecar's
-"capture" object (analysis.validity_capture). The linear ones come from
+"capture" object (analysis.validity.capture). The linear ones come from
 analysis.synthesis' exact steady state; those that need the driver's own
 nonlinearity from NonlinearBlockDriver.
 
@@ -39,7 +39,7 @@ from analysis.drivers import load_driver
 from analysis.multitone import Multitone, design_multitone
 from analysis.recording import Recording, make_recording
 from analysis.synthesis import ChannelNoise, steady_state_period
-from analysis.validity_capture import OUT_OF_RANGE_CODES, CaptureInfo
+from analysis.validity.capture import OUT_OF_RANGE_CODES, CaptureInfo
 from instruments.simulation.nonlinear_driver import NonlinearBlockDriver
 
 PAPER = load_driver("paper")

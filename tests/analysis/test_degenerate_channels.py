@@ -1,4 +1,4 @@
-"""Silent and degenerate channels are judged, not crashed on (analysis.validity_fit, analysis.validity_wiring).
+"""Silent and degenerate channels are judged, not crashed on (analysis.validity.fit, analysis.validity.wiring).
 
 A silent voltage or current leaves the impedance nothing to fit: the result keeps its judged channels (red,
 with the remedy) and every parameter "not measured" with the reason. A silent displacement is left out and
@@ -18,7 +18,7 @@ from analysis.limits import judge_result, parse_limits
 from analysis.pipeline import NotAnalysable, analyze_recording, require_fit
 from analysis.recording import make_recording
 from analysis.report.qa import qa_section
-from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL
+from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 LIMITS = parse_limits({"format": "linpar-limits/1", "parameters": {
@@ -136,7 +136,7 @@ def test_a_refit_that_fits_takes_the_misfit_finding_away(misfit):
     from analysis.effects import parse_effects
     from analysis.fit import FitData, fit_model
     from analysis.model import Model
-    from analysis.validity_fit import qa_blocker, rejudged
+    from analysis.validity.fit import qa_blocker, rejudged
     better = fit_model(FitData.from_spectra(misfit.spectra), Model(parse_effects("lr2,creep-log,delay-current")))
     assert max(better.chi2_red_by_channel().values()) < 2
     validity = rejudged(misfit.validity, better)

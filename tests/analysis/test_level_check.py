@@ -6,7 +6,7 @@ import pytest
 
 from analysis.level_check import LevelProbe, level_check
 from analysis.recording import make_recording
-from analysis.validity import assess
+from analysis.validity.assessment import assess
 from instruments.simulation.faults import BENCH_NOISE, PAPER
 from instruments.simulation.nonlinear_driver import NonlinearBlockDriver
 from tests.builders import multitone

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from analysis.pipeline import analyze_recording
 from analysis.recording import RecordingError, read_recording, write_recording
 from analysis.thresholds import DEFAULT_THRESHOLDS
-from analysis.validity_capture import CaptureInfo, CaptureInfoError, capture_findings
+from analysis.validity.capture import CaptureInfo, CaptureInfoError, capture_findings
 from app.cli import main as linpar
 from tests.builders import TYPICAL_NOISE, multitone, recording
 from tests.pace import paced

@@ -29,8 +29,8 @@ import numpy as np
 from analysis.recording import Recording
 from analysis.spectra import Spectra, period_spectra
 from analysis.thresholds import ValidityThresholds
-from analysis.validity_findings import DRIFT, Finding, Severity, graded
-from analysis.validity_spectral import line_snr_db
+from analysis.validity.findings import DRIFT, Finding, Severity, graded
+from analysis.validity.spectral import line_snr_db
 
 _REMEDY = {
     "voltage": "let the amplifier warm up (more settle periods) and check its level is steady",

@@ -31,8 +31,8 @@ LASER_ERRORS = "laser-errors"
 LASER_OUT_OF_RANGE = "laser-out-of-range"
 DROPOUTS = "dropouts"
 DRIFT = "drift"
-CHANNEL_COPY = "channel-copy"       # a scaled copy of another channel: a wiring fault (analysis.validity_wiring)
-MODEL_MISFIT = "model-misfit"       # the fit's misfit far above the noise (analysis.validity_fit)
+CHANNEL_COPY = "channel-copy"       # a scaled copy of another channel: a wiring fault (analysis.validity.wiring)
+MODEL_MISFIT = "model-misfit"       # the fit's misfit far above the noise (analysis.validity.fit)
 
 
 @dataclass(frozen=True, slots=True)

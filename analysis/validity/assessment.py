@@ -2,12 +2,12 @@
 
 `assess(recording)` runs every check and returns a Validity:
 
-- from the spectra (analysis.validity_spectral): no signal, SNR on the excited
+- from the spectra (analysis.validity.spectral): no signal, SNR on the excited
   lines, noise + distortion on the unexcited lines, and for the displacement
   its usable band and the number of lines above the noise;
-- from the periods (analysis.validity_drift): drift between the first and the
+- from the periods (analysis.validity.drift): drift between the first and the
   last periods;
-- from the capture (analysis.validity_capture, when a CaptureInfo is given or
+- from the capture (analysis.validity.capture, when a CaptureInfo is given or
   the recording's sidecar holds one under "capture"): clipping, headroom,
   dropouts, laser error codes and out-of-range share. A "capture" object
   that cannot be read raises CaptureInfoError (it names the key).
@@ -36,10 +36,10 @@ from analysis.excursion import recording_peak_displacement
 from analysis.recording import Recording
 from analysis.spectra import Spectra, estimate_spectra
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity_capture import CaptureInfo, CaptureInfoError, capture_findings
-from analysis.validity_drift import drift_findings
-from analysis.validity_findings import Finding, Severity, worst
-from analysis.validity_spectral import SIGNALS, spectral_checks
+from analysis.validity.capture import CaptureInfo, CaptureInfoError, capture_findings
+from analysis.validity.drift import drift_findings
+from analysis.validity.findings import Finding, Severity, worst
+from analysis.validity.spectral import SIGNALS, spectral_checks
 
 __all__ = ["ABSENT", "CaptureInfo", "CaptureInfoError", "ChannelValidity", "Finding", "Severity", "Validity",
            "assess", "capture_of"]
@@ -80,7 +80,7 @@ class Validity:
         return {f.code for f in self.channels[channel].findings}
 
     def with_findings(self, extra: Mapping[str, Sequence[Finding]]) -> "Validity":
-        """This validity with more findings on some channels (the fit's, analysis.validity_fit), lights redone."""
+        """This validity with more findings on some channels (the fit's, analysis.validity.fit), lights redone."""
         channels = {}
         for name, ch in self.channels.items():
             added = tuple(extra.get(name, ()))

@@ -31,8 +31,8 @@ from typing import Mapping
 
 from analysis.fit import FitResult
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity import ABSENT, Validity
-from analysis.validity_findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
+from analysis.validity.assessment import ABSENT, Validity
+from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
 
 # Findings after which a channel carries nothing a fit could use.
 UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)

@@ -26,7 +26,7 @@ import numpy as np
 
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import ValidityThresholds
-from analysis.validity_findings import CHANNEL_COPY, Finding, Severity
+from analysis.validity.findings import CHANNEL_COPY, Finding, Severity
 
 # (reference, copy suspect): the finding goes on the second.
 PAIRS = (("voltage", "current"), ("voltage", "displacement"), ("current", "displacement"))

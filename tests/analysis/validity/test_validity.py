@@ -9,7 +9,7 @@ from analysis.recording import make_recording, read_recording, write_recording
 from analysis.spectra import estimate_spectra, period_spectra
 from analysis.synthesis import ChannelNoise
 from analysis.thresholds import DEFAULT_THRESHOLDS, ThresholdsError, ValidityThresholds, load_thresholds
-from analysis.validity import ABSENT, CaptureInfo, CaptureInfoError, assess
+from analysis.validity.assessment import ABSENT, CaptureInfo, CaptureInfoError, assess
 from tests.builders import TYPICAL_NOISE, multitone, recording
 
 MT = multitone(period_samples=8192)
@@ -158,7 +158,7 @@ def test_the_reported_peak_is_that_of_the_recording():
 def test_lines_without_any_noise_do_not_blind_the_laser_band_estimate():
     # A laser whose held samples repeat exactly gives lines of infinite SNR (seen on the serial laser's live
     # path); the pooled running sum must not turn every later line into NaN and cut the band short there.
-    from analysis.validity_spectral import _band_findings
+    from analysis.validity.spectral import _band_findings
     freqs = np.geomspace(5.0, 10_000.0, 80)
     snr = np.full(freqs.size, 60.0)
     snr[40:45] = np.inf
@@ -172,7 +172,7 @@ def test_lines_without_any_noise_do_not_blind_the_laser_band_estimate():
 
 @pytest.mark.parametrize("n, window", [(1, 5), (2, 5), (3, 5), (4, 33), (40, 5), (40, 33), (200, 4)])
 def test_the_pooled_mean_is_each_centred_window_s_mean_even_around_huge_values(n, window):
-    from analysis.validity_spectral import pooled_mean
+    from analysis.validity.spectral import pooled_mean
     rng = np.random.default_rng(n)
     values = rng.uniform(1.0, 2.0, n)
     values[n // 2] = 1e30                    # a line far above the rest must not spoil the others

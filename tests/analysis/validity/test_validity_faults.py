@@ -1,7 +1,7 @@
 """Each fault of instruments.simulation.faults is judged on the right channel with the right code."""
 import pytest
 
-from analysis.validity import assess
+from analysis.validity.assessment import assess
 from instruments.simulation import faults
 
 CHANNELS = ("voltage", "current", "displacement")

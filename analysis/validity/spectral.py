@@ -25,9 +25,9 @@ are raised to it: a noise-free synthetic recording has exactly zero scatter,
 and its rounding residue would otherwise stand "infinitely" above it.
 
 A channel that is a scaled copy of another (two inputs on one sense) is
-found by analysis.validity_wiring, from the same lines.
+found by analysis.validity.wiring, from the same lines.
 
-The same functions serve the whole recording (analysis.validity) and the live
+The same functions serve the whole recording (analysis.validity.assessment) and the live
 per-period frames (analysis.live); they hold no state.
 """
 from __future__ import annotations
@@ -40,9 +40,9 @@ from scipy.interpolate import CubicSpline
 
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import ValidityThresholds
-from analysis.validity_findings import (
+from analysis.validity.findings import (
     DISTORTION_HIGH, NO_SIGNAL, SNR_LOW, X_BAND_LOW, X_FEW_LINES, Finding, Severity, graded)
-from analysis.validity_wiring import copy_findings
+from analysis.validity.wiring import copy_findings
 
 SIGNALS = ("voltage", "current", "displacement")
 # A voltage line counts as carrying something (amplifier distortion) above this |U|^2 / <var_U>.
@@ -180,7 +180,7 @@ def spectral_checks(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray
     distortion_db, distortion_re_signal_db; for the displacement also
     x_band_hz and x_lines. A channel with no signal gets only the no-signal
     finding; one that is a scaled copy of another gets the channel-copy
-    finding first (analysis.validity_wiring).
+    finding first (analysis.validity.wiring).
     """
     excited = np.asarray(excited, dtype=np.int64)
     unexcited = np.asarray(unexcited, dtype=np.int64)

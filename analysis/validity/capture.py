@@ -39,7 +39,7 @@ from typing import Any, Mapping
 
 from analysis.errors import LinparError
 from analysis.thresholds import ValidityThresholds
-from analysis.validity_findings import (
+from analysis.validity.findings import (
     CLIPPING, DROPOUTS, HEADROOM_LOW, LASER_ERRORS, LASER_OUT_OF_RANGE, Finding, Severity)
 
 SOUND_CARD_SIGNALS = ("voltage", "current")

@@ -1,0 +1,37 @@
+"""Whether a measurement can be trusted, channel by channel: the checks of the spectra, the wiring, the drift, the capture and the fit, and their findings.
+
+The public names of analysis.validity.assessment (assess, Validity, ...) are importable from
+the package itself; each is loaded on first use.
+"""
+from __future__ import annotations
+
+import importlib
+
+# Where each public name lives; a name is imported on first use only, so that
+# importing one submodule of the package does not load the rest.
+_HOME = {
+    "ABSENT": "assessment",
+    "CaptureInfo": "assessment",
+    "CaptureInfoError": "assessment",
+    "ChannelValidity": "assessment",
+    "Finding": "assessment",
+    "Severity": "assessment",
+    "Validity": "assessment",
+    "assess": "assessment",
+    "capture_of": "assessment",
+}
+
+__all__ = sorted(_HOME)
+
+
+def __getattr__(name: str):
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{home}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOME))
