@@ -2,7 +2,7 @@
 
 One clause per channel:
 - reduced chi^2 up to NOISE_LEVEL: "explains the impedance down to its noise";
-- a band of misfit (analysis.residuals) holding at least BAND_SHARE of the channel's misfit: "misses 12 % of
+- a band of misfit (analysis.diagnosis.residuals) holding at least BAND_SHARE of the channel's misfit: "misses 12 % of
   the impedance between 200 and 800 Hz", the percentage being the largest relative deviation
   |measured - model| / |model| in the band;
 - otherwise: "explains the impedance to within 2.3 times its noise" (misfit spread over the range).
@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
+from analysis.diagnosis.residuals import channel_finding
 from analysis.fit import ChannelFit, FitResult
-from analysis.residuals import channel_finding
 
 # A reduced chi^2 this close to 1 is noise: the model has nothing left to explain.
 NOISE_LEVEL = 1.5

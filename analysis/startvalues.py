@@ -35,7 +35,7 @@ class StartContext:
     f_min: float
     f_max: float
     # The slope d(phase)/dw (s) of measured / model over the top octave, once a model has been
-    # fitted (analysis.diagnosis sets them): where a delay should start. 0 before any fit.
+    # fitted (analysis.diagnosis.candidates sets them): where a delay should start. 0 before any fit.
     z_phase_slope: float = 0.0
     x_phase_slope: float = 0.0
     # The measured impedance itself, for effects whose start needs more of it than these numbers

@@ -11,20 +11,20 @@ import dataclasses
 import threading
 from dataclasses import dataclass
 
-from analysis import residuals
-from analysis.acceptance import Flag
 from analysis.derived import parameter_table
-from analysis.diagnosis import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
-from analysis.diagnosis_words import drift_from_validity, verdict_headline, verdict_text
+from analysis.diagnosis import residuals
+from analysis.diagnosis.acceptance import Flag
+from analysis.diagnosis.candidates import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
+from analysis.diagnosis.sites import SiteResult
+from analysis.diagnosis.words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
-from analysis.sites import SiteResult
 from analysis.fit import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from analysis.validity.fit import rejudged
-from app.result_curves import ResultCurves, result_curves
 from app.job_book import Job, JobRunner
+from app.result_curves import ResultCurves, result_curves
 
 
 CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
@@ -36,7 +36,7 @@ class LabFit:
 
     result: AnalysisResult      # the lab's recording with this fit and its parameter table
     curves: ResultCurves
-    residual: str               # analysis.residuals.describe(fit)
+    residual: str               # analysis.diagnosis.residuals.describe(fit)
 
     @property
     def fit(self) -> FitResult:
@@ -59,11 +59,11 @@ class CandidateRow:
     effect: Effect
     replaces: Effect | None
     delta_bic: float                # inf when the refit failed
-    explanation: str                # analysis.diagnosis.explain
+    explanation: str                # analysis.diagnosis.candidates.explain
     fitted: LabFit | None           # None when the refit failed
     error: str | None = None
     flags: tuple[Flag, ...] = ()
-    accepted: bool = False          # the acceptance rule would take it (analysis.acceptance)
+    accepted: bool = False          # the acceptance rule would take it (analysis.diagnosis.acceptance)
     judgement: str = ""             # why (not): the assessment's reason code
 
     @property
@@ -83,7 +83,7 @@ class DiagnosisOutcome:
     candidates: tuple[CandidateRow, ...]    # best first
     path: tuple[LabFit, ...]                # greedy path: the models taken, in order (empty: ranking only)
     residual: str                           # where the residual of ranked_from sits
-    verdict: str = ""                       # analysis.acceptance's four verdicts
+    verdict: str = ""                       # analysis.diagnosis.acceptance's four verdicts
     verdict_text: str = ""                  # the verdict in plain words, with the site and what to do next
     sites: tuple[SiteResult, ...] = ()      # where the misfit left belongs, best first
     step_cap_reached: bool = False

@@ -3,7 +3,7 @@ reduced chi^2 fall towards the noise floor version after version.
 
 The lab starts from the model the Results page fitted and keeps its own
 history of versions. Every refit is warm-started from the current version's
-values; a diagnosis ranks every model one move away (analysis.diagnosis) and
+values; a diagnosis ranks every model one move away (analysis.diagnosis.candidates) and
 its candidates can be adopted without a refit, their fits being computed
 already. The current version is handed back to the Results page
 (model_adopted), so that both pages show the same model.
@@ -17,8 +17,8 @@ from pathlib import Path
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
 
-from analysis import acceptance, residuals
 from analysis.derived import parameter_table
+from analysis.diagnosis import acceptance, residuals
 from analysis.errors import LinparError
 from analysis.fit import FitData
 from analysis.fit_words import fit_headline

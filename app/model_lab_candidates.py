@@ -10,8 +10,8 @@ from PySide6.QtGui import QFont
 from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QTableWidget,
                                QTableWidgetItem, QTextBrowser, QVBoxLayout, QWidget)
 
-from analysis import acceptance
-from analysis.diagnosis_words import VERDICT_TITLES
+from analysis.diagnosis import acceptance
+from analysis.diagnosis.words import VERDICT_TITLES
 from app.lab_worker import CandidateRow, DiagnosisOutcome
 from app.model_lab_catalogue import category_title
 

@@ -83,7 +83,7 @@ class ResidualPlot(pg.PlotWidget):
 
 
 class ResidualPanel(QWidget):
-    """Where the residual sits, in words (analysis.residuals.describe), over the residual of Z and Hx."""
+    """Where the residual sits, in words (analysis.diagnosis.residuals.describe), over the residual of Z and Hx."""
 
     def __init__(self, parent=None):
         super().__init__(parent)

@@ -1,6 +1,6 @@
 """The model lab's "Missing physics" view: where the misfit belongs, with the best site's smooth correction.
 
-The correction is drawn as the site takes it (analysis.sites): at the
+The correction is drawn as the site takes it (analysis.diagnosis.sites): at the
 electrical and mechanical sites what it adds (resistance and reactance, in
 ohm or kg/s), at the others the factor (its change of size in per cent and
 its phase in degrees).
@@ -14,9 +14,9 @@ import pyqtgraph as pg
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
-from analysis.acceptance import MIN_BIC_GAIN
-from analysis.diagnosis_words import SITE_WORDS, chi2_words, tied_sites
-from analysis.sites import SiteResult
+from analysis.diagnosis.acceptance import MIN_BIC_GAIN
+from analysis.diagnosis.sites import SiteResult
+from analysis.diagnosis.words import SITE_WORDS, chi2_words, tied_sites
 from app import style
 from app.grid_axis import show_grid
 from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis

@@ -21,7 +21,7 @@ class Site(Enum):
 
     The member's `key` is the site's name in files, JSON and on screen: the
     same six names are the sites of the catalogue, of the site localisation
-    (analysis.sites) and of effects of the user's own.
+    (analysis.diagnosis.sites) and of effects of the user's own.
     """
 
     BLOCKED = "blocked electrical impedance"      # added to Ze = RE + s*LE (ohm)

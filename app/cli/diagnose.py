@@ -12,7 +12,7 @@ from app.cli.options import add_json_option, add_sd_option, model_effects
 from app.cli.output import print_json
 
 if TYPE_CHECKING:
-    from analysis.diagnosis import Candidate, Diagnosis, Step
+    from analysis.diagnosis.candidates import Candidate, Diagnosis, Step
     from analysis.fit import FitData, FitResult
 
 
@@ -30,7 +30,7 @@ def register(sub) -> None:
 
 def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
     """The lines to diagnose (from a recording, or from imported curves), Sd, and the recording's drift finding."""
-    from analysis.diagnosis_words import drift_from_validity
+    from analysis.diagnosis.words import drift_from_validity
     from analysis.pipeline import judged_fit_data, resolve_sd
     from analysis.recording import read_recording
     if curves.wants_curves(args):
@@ -44,7 +44,7 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
 
 
 def run_diagnosis(args: argparse.Namespace):
-    from analysis.diagnosis import diagnose
+    from analysis.diagnosis.candidates import diagnose
     from analysis.model import Model
     from analysis.parallel import fit_executor
     start = model_effects(args.start, "--from")     # a bad --from fails before the data are read
@@ -60,8 +60,8 @@ def _fit_summary(fit: FitResult) -> dict:
 
 
 def _candidate_json(current: FitResult, c: Candidate) -> dict:
-    from analysis import acceptance
-    from analysis.diagnosis import explain
+    from analysis.diagnosis import acceptance
+    from analysis.diagnosis.candidates import explain
     return {
         "action": c.action,
         "effect": c.effect.id,
@@ -78,15 +78,15 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
 
 
 def _step_json(step: Step) -> dict:
-    from analysis import acceptance
+    from analysis.diagnosis import acceptance
     return {**_fit_summary(step.fit), "chosen": step.chosen.effect.id if step.chosen else None,
             "flags": acceptance.flags_json(step.flags)}
 
 
 def diagnosis_json(result: Diagnosis, sd_m2: float | None, drift: str | None = None) -> dict:
-    from analysis import acceptance
+    from analysis.diagnosis import acceptance
     from analysis.derived import parameter_table
-    from analysis.diagnosis_words import residual_json, sites_json, verdict_text
+    from analysis.diagnosis.words import residual_json, sites_json, verdict_text
     final = result.final
     return {
         "verdict": result.verdict,
@@ -109,8 +109,8 @@ def _flags_text(flags) -> str:
 
 
 def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
-    from analysis.diagnosis import explain
-    from analysis.diagnosis_words import VERDICT_TITLES, chi2_words, tied_sites, verdict_text
+    from analysis.diagnosis.candidates import explain
+    from analysis.diagnosis.words import VERDICT_TITLES, chi2_words, tied_sites, verdict_text
     lines = [f"verdict: {VERDICT_TITLES[result.verdict]}", "  " + verdict_text(result, drift), "",
              f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", "",
              f"{'rank':<5}{'move':<34}{'delta BIC':>12}  {'taken?':<12} reduced chi^2"]

@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from analysis import acceptance
-from analysis.diagnosis import diagnose
-from analysis.diagnosis_words import drift_from_validity, verdict_text
+from analysis.diagnosis import acceptance
+from analysis.diagnosis.candidates import diagnose
+from analysis.diagnosis.words import drift_from_validity, verdict_text
 from analysis.effects import parse_effects
 from analysis.fit import FitData, fit_model
 from analysis.heating import COPPER_PER_K, coil_heating

@@ -10,9 +10,9 @@ current delay is explained.
 import numpy as np
 import pytest
 
-from analysis import acceptance
 from analysis.derived import parameter_table
-from analysis.diagnosis import diagnose
+from analysis.diagnosis import acceptance
+from analysis.diagnosis.candidates import diagnose
 from analysis.effects import get_effect, parse_effects
 from analysis.fit import FitData, FitResult
 from analysis.model import Model
@@ -109,7 +109,7 @@ def test_with_a_hidden_delay_too_the_delay_is_taken_and_the_rest_left_to_its_sit
 
 def test_a_reduced_chi2_far_below_one_is_said_to_be_an_inflated_noise_not_the_noise_floor(pool):
     import dataclasses
-    from analysis.diagnosis_words import verdict_text
+    from analysis.diagnosis.words import verdict_text
     data = FitData.from_spectra(estimate_spectra(odd_recording(None)))
     inflated = FitData(*(dataclasses.replace(tf, std=10 * tf.std) for tf in (data.impedance, data.displacement)))
     result = diagnose(inflated, Model(parse_effects(DEFAULT)), executor=pool, locate=False)

@@ -10,8 +10,8 @@ import math
 
 import pytest
 
-from analysis import acceptance
-from analysis.diagnosis import diagnose
+from analysis.diagnosis import acceptance
+from analysis.diagnosis.candidates import diagnose
 from analysis.effects import parse_effects
 from analysis.fit import FitData
 from analysis.model import Model

@@ -15,17 +15,17 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt
 
-import analysis.diagnosis
+import analysis.diagnosis.candidates
 import app.lab_worker
-from analysis.diagnosis import MIN_BIC_GAIN
+from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit import FitCancelled, FitError
 from analysis.pipeline import analyze_recording
 from analysis.recording import read_recording
 from app import style
 from app.model_lab import ModelLab
-from app.model_lab_catalogue import EFFECT_ROLE
 from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
+from app.model_lab_catalogue import EFFECT_ROLE
 from app.parameter_table import VALUE
 
 from .conftest import ANALYSIS_TIMEOUT_MS, PAPER, open_and_wait
@@ -238,13 +238,13 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
     def one_process_pool(workers=None):     # a thread stands in for the process: same Executor interface
         with concurrent.futures.ThreadPoolExecutor(max_workers=1) as pool:
             yield pool
-    monkeypatch.setattr(analysis.diagnosis, "_refit", slow_refit)
+    monkeypatch.setattr(analysis.diagnosis.candidates, "_refit", slow_refit)
     monkeypatch.setattr(app.lab_worker, "fit_executor", one_process_pool)
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: bool(calls), timeout=10_000)
     with qtbot.waitSignal(lab.job_cancelled, timeout=10_000):
         qtbot.mouseClick(lab.jobs.cancel_button, Qt.LeftButton)
-    assert len(calls) <= 2 < len(analysis.diagnosis.candidate_models(lab.current.fitted.fit.model))
+    assert len(calls) <= 2 < len(analysis.diagnosis.candidates.candidate_models(lab.current.fitted.fit.model))
     assert lab.candidates.table.rowCount() == 0 and len(lab.versions) == 1
     assert lab.candidates.diagnose_button.isEnabled()
 

@@ -5,13 +5,13 @@ import numpy as np
 import pytest
 from scipy.optimize._numdiff import approx_derivative
 
-from analysis.diagnosis_words import tied_sites
+from analysis.diagnosis.site_correction import site_correction
+from analysis.diagnosis.sites import SITES, _band, _SiteProblem, localise
+from analysis.diagnosis.words import tied_sites
 from analysis.effects import parse_effects
 from analysis.effects.base import Effect, Site
 from analysis.fit import FitData, fit_model
 from analysis.model import Model
-from analysis.site_correction import site_correction
-from analysis.sites import SITES, _band, _SiteProblem, localise
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER
 from tests.odd_physics import odd_recording

@@ -15,7 +15,7 @@ these hold (docs/diagnosis.md says why each is needed):
    At the noise floor this is the ordinary BIC rule; far from it, an effect
    must remove a share of the misfit, not just many sigma of it.
 3. It explains its site's misfit: a smooth, flexible correction at the
-   effect's own site (analysis.sites) shows how much of the misfit any
+   effect's own site (analysis.diagnosis.sites) shows how much of the misfit any
    effect there could remove. The candidate must remove most of that:
 
        chi^2(candidate) <= chi^2(site) + (1 - SITE_SHARE) * (chi^2(current) - chi^2(site)) + d + 3 sqrt(2 d)
@@ -40,7 +40,7 @@ from analysis.effects.base import Effect, ParamSpec
 from analysis.fit import FitResult
 
 if TYPE_CHECKING:  # pragma: no cover
-    from analysis.sites import SiteResult
+    from analysis.diagnosis.sites import SiteResult
 
 MIN_BIC_GAIN = 10.0
 NOISE_FLOOR_CHI2 = 2.0          # "explained": reduced chi^2 at or below this on every channel

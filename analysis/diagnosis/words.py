@@ -7,11 +7,11 @@ from __future__ import annotations
 
 from typing import Iterable
 
-from analysis import acceptance, residuals
-from analysis.diagnosis import Diagnosis
+from analysis.diagnosis import acceptance, residuals
+from analysis.diagnosis.candidates import Diagnosis
+from analysis.diagnosis.sites import SiteResult
 from analysis.effects.base import Site
 from analysis.fit import FitResult
-from analysis.sites import SiteResult
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
 # Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)
@@ -39,7 +39,7 @@ def chi2_words(chi2_red: dict[str, float]) -> str:
 
 
 def residual_json(fit: FitResult) -> list[dict]:
-    """Where the residual sits, as data: the words of analysis.residuals.describe."""
+    """Where the residual sits, as data: the words of analysis.diagnosis.residuals.describe."""
     return [{"channel": f.channel, "f_lo": f.f_low, "f_hi": f.f_high, "kind": f.part, "sign": f.sign,
              "size_sigma": f.peak_sigma, "share": f.share} for f in residuals.findings(fit)]
 

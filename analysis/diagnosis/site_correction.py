@@ -67,7 +67,7 @@ class SiteCorrection(Effect):
 
     knots: np.ndarray = field(default_factory=lambda: np.zeros(0), compare=False)
     scale: float = 1.0                   # RE0 (electrical) or 1/RES0 (mechanical); unused elsewhere
-    offset: float = 0.0                  # added to h at every line: how analysis.sites differentiates
+    offset: float = 0.0                  # added to h at every line: how analysis.diagnosis.sites differentiates
     _designs: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property

@@ -9,7 +9,7 @@ uncertainties. A recording with nothing missing must end with nothing added.
 import numpy as np
 import pytest
 
-from analysis.diagnosis import diagnose
+from analysis.diagnosis.candidates import diagnose
 from analysis.effects import parse_effects
 from analysis.fit import FitData
 from analysis.model import Model

@@ -9,9 +9,9 @@ extra parameter must buy a chi^2 drop of ln n (about 7) to pay for itself.
 That alone is not enough far from the noise floor (at a reduced chi^2 of
 10^4 any flexible effect lowers BIC by thousands), so the greedy path takes
 the best-ranked candidate that passes the acceptance rule of
-analysis.acceptance: no flag, a gain at the misfit's own scale, and no more
+analysis.diagnosis.acceptance: no flag, a gain at the misfit's own scale, and no more
 misfit left than a smooth correction at its site leaves. It stops when none
-does, or at the step cap. Then the site localisation (analysis.sites) says
+does, or at the step cap. Then the site localisation (analysis.diagnosis.sites) says
 where the misfit that is left belongs, and the verdict says how much the
 catalogue explained.
 """
@@ -25,19 +25,19 @@ from typing import Callable
 
 import numpy as np
 
-from analysis import acceptance, residuals
-from analysis.acceptance import MIN_BIC_GAIN, Assessment, Flag
+from analysis.diagnosis import acceptance, residuals
+from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
+from analysis.diagnosis.sites import SiteResult, localise
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
 from analysis.lumped import resonance_frequency
 from analysis.model import Model, ModelError
-from analysis.sites import SiteResult, localise
 from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
 # A candidate's refit gets fewer evaluations than a fit of one's choice: every candidate the path takes
-# on the recordings of tests/analysis/test_diagnosis.py and test_new_physics.py needs at most 91 per
+# on the recordings of tests/analysis/diagnosis/test_diagnosis.py and test_new_physics.py needs at most 91 per
 # parameter (the closed box), while one the data do not ask for wanders along its undetermined parameters,
 # or crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
 CANDIDATE_EVALUATIONS_PER_PARAMETER = 120

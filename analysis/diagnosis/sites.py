@@ -1,7 +1,7 @@
 """Where the physics is missing: the site localisation.
 
 For each of the six sites of physics.md section 8, the current model gets a
-smooth, flexible complex correction there (analysis.site_correction) and is
+smooth, flexible complex correction there (analysis.diagnosis.site_correction) and is
 refitted with it, its own parameters free. The sites are ranked by how much
 misfit their correction removes, paid for by its effective number of
 parameters:
@@ -31,11 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, site_correction
 from analysis.effects.base import Site
 from analysis.fit import FitCancelled, FitData, FitResult, channel_sigmas
 from analysis.lumped import resonance_frequency
 from analysis.model import Model
-from analysis.site_correction import SiteCorrection, coefficient_names, site_correction
 
 SITES = (Site.BLOCKED, Site.FORCE_FACTOR, Site.MECHANICAL, Site.COMPLIANCE, Site.CURRENT, Site.DISPLACEMENT)
 ROUGHNESS_WEIGHT = 1.0       # on second differences of the coefficients, in noise units per unit of h
