@@ -42,11 +42,11 @@ from analysis.default_model import ADDED_MASS_EFFECTS
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import Site
-from analysis.fit import ASSUMED_RELATIVE_STD, ChannelFit, FitData, FitResult, fit_model
+from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, ChannelFit, FitData, FitResult, fit_model
+from analysis.fit.startvalues import start_context
 from analysis.model import BASE_PARAMS, BL_PARAM, Model, ModelError
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
-from analysis.startvalues import start_context
 
 # Agreement of an added-mass result with the laser's, per parameter: green
 # when within AGREE_SIGMA combined sigmas or AGREE_PERCENT, red when beyond

@@ -30,16 +30,16 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
+from analysis.curve_noise import describe_noise, with_estimated_noise
 from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
-from analysis.curve_noise import describe_noise, with_estimated_noise
 from analysis.errors import LinparError
-from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
+from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
+from analysis.fit.startvalues import start_context
 from analysis.model import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
-from analysis.startvalues import start_context
 
 HX_MAX_OVER_FS = 4.0
 # Linearly spaced exports (0.5 Hz or 1 Hz steps up to kHz) put nearly every line
@@ -200,7 +200,7 @@ def curve_json(result: CurveAnalysis) -> dict:
 
 
 def weighted_residual(model: Model, values: Mapping[str, float], data: FitData) -> np.ndarray:
-    """The fit's residual, each line in units of its noise, as analysis.fit builds it."""
+    """The fit's residual, each line in units of its noise, as analysis.fit.least_squares builds it."""
     parts = []
     for tf, evaluate in ((data.impedance, model.impedance), (data.displacement, model.displacement)):
         if tf is None or (tf is data.displacement and not model.with_displacement):
@@ -235,7 +235,7 @@ def jacobian_covariance(residual: Callable[[dict], np.ndarray], values: Mapping[
 
     The scaling is lmfit's scale_covar, right for relative weights whose
     absolute size is unknown; with known (or estimated) noise it is the
-    Birge ratio, never below 1, as analysis.fit does. None when the Jacobian
+    Birge ratio, never below 1, as analysis.fit.least_squares does. None when the Jacobian
     is rank deficient (a parameter the data do not determine).
     """
     base = dict(values)

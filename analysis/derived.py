@@ -23,7 +23,7 @@ from uncertainties import umath
 from analysis.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
 
 if TYPE_CHECKING:       # the fit needs lmfit (half a second to import): not for a table of units (`qa stats`)
-    from analysis.fit import FitResult
+    from analysis.fit.least_squares import FitResult
 
 P_REF = 20e-6     # Pa
 V_283 = 2.83      # V, the customary sensitivity drive (1 W into 8 ohm)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.effects.base import Effect
-from analysis.fit import FitResult
+from analysis.fit.least_squares import FitResult
 from analysis.model import Model
 
 

@@ -24,6 +24,6 @@ def fit_executor(workers: int | None = None) -> Iterator[Executor | None]:
         yield None
         return
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["analysis.fit", "analysis.diagnosis.candidates"])
+    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates"])
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
         yield pool

@@ -23,12 +23,12 @@ import numpy as np
 from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
-from analysis.fit import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.model import Model, ModelError
 from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
-from analysis.startvalues import StartValueError, start_context
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
 from analysis.validity.fit import FitChannels, fit_channels, misfit_findings

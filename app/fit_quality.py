@@ -1,7 +1,7 @@
 """Fit quality in words, with the numbers behind a Details toggle (Results page, wizard's Results step).
 
 The headline names the model by its effects' titles and says how well it explains each channel
-(analysis.fit_words). The statistics a developer reads (reduced chi^2 per channel, AIC, BIC, the
+(analysis.fit.words). The statistics a developer reads (reduced chi^2 per channel, AIC, BIC, the
 counts, the effect ids) sit in a details section that is folded away until asked for.
 """
 from __future__ import annotations
@@ -11,7 +11,7 @@ import html
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QToolButton, QVBoxLayout, QWidget
 
-from analysis.fit_words import fit_headline, fit_is_at_noise
+from analysis.fit.words import fit_headline, fit_is_at_noise
 from analysis.pipeline import AnalysisResult
 
 # Widgets whose object name is this hold the numbers behind a plain-language text (see the UI-text test).

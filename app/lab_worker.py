@@ -18,7 +18,7 @@ from analysis.diagnosis.candidates import MAX_STEPS, Candidate, Diagnosis, Step,
 from analysis.diagnosis.sites import SiteResult
 from analysis.diagnosis.words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
-from analysis.fit import FitCancelled, FitData, FitResult, fit_model
+from analysis.fit.least_squares import FitCancelled, FitData, FitResult, fit_model
 from analysis.model import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult

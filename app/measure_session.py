@@ -18,7 +18,7 @@ from typing import Callable
 
 from PySide6.QtCore import QObject
 
-from analysis.fit import FitCancelled
+from analysis.fit.least_squares import FitCancelled
 from app.job_book import Job, JobRunner
 from app.result_curves import result_curves
 from app.workers import AnalysisOutcome

@@ -20,8 +20,8 @@ from PySide6.QtWidgets import QHBoxLayout, QLabel, QSplitter, QStackedWidget, QT
 from analysis.derived import parameter_table
 from analysis.diagnosis import acceptance, residuals
 from analysis.errors import LinparError
-from analysis.fit import FitData
-from analysis.fit_words import fit_headline
+from analysis.fit.least_squares import FitData
+from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
 from app.job_controls import JobControls
 from app.lab_worker import DiagnosisOutcome, LabFit, LabWorker

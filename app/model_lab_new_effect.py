@@ -26,7 +26,7 @@ from analysis.effects.base import SITE_KEYS, Site
 from analysis.effects.formula import FUNCTIONS
 from analysis.effects.user import (UNITS_AT_SITE, EffectFileError, ParameterEntry, UserEffect, effect_file_text,
                                    effect_from_text, load_effect_file)
-from analysis.fit import FitResult
+from analysis.fit.least_squares import FitResult
 from analysis.model import ModelError
 from app import style
 from app.plots import LogFrequencyAxis, style_plot

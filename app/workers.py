@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from analysis.fit import FitCancelled
+from analysis.fit.least_squares import FitCancelled
 from analysis.pipeline import AnalysisResult, analyze_recording
 from analysis.recording import read_recording
 from app.job_book import Job, JobRunner

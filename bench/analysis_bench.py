@@ -12,7 +12,7 @@ from bench.common import Row, at_most, median_time, standard_recording
 def run(workdir: Path) -> list[Row]:
     from analysis.diagnosis.candidates import diagnose
     from analysis.diagnosis.sites import localise
-    from analysis.fit import FitData
+    from analysis.fit.least_squares import FitData
     from analysis.model import Model
     from analysis.parallel import fit_executor
     from analysis.pipeline import analyze_path

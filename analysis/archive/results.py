@@ -22,7 +22,7 @@ import numpy as np
 from analysis.bounds import FREQUENCY, SD
 from analysis.derived import ParameterValue
 from analysis.errors import LinparError
-from analysis.fit_report import fit_report_json
+from analysis.fit.report import fit_report_json
 from analysis.json_finite import finite
 from analysis.session import session_of
 
@@ -161,7 +161,7 @@ class Curve:
 
     @property
     def normalized_residual(self) -> np.ndarray:
-        """As analysis.fit.ChannelFit: (model - measured) per component in units of its std."""
+        """As analysis.fit.least_squares.ChannelFit: (model - measured) per component in units of its std."""
         sigma = self.std / np.sqrt(2.0)
         if not self.has_phase:
             return (np.abs(self.model) - self.measured.real) / sigma

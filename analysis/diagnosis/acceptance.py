@@ -37,7 +37,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from analysis.effects.base import Effect, ParamSpec
-from analysis.fit import FitResult
+from analysis.fit.least_squares import FitResult
 
 if TYPE_CHECKING:  # pragma: no cover
     from analysis.diagnosis.sites import SiteResult

@@ -30,10 +30,10 @@ from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.diagnosis.sites import SiteResult, localise
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
-from analysis.fit import FitData, FitError, FitResult, fit_model, screen_fit
+from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
+from analysis.fit.startvalues import StartContext, phase_slope, start_context
 from analysis.lumped import resonance_frequency
 from analysis.model import Model, ModelError
-from analysis.startvalues import StartContext, phase_slope, start_context
 
 MAX_STEPS = 6
 # A candidate's refit gets fewer evaluations than a fit of one's choice: every candidate the path takes

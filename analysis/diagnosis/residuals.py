@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.fit import ChannelFit, FitResult
+from analysis.fit.least_squares import ChannelFit, FitResult
 
 THRESHOLD_SIGMA = 3.0
 PEAK_FRACTION = 0.1

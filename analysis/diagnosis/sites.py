@@ -33,7 +33,7 @@ from scipy.optimize import least_squares
 
 from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, site_correction
 from analysis.effects.base import Site
-from analysis.fit import FitCancelled, FitData, FitResult, channel_sigmas
+from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
 from analysis.lumped import resonance_frequency
 from analysis.model import Model
 

@@ -11,7 +11,7 @@ from analysis.diagnosis import acceptance, residuals
 from analysis.diagnosis.candidates import Diagnosis
 from analysis.diagnosis.sites import SiteResult
 from analysis.effects.base import Site
-from analysis.fit import FitResult
+from analysis.fit.least_squares import FitResult
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
 # Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)

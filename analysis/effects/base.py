@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Mapping
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from analysis.startvalues import StartContext
+    from analysis.fit.startvalues import StartContext
 
 
 class Site(Enum):

@@ -67,7 +67,7 @@ delay_current = CurrentDelay(
     reference=("R. Pintelon, J. Schoukens, 'System Identification: A Frequency Domain Approach', 2nd ed., "
                "Wiley-IEEE Press, 2012 (delays and calibration of the measurement channels)"),
     notes=("The fit starts from the slope of the phase that the current model leaves in Z over the top "
-           "octave (analysis.startvalues.phase_slope): a start of 0 can end in a local minimum when the "
+           "octave (analysis.fit.startvalues.phase_slope): a start of 0 can end in a local minimum when the "
            "model is far from the data (a hidden -50 us did, at -7 us, with a reduced chi^2 of 3e8 to "
            "start from), and far from the data the diagnosis also refits it from the data's own start values "
            "(the bent fit's other parameters can hold it in a local minimum even when it starts at the true "

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.startvalues import impedance_peaks
+from analysis.fit.startvalues import impedance_peaks
 
 CATEGORY = "enclosure"
 ALPHA = ParamSpec("alpha_b", "1", "-", 1.0, 0.005, 100.0, 1.0,

@@ -29,7 +29,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from analysis.fit import FitResult
+from analysis.fit.least_squares import FitResult
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import ABSENT, Validity
 from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst

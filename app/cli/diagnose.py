@@ -13,7 +13,7 @@ from app.cli.output import print_json
 
 if TYPE_CHECKING:
     from analysis.diagnosis.candidates import Candidate, Diagnosis, Step
-    from analysis.fit import FitData, FitResult
+    from analysis.fit.least_squares import FitData, FitResult
 
 
 def register(sub) -> None:

@@ -49,5 +49,5 @@ def format_result(result) -> str:
         for f in channel.get("findings") or ():
             lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
     if fit is not None:
-        lines += ["", report]           # the fit's own report (analysis.fit_report): correlations, bounds
+        lines += ["", report]           # the fit's own report (analysis.fit.report): correlations, bounds
     return "\n".join(lines)

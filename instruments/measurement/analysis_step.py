@@ -24,7 +24,7 @@ from typing import Sequence
 import numpy as np
 
 from analysis.effects import Effect, Site
-from analysis.fit import FitData, fit_model, start_values
+from analysis.fit.least_squares import FitData, fit_model, start_values
 from analysis.model import Model
 from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra, naming_the_file
 from analysis.recording import Recording

@@ -8,8 +8,8 @@ import pytest
 from analysis.effects import CATALOGUE, DEFAULT_EFFECTS, UnknownEffectError, categories, get_effect, parse_effects
 from analysis.effects.base import Site
 from analysis.errors import LinparError
+from analysis.fit.startvalues import StartContext
 from analysis.model import Model, ModelError
-from analysis.startvalues import StartContext
 from tests.analysis.test_effects import BASE
 
 REQUIRED_CATEGORIES = {"inductance", "creep", "electrical-channel", "displacement-sensor", "breakup"}

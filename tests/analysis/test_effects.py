@@ -6,7 +6,7 @@ import pytest
 
 from analysis.effects import CATALOGUE, get_effect
 from analysis.effects.breakup import breakup
-from analysis.startvalues import StartContext
+from analysis.fit.startvalues import StartContext
 
 # The paper's driver (physics.md section 7): fs = 70.5 Hz.
 BASE = {"RE": 3.02, "LE": 0.132e-3, "CMES": 433e-6, "LCES": 11.75e-3, "RES": 12.08, "Bl": 5.23}
@@ -312,9 +312,9 @@ def test_a_vented_box_holds_the_cone_at_fb_and_is_the_closed_box_far_above():
 
 def test_the_vented_box_reads_its_start_from_the_two_impedance_peaks():
     from analysis.effects.enclosure import vented_box
-    from analysis.fit import FitData
+    from analysis.fit.least_squares import FitData
     from analysis.spectra import estimate_spectra
-    from analysis.startvalues import start_context
+    from analysis.fit.startvalues import start_context
     from tests.builders import PAPER, TYPICAL_NOISE, recording
     truth = {**PAPER.parameters, "alpha_b": 1.5, "fb": 50.0, "QL": 7.0}
     data = FitData.from_spectra(estimate_spectra(recording(truth, "lr2,creep-log,vented-box", noise=TYPICAL_NOISE,

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from analysis.effects import CATALOGUE, get_effect
-from analysis.fit import FitData, fit_model
+from analysis.fit.least_squares import FitData, fit_model
+from analysis.fit.startvalues import start_context
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
-from analysis.startvalues import start_context
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 CASES = {

@@ -6,7 +6,7 @@ from analysis.diagnosis import acceptance
 from analysis.diagnosis.candidates import diagnose
 from analysis.diagnosis.words import drift_from_validity, verdict_text
 from analysis.effects import parse_effects
-from analysis.fit import FitData, fit_model
+from analysis.fit.least_squares import FitData, fit_model
 from analysis.heating import COPPER_PER_K, coil_heating
 from analysis.model import Model
 from analysis.pipeline import analyze_recording

@@ -14,7 +14,7 @@ from analysis.derived import parameter_table
 from analysis.diagnosis import acceptance
 from analysis.diagnosis.candidates import diagnose
 from analysis.effects import get_effect, parse_effects
-from analysis.fit import FitData, FitResult
+from analysis.fit.least_squares import FitData, FitResult
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER

@@ -13,7 +13,7 @@ import pytest
 from analysis.diagnosis import acceptance
 from analysis.diagnosis.candidates import diagnose
 from analysis.effects import parse_effects
-from analysis.fit import FitData
+from analysis.fit.least_squares import FitData
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording

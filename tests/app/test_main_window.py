@@ -8,7 +8,7 @@ from PySide6.QtCore import QMimeData, QPoint, Qt, QUrl
 from PySide6.QtGui import QDropEvent
 
 import app.workers
-from analysis.fit import FitCancelled
+from analysis.fit.least_squares import FitCancelled
 from analysis.recording import RecordingError, read_recording
 from app.main_window import MainWindow
 from app.placeholders import PAGES, PlaceholderPage

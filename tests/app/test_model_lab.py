@@ -19,7 +19,7 @@ import analysis.diagnosis.candidates
 import app.lab_worker
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
-from analysis.fit import FitCancelled, FitError
+from analysis.fit.least_squares import FitCancelled, FitError
 from analysis.pipeline import analyze_recording
 from analysis.recording import read_recording
 from app import style

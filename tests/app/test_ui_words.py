@@ -115,7 +115,7 @@ def offending_texts(root: QWidget, patterns: dict[str, re.Pattern] = FORBIDDEN) 
 @pytest.mark.parametrize("text, bad", [
     ("SimulatedAudio(LinearBlockDriver(lr2,creep-log, 48000 Hz, 65536 taps), 48000 Hz)", True),
     ("Fit(method='leastsq')", True),
-    ("<analysis.fit.FitResult object at 0x7f00>", True),
+    ("<analysis.fit.least_squares.FitResult object at 0x7f00>", True),
     ("see physics.md section 5", True),
     ("as the paper's Table I.", True),
     ("ΔBIC -9.2e9", True),

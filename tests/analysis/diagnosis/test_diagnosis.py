@@ -11,7 +11,7 @@ import pytest
 
 from analysis.diagnosis.candidates import diagnose
 from analysis.effects import parse_effects
-from analysis.fit import FitData
+from analysis.fit.least_squares import FitData
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording

@@ -10,7 +10,7 @@ from analysis.diagnosis.sites import SITES, _band, _SiteProblem, localise
 from analysis.diagnosis.words import tied_sites
 from analysis.effects import parse_effects
 from analysis.effects.base import Effect, Site
-from analysis.fit import FitData, fit_model
+from analysis.fit.least_squares import FitData, fit_model
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER

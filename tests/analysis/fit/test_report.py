@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from analysis.archive.results import StoredResult, results_document
-from analysis.fit_report import MIN_CORREL, fit_report_json, fit_report_text
+from analysis.fit.report import MIN_CORREL, fit_report_json, fit_report_text
 from analysis.pipeline import analyze_recording
 from analysis.report import build_report
 from tests.builders import TYPICAL_NOISE, recording

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from analysis.effects import parse_effects
-from analysis.fit import FitCancelled, FitData, fit_model
+from analysis.fit.least_squares import FitCancelled, FitData, fit_model
 from analysis.model import Model
 from analysis.spectra import estimate_spectra
 from analysis.synthesis import ChannelNoise

@@ -24,7 +24,7 @@ Correlations: lmfit shows |r| >= 0.1. A loudspeaker's lumped parameters all shar
 nearly every pair is listed; MIN_CORREL = 0.5 keeps the pairs that trade against each other, the ones a
 reader must know about before trusting either value alone.
 
-Nothing here imports analysis.fit (which calls this module): the fit is read by its attributes.
+Nothing here imports analysis.fit.least_squares (which calls this module): the fit is read by its attributes.
 """
 from __future__ import annotations
 

@@ -6,8 +6,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from analysis.fit import ChannelFit
-from analysis.fit_words import channel_clause, fit_headline
+from analysis.fit.least_squares import ChannelFit
+from analysis.fit.words import channel_clause, fit_headline
 
 FREQS = np.geomspace(10, 10000, 200)
 

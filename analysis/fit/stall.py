@@ -4,7 +4,7 @@ A fit whose chi^2 has not dropped by more than STALL_CHI2 (in noise units) and S
 over STALL_ITERATIONS iterations has stopped: it wanders along a direction the data do not determine
 (an effect that is not there) or crawls along a parameter held at its bound, which MINPACK's own tests
 can follow for thousands of evaluations. At that pace halving chi^2 would take 10^5 iterations.
-analysis.fit ends such a fit through lmfit's iteration callback and polishes it from its best point.
+analysis.fit.least_squares ends such a fit through lmfit's iteration callback and polishes it from its best point.
 """
 from __future__ import annotations
 

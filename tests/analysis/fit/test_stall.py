@@ -3,7 +3,7 @@ import lmfit
 import numpy as np
 import pytest
 
-from analysis.fit_stall import STALL_ITERATIONS, StallWatch
+from analysis.fit.stall import STALL_ITERATIONS, StallWatch
 
 
 def _params(x: float) -> lmfit.Parameters:

@@ -30,10 +30,10 @@ import numpy as np
 
 from analysis.effects.base import Site
 from analysis.errors import LinparError
-from analysis.fit_stall import StallWatch
+from analysis.fit.stall import StallWatch
+from analysis.fit.startvalues import linear_gain, start_context
 from analysis.model import Model
 from analysis.spectra import Spectra, TransferFunction
-from analysis.startvalues import linear_gain, start_context
 
 # A line's uncertainty never counts as less than this fraction of its value:
 # noise-free (simulated) data would otherwise get infinite weights.
@@ -147,8 +147,8 @@ class FitResult:
 
     def report(self, min_correl: float | None = None) -> str:
         """The fit report, as lmfit's fit_report: statistics, parameters with sigma, correlations with
-        |r| >= min_correl (default analysis.fit_report.MIN_CORREL), parameters on a bound."""
-        from analysis.fit_report import MIN_CORREL, fit_report_json, fit_report_text
+        |r| >= min_correl (default analysis.fit.report.MIN_CORREL), parameters on a bound."""
+        from analysis.fit.report import MIN_CORREL, fit_report_json, fit_report_text
         return fit_report_text(fit_report_json(self, MIN_CORREL if min_correl is None else min_correl))
 
 
@@ -231,7 +231,7 @@ def _minimize(model, params, data, use_x, sigmas, cancel,
                                 max_nfev=per_parameter * (n_varying + 1))
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
-    # Stopped where it had stopped improving (analysis.fit_stall): polished from its best point.
+    # Stopped where it had stopped improving (analysis.fit.stall): polished from its best point.
     return watch.polished(residual, params, result)
 
 

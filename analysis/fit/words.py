@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from analysis.diagnosis.residuals import channel_finding
-from analysis.fit import ChannelFit, FitResult
+from analysis.fit.least_squares import ChannelFit, FitResult
 
 # A reduced chi^2 this close to 1 is noise: the model has nothing left to explain.
 NOISE_LEVEL = 1.5
