@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 
 
 def peak_of_period(mean_period: np.ndarray) -> float:

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.spectra import Spectra, displacement_noise_factor, period_spectra, transfer_from_periods
 
 COPPER_PER_K = 0.00393

@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import Validity, assess
 

@@ -30,7 +30,7 @@ from analysis.derived import ParameterValue
 from analysis.effects import Effect
 from analysis.errors import LinparError
 from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording, require_fit
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.validity.findings import DISTORTION_HIGH
 
 # The columns of the paper's Table II (and this module's), in order.

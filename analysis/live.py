@@ -32,7 +32,7 @@ import numpy as np
 import scipy.fft
 
 from analysis.excursion import peak_of_period
-from analysis.recording import UNITS
+from analysis.recording.format import UNITS
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.findings import Finding, worst

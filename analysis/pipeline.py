@@ -27,7 +27,7 @@ from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResul
 from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.model import Model, ModelError
-from analysis.recording import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
+from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT

@@ -24,7 +24,7 @@ import numpy as np
 
 from analysis.bounds import FREQUENCY
 from analysis.errors import LinparError
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 
 ANALYSED_SIGNALS = ("voltage", "current", "displacement")
 # A line counts as excited when it stands this far above the noise and is

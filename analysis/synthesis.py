@@ -17,7 +17,7 @@ from typing import Callable, Mapping
 import numpy as np
 
 from analysis.model import Model
-from analysis.recording import Recording, make_recording
+from analysis.recording.format import Recording, make_recording
 
 
 @dataclass(frozen=True, slots=True)

@@ -21,7 +21,7 @@ from PySide6.QtCore import QSize, Qt, QTimer, Signal
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
 from analysis.live import DB_FLOOR, LiveFrame
-from analysis.recording import UNITS
+from analysis.recording.format import UNITS
 from app import style
 from app.grid_axis import show_grid
 from app.plot_placeholder import PlotPlaceholder

@@ -160,7 +160,7 @@ class Menus:
         """Write the shown result as `kind` (from the suffix when None); False, and why, when it cannot be."""
         from analysis.archive.results import StoredResult, header_of_recording, results_document
         from analysis.export import write_exports
-        from analysis.recording import read_recording
+        from analysis.recording.format import read_recording
         result = self.window.results.result
         suffixes = suffix_kind()
         kind = kind or suffixes.get(path.suffix.lower())

@@ -75,7 +75,7 @@ def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> s
     limits: the analysis.limits.Limits the page shows, for the report's QA section (None: none).
     """
     from analysis.archive.results import StoredResult, calibration_of, header_of_recording, results_document
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     from analysis.report import build_report, write_report
     recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
     stored = StoredResult.from_json(results_document(result, recording))

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from analysis.fit.least_squares import FitCancelled
 from analysis.pipeline import AnalysisResult, analyze_recording
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from app.job_book import Job, JobRunner
 from app.result_curves import ResultCurves, result_curves
 

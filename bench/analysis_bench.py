@@ -16,7 +16,7 @@ def run(workdir: Path) -> list[Row]:
     from analysis.model import Model
     from analysis.parallel import fit_executor
     from analysis.pipeline import analyze_path
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     from analysis.spectra import estimate_spectra
 
     path = standard_recording(workdir)

@@ -34,7 +34,7 @@ def fill(root: Path, n: int = N_MEASUREMENTS) -> float:
     from analysis.archive import Archive
     from analysis.archive.results import results_document
     from analysis.pipeline import analyze_recording
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     rec = small_recording()
     path = root.parent / "bench-recording"
     write_recording(path, rec)

@@ -44,7 +44,7 @@ def standard_recording(directory: Path) -> Path:
     """3 channels, 48 kHz, 16 periods of 65,536 samples plus one settle period (the issue's benchmark)."""
     from analysis.drivers import load_driver
     from analysis.multitone import design_multitone
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     from analysis.synthesis import ChannelNoise, synthesize_recording
 
     path = directory / "standard"

@@ -246,7 +246,7 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
 
 
 def _audio_stats(wav: Path) -> float:
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     capture = read_recording(wav).extra.get("audio_capture", {})
     return float(sum(capture.get(k, 0) for k in ("input_overflows", "input_underflows", "output_underflows",
                                                  "output_overflows", "restarts")))
@@ -256,7 +256,7 @@ def _diagnosing(app, window, folder: Path) -> list[Row]:
     from analysis.drivers import load_driver
     from analysis.effects import get_effect
     from analysis.multitone import design_multitone
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     from analysis.synthesis import ChannelNoise, synthesize_recording
 
     driver = load_driver("paper")

@@ -40,7 +40,7 @@ def _template(workdir: Path) -> tuple[dict, Path, dict]:
     from analysis.archive import Archive
     from analysis.archive.results import results_document
     from analysis.pipeline import analyze_recording
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     from bench.archive_bench import small_recording
     rec = small_recording()
     path = workdir / "production-unit"

@@ -15,7 +15,7 @@ SIMULATOR_TARGET_S = 5.0      # 16 periods of 16,384 samples through the nonline
 
 def run(workdir: Path) -> list[Row]:
     from analysis.live import LiveAccumulator
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     from analysis.spectra import estimate_spectra
     from analysis.validity.assessment import assess
 

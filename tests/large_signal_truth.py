@@ -33,7 +33,7 @@ def truth_model(driver, x_range=(-4e-3, 4e-3)) -> LargeSignalModel:
 
 from analysis.drivers import load_driver                       # noqa: E402
 from analysis.multitone import design_multitone                # noqa: E402
-from analysis.recording import make_recording                  # noqa: E402
+from analysis.recording.format import make_recording                  # noqa: E402
 from analysis.synthesis import ChannelNoise                    # noqa: E402
 
 FS = 48000
@@ -77,7 +77,7 @@ def noisy_recording(block, mt, settle: int = 2, seed: int = 0, noise: ChannelNoi
 
 def write_steps(folder, levels=(5.0, 9.0), period: int = 8192) -> list:
     """The known driver at each level, 4 periods each, written as recordings in folder: their WAV paths."""
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     driver = known_driver(period)
     paths = []
     for level in levels:

@@ -30,7 +30,7 @@ def small_measurement(folder: Path) -> tuple[Path, dict]:
     """(recording path, results document) of the small measurement, written into `folder`."""
     from analysis.archive.results import results_document
     from analysis.pipeline import analyze_recording
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     rec = small_recording()
     path = Path(folder) / "unit"
     write_recording(path, rec)

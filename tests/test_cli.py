@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.cli import main
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 

@@ -4,7 +4,7 @@ import json
 import pytest
 
 from analysis.importers import read_curve
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.cli import main
 from instruments.simulation import faults
 from tests.builders import TYPICAL_NOISE, recording

@@ -13,7 +13,7 @@ import struct
 import numpy as np
 import pytest
 
-from analysis.recording import make_recording, write_recording
+from analysis.recording.format import make_recording, write_recording
 from app.cli import main
 from tests.builders import TYPICAL_NOISE, recording
 

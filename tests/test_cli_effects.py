@@ -7,7 +7,7 @@ from analysis.effects import parse_effects
 from analysis.effects.user import load_effect_file
 from analysis.model import Model
 from analysis.multitone import design_multitone
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from analysis.synthesis import synthesize_recording
 from app.cli import main
 from tests.analysis.test_user_effects import BAD_FILES, EXAMPLE

@@ -107,7 +107,7 @@ NOT_USER_ERRORS = {"Cancelled", "_NotJson", "SchemaError", "SpecError"}
 
 def test_every_error_a_module_defines_derives_from_linpar_error():
     classes = every_error_class()
-    assert "analysis.recording_sidecar.RecordingError" in classes
+    assert "analysis.recording.sidecar.RecordingError" in classes
     stray = sorted(name for name, cls in classes.items()
                    if not issubclass(cls, LinparError) and not any(n in name for n in NOT_USER_ERRORS))
     assert stray == []

@@ -13,7 +13,7 @@ import time
 import pytest
 
 from analysis.archive import Archive
-from analysis.recording import make_recording, write_recording
+from analysis.recording.format import make_recording, write_recording
 from app.cli import main
 from tests.builders import TYPICAL_NOISE, recording
 from tests.pace import paced

@@ -7,7 +7,7 @@ import pytest
 
 from analysis.effects import parse_effects
 from analysis.model import Model
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.cli import main
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 from tests.builders import REAL_DATA

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from analysis.recording import make_recording, write_recording
+from analysis.recording.format import make_recording, write_recording
 from app.cli import main
 from tests.large_signal_truth import KNOWN_OFFSET_M, write_steps
 

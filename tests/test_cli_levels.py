@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.cli import main
 from tests.builders import TYPICAL_NOISE, recording
 

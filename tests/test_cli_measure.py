@@ -11,7 +11,7 @@ from datetime import datetime, timezone
 import pytest
 
 from analysis.pipeline import result_json
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from app.cli import main
 from instruments.measurement.analysis_step import analyse_measurement
 from instruments.measurement.runner import default_effects

@@ -15,7 +15,7 @@ import sys
 import pytest
 
 import app.cli.devices as cli_devices
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from app.cli import main
 from instruments.audio.simulated import SimulatedAudio
 

@@ -112,8 +112,8 @@ def test_the_circle_finder_finds_circles():
 
 def test_late_and_type_only_imports_are_edges(tmp_path):
     module = tmp_path / "m.py"
-    module.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from analysis.recording import Recording\n"
+    module.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from analysis.recording.format import Recording\n"
                       "def f():\n    from app.cli import main\n    import instruments.audio\n"
                       "from . import sibling\n", encoding="utf-8")
     names = imported_names("analysis.m", module, {"analysis.sibling"})
-    assert names == {"typing", "analysis.recording", "app.cli", "instruments.audio", "analysis.sibling"}
+    assert names == {"typing", "analysis.recording.format", "app.cli", "instruments.audio", "analysis.sibling"}

@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 
 from analysis.drivers import load_driver
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from tests.builders import TYPICAL_NOISE, recording
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -22,7 +22,7 @@ from analysis.drivers import load_driver  # noqa: E402
 from analysis.limits import load_limits  # noqa: E402
 from analysis.multitone import design_multitone  # noqa: E402
 from analysis.pipeline import analyze_recording  # noqa: E402
-from analysis.recording import read_recording, write_recording  # noqa: E402
+from analysis.recording.format import read_recording, write_recording  # noqa: E402
 from analysis.report import build_report, write_report  # noqa: E402
 from analysis.synthesis import ChannelNoise, synthesize_recording  # noqa: E402
 

@@ -9,7 +9,7 @@ from PySide6.QtWidgets import QApplication
 
 from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from analysis.synthesis import ChannelNoise, synthesize_recording
 
 SIZE = (1400, 900)

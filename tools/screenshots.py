@@ -55,7 +55,7 @@ from PySide6.QtWidgets import QApplication  # noqa: E402
 from analysis.drivers import load_driver  # noqa: E402
 from analysis.effects import get_effect  # noqa: E402
 from analysis.multitone import design_multitone  # noqa: E402
-from analysis.recording import write_recording  # noqa: E402
+from analysis.recording.format import write_recording  # noqa: E402
 from analysis.synthesis import ChannelNoise, synthesize_recording  # noqa: E402
 from tools.screenshot_kit import (ANALYSIS_TIMEOUT_S, SIZE, SMALL_AND_LARGE, grab_small_and_large,  # noqa: E402
                                   settle, synthetic_recording, wait_for, wait_for_click)
@@ -253,7 +253,7 @@ def archive_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
     the list, then four of them compared."""
     from analysis.archive import Archive
     from analysis.pipeline import analyze_recording
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     from instruments.simulation import faults
 
     from datetime import datetime, timedelta, timezone
@@ -443,7 +443,7 @@ def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     both screen sizes; then Help's guide and About."""
     import numpy as np
 
-    from analysis.recording import make_recording, read_recording
+    from analysis.recording.format import make_recording, read_recording
     good = read_recording(synthetic_recording(folder))
     signals = {c.signal: good.signal(c.signal) for c in good.channels}
     signals["current"] = np.zeros_like(signals["current"])

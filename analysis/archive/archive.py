@@ -40,8 +40,8 @@ from analysis.archive.record import RECORD_FILE, RECORD_FORMAT, TEXT_FIELDS, Ent
 from analysis.archive.schema import KEY_PARAMETERS
 from analysis.bounds import YEAR
 from analysis.config_folder import data_folder, overridden
-from analysis.session import recording_header
 from analysis.files import read_text, regular_file
+from analysis.session import recording_header
 
 MeasurementId = str
 FOLDERS = "measurements"
@@ -206,14 +206,14 @@ class Archive(FolderQA):
         """Store a measurement; return its id.
 
         recording: a path (NAME, NAME.wav or NAME.json; copied byte for byte)
-        or an analysis.recording.Recording (written as float32). result: an
+        or an analysis.recording.format.Recording (written as float32). result: an
         analysis.pipeline.AnalysisResult or its results document (a dict, as
         analysis.archive.results.results_document makes). meta: MeasurementMeta or a dict.
         When the archive holds limits, the record keeps the verdict of its newest version and that
         version's number (`judge_with`: another analysis.archive.limits_store.LimitsVersion, or None).
         """
         from analysis.archive.results import results_document
-        from analysis.recording import Recording, read_recording, recording_paths, write_recording
+        from analysis.recording.format import Recording, read_recording, recording_paths, write_recording
         meta = MeasurementMeta.coerce(meta)
         rec_obj = recording if isinstance(recording, Recording) else read_recording(recording)
         doc = result if isinstance(result, Mapping) else results_document(result, rec_obj)

@@ -305,7 +305,7 @@ def _session(doc: Mapping) -> dict:
 def stored_from_recording(path, sd_m2: float | None = None, effects=None):
     """Analyse a recording file now: (StoredResult, header, calibration), as an archived copy would give."""
     from analysis.pipeline import analyze_recording
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     recording = read_recording(path)
     result = analyze_recording(recording, sd_m2, effects)
     stored = StoredResult.from_json(results_document(result, recording))

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.errors import LinparError
-from analysis.recording import MIN_PERIODS, Recording
+from analysis.recording.format import MIN_PERIODS, Recording
 
 
 class LargeSignalError(LinparError, ValueError):

@@ -27,7 +27,7 @@ from analysis.large_signal.model import LargeSignalModel, model_of
 from analysis.large_signal.simulate import SimulationDiverged
 from analysis.large_signal.stepping import VOLTAGE_DISTORTION_DB, clipped_inputs, distortion_db
 from analysis.large_signal.trust import delay_doubtful, delay_not_found, delays_found, verdict
-from analysis.recording import Recording, read_recording
+from analysis.recording.format import Recording, read_recording
 from analysis.session import recording_header
 
 # Flags: a misfit this many times the noise; explained distortion below this; a band wider than this at the edges.

@@ -41,7 +41,7 @@ import numpy as np
 from analysis.bounds import DISTORTION_DB, EXCURSION_MM, LEVEL_V_RMS, TEMPERATURE_RISE_K
 from analysis.excursion import recording_peak_displacement
 from analysis.large_signal.data import LargeSignalError
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 
 COPPER_ALPHA_PER_K = 0.00393
 MIN_STEP_RATIO = 1.02

@@ -33,7 +33,7 @@ from types import MappingProxyType
 from typing import Mapping, Sequence
 
 from analysis.excursion import recording_peak_displacement
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.capture import CaptureInfo, CaptureInfoError, capture_findings

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.spectra import Spectra, period_spectra
 from analysis.thresholds import ValidityThresholds
 from analysis.validity.findings import DRIFT, Finding, Severity, graded

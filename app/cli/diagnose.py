@@ -32,7 +32,7 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
     """The lines to diagnose (from a recording, or from imported curves), Sd, and the recording's drift finding."""
     from analysis.diagnosis.words import drift_from_validity
     from analysis.pipeline import judged_fit_data, resolve_sd
-    from analysis.recording import read_recording
+    from analysis.recording.format import read_recording
     if curves.wants_curves(args):
         from analysis.curve_fit import curve_data
         z, hx, notes = curves.load_curves(args)

@@ -141,7 +141,7 @@ def checked_outputs(args: argparse.Namespace, inputs) -> dict[str, Path]:
     """The files to write; OutputError (one line) when one would replace an input of this command (a recording's
     WAV or sidecar), another output or something that is not a regular file."""
     from analysis.files import check_output, check_outputs_spare_inputs
-    from analysis.recording import recording_paths
+    from analysis.recording.format import recording_paths
     taken = [p for path in inputs for p in _recording_files(path, recording_paths)]
     outputs = {option: path for option, _ in OUTPUTS
                if (path := getattr(args, option.replace("-", "_"))) is not None}

@@ -50,7 +50,7 @@ def register(sub) -> None:
 
 
 def _is_recording(text: str) -> bool:
-    from analysis.recording import recording_paths
+    from analysis.recording.format import recording_paths
     wav, sidecar = recording_paths(text)
     return wav.is_file() and sidecar.is_file()
 
@@ -73,7 +73,7 @@ def load_source(args):
 def _outputs_spare_the_inputs(args, outputs) -> None:
     """OutputError when an output file is one of the command's inputs (the recording, the limits, each other)."""
     from analysis.files import check_outputs_spare_inputs
-    from analysis.recording import recording_paths
+    from analysis.recording.format import recording_paths
     inputs = [*recording_paths(args.source), *([Path(args.limits)] if getattr(args, "limits", None) else [])]
     check_outputs_spare_inputs(outputs, inputs)
 

@@ -177,7 +177,7 @@ def measure_resistor(config, r_ohm: float, level_v: float, cancel: threading.Eve
     audio = open_audio(config)
     captured = capture(audio, mt.waveform, CAL_PERIODS, CAL_SETTLE, cancel=cancel, progress=progress)
     signals = {k: v for k, v in captured.signals().items() if k != "displacement"}
-    from analysis.recording import make_recording
+    from analysis.recording.format import make_recording
     recording = make_recording(captured.sample_rate, signals, captured.period_samples,
                                excited_bins=tuple(int(b) for b in mt.excited_bins))
     return check_resistor(estimate_spectra(recording), r_ohm, config.key())

@@ -99,7 +99,7 @@ class CapturedSignals:
         return self.voltage.size // self.period_samples
 
     def signals(self) -> dict[str, np.ndarray]:
-        """Name -> samples, as analysis.recording.make_recording takes them."""
+        """Name -> samples, as analysis.recording.format.make_recording takes them."""
         out = {"voltage": self.voltage, "current": self.current}
         if self.displacement is not None:
             out["displacement"] = self.displacement
@@ -111,7 +111,7 @@ class CapturedSignals:
         The sidecar gets "capture" (what analysis.validity.assessment reads) and
         "audio_capture" (every count of CaptureStats, for the report).
         """
-        from analysis.recording import make_recording
+        from analysis.recording.format import make_recording
         return make_recording(self.sample_rate, self.signals(), self.period_samples, settle_periods=0,
                               excited_bins=None if excited_bins is None else tuple(int(b) for b in excited_bins),
                               driver=dict(driver or {}),

@@ -27,7 +27,7 @@ from analysis.effects import Effect, Site
 from analysis.fit.least_squares import FitData, fit_model, start_values
 from analysis.model import Model
 from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra, naming_the_file
-from analysis.recording import Recording
+from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra
 
 DISPLACEMENT_MAX_KEY = "displacement_max_hz"

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from analysis.recording import make_recording, write_recording
+from analysis.recording.format import make_recording, write_recording
 from instruments.audio.captured import CLIP_LEVEL
 from instruments.audio.config import Calibration, ChannelMap
 from instruments.audio.periods import PeriodCollector

@@ -45,7 +45,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from analysis.pipeline import AnalysisResult
-from analysis.recording import Recording, make_recording, read_recording, write_recording
+from analysis.recording.format import Recording, make_recording, read_recording, write_recording
 from analysis.session import SESSION_KEY, new_session
 from instruments.audio import CapturedSignals, capture
 from instruments.audio.errors import AudioError, CaptureCancelled

@@ -37,7 +37,7 @@ import numpy as np
 
 from analysis.drivers import load_driver
 from analysis.multitone import Multitone, design_multitone
-from analysis.recording import Recording, make_recording
+from analysis.recording.format import Recording, make_recording
 from analysis.synthesis import ChannelNoise, steady_state_period
 from analysis.validity.capture import OUT_OF_RANGE_CODES, CaptureInfo
 from instruments.simulation.nonlinear_driver import NonlinearBlockDriver

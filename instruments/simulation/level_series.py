@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Sequence
 
 from analysis.errors import LinparError
-from analysis.recording import Recording, write_recording
+from analysis.recording.format import Recording, write_recording
 from instruments.simulation.faults import DEFAULT_BENCH, Bench, clean_nonlinear
 
 DEFAULT_LEVELS_V = (0.3, 1.0, 3.0, 6.0, 10.0, 14.0)

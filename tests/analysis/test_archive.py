@@ -17,7 +17,7 @@ from analysis.archive.record import read_record
 from analysis.archive.results import StoredResult, results_document
 from analysis.archive.schema import CURRENT_VERSION, MIGRATIONS
 from analysis.pipeline import analyze_recording
-from analysis.recording import read_recording, write_recording
+from analysis.recording.format import read_recording, write_recording
 from tests.builders import TYPICAL_NOISE, recording
 
 

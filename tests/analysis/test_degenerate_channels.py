@@ -16,7 +16,7 @@ import pytest
 
 from analysis.limits import judge_result, parse_limits
 from analysis.pipeline import NotAnalysable, analyze_recording, require_fit
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.report.qa import qa_section
 from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL
 from tests.builders import PAPER, TYPICAL_NOISE, recording

@@ -14,7 +14,7 @@ import pytest
 
 import analysis.files as files
 from analysis.bounds import GiB, size_limits_set
-from analysis.recording import RecordingError, read_recording, write_recording
+from analysis.recording.format import RecordingError, read_recording, write_recording
 from tests.builders import TYPICAL_NOISE, multitone, recording
 
 
@@ -59,7 +59,7 @@ def test_a_large_wav_is_memory_mapped_and_decodes_as_when_read(rec, monkeypatch)
 
 @pytest.mark.parametrize("bits", [16, 24, 32])
 def test_integer_pcm_decodes_channel_by_channel(tmp_path, bits):
-    from analysis.recording_wav import decode_wav
+    from analysis.recording.wav import decode_wav
     ints = np.array([[0, 1, -1, 2**(bits - 1) - 1, -2**(bits - 1)], [5, -5, 7, -7, 0], [1, 2, 3, 4, 5]])
     width = bits // 8
     frames = b"".join(int(v).to_bytes(width, "little", signed=True) for v in ints.T.reshape(-1))

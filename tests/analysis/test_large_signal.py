@@ -19,7 +19,7 @@ from analysis.large_signal.data import recording_data
 from analysis.large_signal.distortion import harmonics, recording_fit
 from analysis.large_signal.trust import delay_doubtful, delay_not_found
 from analysis.large_signal.words import format_large_signal
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from tests.large_signal_truth import (KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, clean_periods, inner,
                                       known_driver, noisy_recording, relative_errors)
 

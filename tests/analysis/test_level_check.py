@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from analysis.level_check import LevelProbe, level_check
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.validity.assessment import assess
 from instruments.simulation.faults import BENCH_NOISE, PAPER
 from instruments.simulation.nonlinear_driver import NonlinearBlockDriver

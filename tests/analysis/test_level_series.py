@@ -111,7 +111,7 @@ def test_text_table_has_a_row_per_level(series):
 
 
 def test_results_paths_and_recordings_mix(tmp_path, results):
-    from analysis.recording import write_recording
+    from analysis.recording.format import write_recording
     rec = recording(noise=TYPICAL_NOISE, n_periods=4, seed=5)       # linear, 1 V RMS
     wav, _ = write_recording(tmp_path / "linear", rec)
     s = level_series([results[0], wav, rec])

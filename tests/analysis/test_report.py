@@ -10,7 +10,7 @@ import pytest
 from analysis.archive import Archive
 from analysis.archive.results import StoredResult, results_document
 from analysis.pipeline import analyze_recording
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from analysis.report import build_report, render_html, report_for_measurement, report_for_recording, write_report
 from instruments.simulation import faults
 from tests.builders import TYPICAL_NOISE, needs_pdftotext, pdf_text, recording

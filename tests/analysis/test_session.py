@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from importlib.metadata import version
 
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.session import new_session, recording_header, session_of, software
 from tests.builders import recording
 

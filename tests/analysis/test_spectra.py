@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from analysis.model import Model
 from analysis.effects import parse_effects
-from analysis.recording import make_recording
+from analysis.model import Model
+from analysis.recording.format import make_recording
 from analysis.spectra import estimate_spectra, period_spectra, pooling_window
 from analysis.synthesis import ChannelNoise
 from tests.builders import PAPER, multitone, recording

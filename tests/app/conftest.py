@@ -16,7 +16,7 @@ from PySide6.QtWidgets import QMessageBox
 
 from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from analysis.synthesis import ChannelNoise, synthesize_recording
 
 PAPER = load_driver("paper")

@@ -13,7 +13,7 @@ from analysis.archive import Archive
 from analysis.archive.index import INDEX_FILE
 from analysis.archive.results import results_document
 from analysis.pipeline import analyze_recording
-from analysis.recording import read_recording, write_recording
+from analysis.recording.format import read_recording, write_recording
 from analysis.report import report_for_measurement, report_for_recording, write_report
 from analysis.session import software
 from app.archive_page import ROOT_KEY

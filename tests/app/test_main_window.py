@@ -9,7 +9,7 @@ from PySide6.QtGui import QDropEvent
 
 import app.workers
 from analysis.fit.least_squares import FitCancelled
-from analysis.recording import RecordingError, read_recording
+from analysis.recording.format import RecordingError, read_recording
 from app.main_window import MainWindow
 from app.placeholders import PAGES, PlaceholderPage
 from app.settings import MAX_RECENT

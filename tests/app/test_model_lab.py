@@ -21,7 +21,7 @@ from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit.least_squares import FitCancelled, FitError
 from analysis.pipeline import analyze_recording
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from app import style
 from app.model_lab import ModelLab
 from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED

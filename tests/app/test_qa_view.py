@@ -7,9 +7,9 @@ import json
 import pytest
 
 import app.qa_view as qa_view
-from analysis.recording import make_recording, write_recording
-from app.qa_view import NO_LIMITS, NO_REPORT, QAView
+from analysis.recording.format import make_recording, write_recording
 from analysis.validity.findings import NO_SIGNAL
+from app.qa_view import NO_LIMITS, NO_REPORT, QAView
 from instruments.simulation import faults
 from tests.builders import needs_pdftotext, pdf_text
 

@@ -1,7 +1,7 @@
 """The Series page: repeatability and level series analysed off the GUI thread."""
 import pytest
 
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.series_page import SeriesPage
 from instruments.simulation.level_series import write_level_series
 from tests.builders import TYPICAL_NOISE, recording

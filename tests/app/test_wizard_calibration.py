@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from analysis.multitone import design_multitone
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.spectra import estimate_spectra
 from app.wizard import MeasureWizard
 from app.wizard.calibration import Corrections, check_resistor, measure_resistor

@@ -18,7 +18,7 @@ import pytest
 
 from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.synthesis import steady_state_period
 from instruments.laser.sensor import LaserBlock
 from instruments.measurement import alignment

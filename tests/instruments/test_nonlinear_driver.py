@@ -5,7 +5,7 @@ import pytest
 from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
 from analysis.pipeline import analyze_recording
-from analysis.recording import make_recording
+from analysis.recording.format import make_recording
 from analysis.synthesis import steady_state_period
 from instruments.simulation.block_driver import BlockDriver
 from instruments.simulation.nonlinear_driver import NonlinearBlockDriver

@@ -13,7 +13,7 @@ import shutil
 
 import pytest
 
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from tests.builders import TYPICAL_NOISE, multitone, recording
 from tests.reliability.cli_outcome import outcome
 

@@ -25,7 +25,7 @@ from analysis.archive import Archive
 from analysis.archive.archive import FOLDERS, RESULTS_FILE
 from analysis.archive.results import results_document
 from analysis.pipeline import analyze_recording
-from analysis.recording import read_recording, write_recording
+from analysis.recording.format import read_recording, write_recording
 from instruments.measurement.analysis_step import analyse_measurement
 from instruments.measurement.recovery import RecoveryError, discard, find_unfinished, inspect, recover
 from instruments.measurement.runner import default_effects

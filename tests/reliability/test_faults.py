@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from instruments.laser.ild1420 import ErrorPlan
 from instruments.measurement import MeasurementError, MeasurementFailed
 from instruments.measurement.recovery import JournalKept, find_unfinished, recover, run_journaled

@@ -30,7 +30,7 @@ from analysis.archive.archive import FOLDERS
 from analysis.archive.names import folder_name, inside, safe_suffix, slug
 from analysis.archive.record import RECORD_FILE
 from analysis.pipeline import analyze_recording
-from analysis.recording import make_recording, read_recording, write_recording
+from analysis.recording.format import make_recording, read_recording, write_recording
 from tests.builders import REPO_ROOT, TYPICAL_NOISE, recording
 
 pytestmark = pytest.mark.timeout(60)

@@ -25,7 +25,7 @@ from analysis.archive.index import INDEX_FILE
 from analysis.archive.record import RECORD_FILE
 from analysis.archive.results import results_document
 from analysis.pipeline import analyze_recording
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from app.cli import main as linpar
 from tests.builders import TYPICAL_NOISE, recording
 from tests.reliability.fuzzing import FUZZ_FEW, one_line

@@ -18,7 +18,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from analysis.pipeline import analyze_recording
-from analysis.recording import RecordingError, read_recording, write_recording
+from analysis.recording.format import RecordingError, read_recording, write_recording
 from analysis.thresholds import DEFAULT_THRESHOLDS
 from analysis.validity.capture import CaptureInfo, CaptureInfoError, capture_findings
 from app.cli import main as linpar

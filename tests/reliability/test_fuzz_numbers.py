@@ -21,7 +21,7 @@ from hypothesis import example, given
 from hypothesis import strategies as st
 
 from analysis.archive import Archive
-from analysis.recording import write_recording
+from analysis.recording.format import write_recording
 from tests.builders import TYPICAL_NOISE, multitone, recording
 from tests.reliability.cli_outcome import outcome
 from tests.reliability.fuzzing import FUZZ, FUZZ_FEW, FUZZ_MANY

@@ -1,6 +1,6 @@
 """Recordings from damaged or hostile files: a Recording or one RecordingError line, never a traceback or a hang.
 
-tests/analysis/test_recording.py already flips bytes of one good WAV and puts
+tests/analysis/recording/test_recording.py already flips bytes of one good WAV and puts
 JSON-ish values at the sidecar's known keys. This adds what that does not
 reach: WAV files built from random chunk lists (chunk ids, lying sizes, odd
 'fmt ' contents, WAVE_FORMAT_EXTENSIBLE GUIDs), byte-level damage to the
@@ -18,7 +18,7 @@ import scipy.io.wavfile
 from hypothesis import example, given
 from hypothesis import strategies as st
 
-from analysis.recording import RecordingError, read_recording, write_recording
+from analysis.recording.format import RecordingError, read_recording, write_recording
 from tests.reliability.fuzzing import FUZZ, FUZZ_MANY, one_line
 
 pytestmark = pytest.mark.timeout(60)

@@ -19,7 +19,7 @@ import time
 
 import pytest
 
-from analysis.recording import read_recording
+from analysis.recording.format import read_recording
 from instruments.laser import LaserSpec, open_laser
 from instruments.measurement import MeasurementFailed, MeasurementPlan
 from instruments.measurement.recovery import find_unfinished, run_journaled

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from analysis.excursion import peak_excursion, peak_from_spectrum
-from analysis.recording import make_recording, read_recording, write_recording
+from analysis.recording.format import make_recording, read_recording, write_recording
 from analysis.spectra import estimate_spectra, period_spectra
 from analysis.synthesis import ChannelNoise
 from analysis.thresholds import DEFAULT_THRESHOLDS, ThresholdsError, ValidityThresholds, load_thresholds

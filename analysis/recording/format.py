@@ -9,8 +9,8 @@ when it is built, whether from files (read_recording), from signals
 Messages name the file (or "<in memory>"), the sidecar key or the channel, what
 was found and what was expected, on one line: they are shown to the user as is.
 
-The JSON of the sidecar is read and written by analysis.recording_sidecar, the
-samples by analysis.recording_wav; this module holds the rules and the files.
+The JSON of the sidecar is read and written by analysis.recording.sidecar, the
+samples by analysis.recording.wav; this module holds the rules and the files.
 """
 from __future__ import annotations
 
@@ -27,10 +27,10 @@ import numpy as np
 # The sidecar's vocabulary (FORMAT, UNITS, Channel, RecordingError) is defined there and importable from here.
 from analysis.bounds import CHANNEL_SCALE, PERIOD_SAMPLES, SAMPLE_RATE, SD
 from analysis.files import mapped, regular_file, write_atomic
-from analysis.recording_sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
+from analysis.recording.sidecar import (CHANNEL_KEYS, EXCITATION_KEYS, FORMAT, TOP_KEYS, UNITS, Channel,
                                         RecordingError, format_sidecar, json_default, load_sidecar, parse_sidecar,
                                         show, unit_wanted)
-from analysis.recording_wav import WavFormatError, decode_wav, encode_float32_wav
+from analysis.recording.wav import WavFormatError, decode_wav, encode_float32_wav
 
 __all__ = ["FORMAT", "IN_MEMORY", "MIN_PERIODS", "REQUIRED_SIGNALS", "UNITS", "Channel", "Recording",
            "RecordingError", "make_recording", "read_recording", "recording_paths", "write_recording"]

@@ -19,7 +19,7 @@ import scipy.io.wavfile
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from analysis.recording import (Channel, Recording, RecordingError, make_recording, read_recording,
+from analysis.recording.format import (Channel, Recording, RecordingError, make_recording, read_recording,
                                 write_recording)
 
 RATE = 8000

@@ -1,10 +1,10 @@
 """The sidecar of a recording, NAME.json: its vocabulary, and its JSON read, checked by key, and written.
 
-analysis.recording builds and checks Recordings; this module is the layer
+analysis.recording.format builds and checks Recordings; this module is the layer
 below it that knows the JSON: the format's name, the signals and their units,
 the keys of each object, a Channel (one entry of "channels"), RecordingError,
 and the one-line messages about a sidecar. Import the public names from
-analysis.recording, which re-exports them; the format is
+analysis.recording.format, which re-exports them; the format is
 ../shared/spec/recording-format.md.
 """
 from __future__ import annotations
@@ -160,7 +160,7 @@ def json_default(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
-# --- files and messages, shared with analysis.recording ---------------------
+# --- files and messages, shared with analysis.recording.format ---------------------
 
 def unit_wanted(signal) -> str:
     if isinstance(signal, str) and signal in UNITS:

@@ -1,0 +1,40 @@
+"""Recordings: the raw signals of one multitone measurement, and their files (NAME.wav + NAME.json).
+
+The public names of analysis.recording.format (Recording, read_recording, write_recording,
+make_recording, ...) are importable from the package itself; each is loaded on first use.
+"""
+from __future__ import annotations
+
+import importlib
+
+# Where each public name lives; a name is imported on first use only, so that
+# importing one submodule of the package does not load the rest.
+_HOME = {
+    "FORMAT": "format",
+    "IN_MEMORY": "format",
+    "MIN_PERIODS": "format",
+    "REQUIRED_SIGNALS": "format",
+    "UNITS": "format",
+    "Channel": "format",
+    "Recording": "format",
+    "RecordingError": "format",
+    "make_recording": "format",
+    "read_recording": "format",
+    "recording_paths": "format",
+    "write_recording": "format",
+}
+
+__all__ = sorted(_HOME)
+
+
+def __getattr__(name: str):
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{home}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOME))
