@@ -38,13 +38,13 @@ from scipy.optimize import minimize_scalar
 
 from analysis.curve_fit import (CurveFitError, FitRange, covariance_with_bounds, curve_validity, fit_curves,
                                 relative_residual)
-from analysis.default_model import ADDED_MASS_EFFECTS
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import Site
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, ChannelFit, FitData, FitResult, fit_model
 from analysis.fit.startvalues import start_context
-from analysis.model import BASE_PARAMS, BL_PARAM, Model, ModelError
+from analysis.model.composed import BASE_PARAMS, BL_PARAM, Model, ModelError
+from analysis.model.defaults import ADDED_MASS_EFFECTS
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
 
@@ -56,7 +56,7 @@ from analysis.spectra import TransferFunction
 AGREE_SIGMA, DISAGREE_SIGMA = 2.0, 3.0
 AGREE_PERCENT, DISAGREE_PERCENT = 2.0, 5.0
 COMPARED = ("Bl", "Mms", "Cms")
-DEFAULT_EFFECTS = ",".join(ADDED_MASS_EFFECTS)      # why these: analysis.default_model
+DEFAULT_EFFECTS = ",".join(ADDED_MASS_EFFECTS)      # why these: analysis.model.defaults
 MODEL_FREE_BAND = (0.8, 1.2)     # x fs, Speakerbench's averaging band
 REPORTED = ("Bl", "Mms", "Cms", "Rms", "Vas", "fs", "Qms", "Qes", "Qts", "RE")
 

@@ -37,7 +37,7 @@ from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
 from analysis.fit.startvalues import start_context
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
 

@@ -20,7 +20,7 @@ import numpy as np
 import uncertainties
 from uncertainties import umath
 
-from analysis.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
+from analysis.model.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
 
 if TYPE_CHECKING:       # the fit needs lmfit (half a second to import): not for a table of units (`qa stats`)
     from analysis.fit.least_squares import FitResult
@@ -166,7 +166,7 @@ def parameter_table(fit: FitResult, sd_m2: float | None,
 
 
 def unmeasured_table(model, reason: str) -> dict[str, ParameterValue]:
-    """Every parameter of `model` (an analysis.model.Model) and the derived ones, each "not measured: reason"."""
+    """Every parameter of `model` (an analysis.model.composed.Model) and the derived ones, each "not measured: reason"."""
     table = {spec.name: ParameterValue(spec.name, None, None, spec.unit, spec.display_unit, spec.display_scale,
                                        reason)
              for spec in model.param_specs}

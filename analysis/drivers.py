@@ -10,11 +10,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from analysis.effects import parse_effects
 from analysis.bounds import SD, Bound
+from analysis.effects import parse_effects
 from analysis.errors import LinparError
 from analysis.files import read_text
-from analysis.model import Model
+from analysis.model.composed import Model
 
 DRIVERS_DIR = Path(__file__).resolve().parent.parent / "resources" / "drivers"
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from analysis.effects.base import Effect
 from analysis.fit.least_squares import FitResult
-from analysis.model import Model
+from analysis.model.composed import Model
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,7 +25,7 @@ class ChannelSignature:
 
 
 def with_effect(model: Model, effect: Effect) -> Model:
-    """The model with `effect` added, or swapped for the effect of its category (analysis.model.ModelError if not)."""
+    """The model with `effect` added, or swapped for the effect of its category (analysis.model.composed.ModelError if not)."""
     kept = tuple(e for e in model.effects if e.category != effect.category and e.id != effect.id)
     return model.with_effects(kept + (effect,))
 

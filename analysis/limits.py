@@ -59,7 +59,7 @@ def parameter_units() -> dict[str, tuple[str, str, float]]:
     """name -> (SI unit, customary unit, customary = SI x scale) for every parameter linpar can report."""
     from analysis.derived import DERIVED
     from analysis.effects import CATALOGUE
-    from analysis.model import BASE_PARAMS, BL_PARAM
+    from analysis.model.composed import BASE_PARAMS, BL_PARAM
     table = {}
     for spec in (*BASE_PARAMS, BL_PARAM, *(p for e in CATALOGUE.values() for p in e.params)):
         table.setdefault(spec.name, (spec.unit, spec.display_unit, spec.display_scale))

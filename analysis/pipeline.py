@@ -26,7 +26,7 @@ from analysis.errors import LinparError
 from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult, fit_model
 from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
-from analysis.model import Model, ModelError
+from analysis.model.composed import Model, ModelError
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of

@@ -16,7 +16,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.recording.format import Recording, make_recording
 
 

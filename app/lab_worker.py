@@ -19,7 +19,7 @@ from analysis.diagnosis.sites import SiteResult
 from analysis.diagnosis.words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, fit_model
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from analysis.validity.fit import rejudged

@@ -1,6 +1,6 @@
 """The effects catalogue of the model lab: checkboxes by category, and a pane explaining each effect.
 
-Effects of one category are alternatives (analysis.model allows one per
+Effects of one category are alternatives (analysis.model.composed allows one per
 category): checking a second one swaps it for the first, like radio buttons
 that may also all be off. Effects of the user's own (analysis.effects.registry:
 the user folder, packages) have a branch of their own, "User effects", with the

@@ -27,7 +27,7 @@ from analysis.effects.formula import FUNCTIONS
 from analysis.effects.user import (UNITS_AT_SITE, EffectFileError, ParameterEntry, UserEffect, effect_file_text,
                                    effect_from_text, load_effect_file)
 from analysis.fit.least_squares import FitResult
-from analysis.model import ModelError
+from analysis.model.composed import ModelError
 from app import style
 from app.plots import LogFrequencyAxis, style_plot
 

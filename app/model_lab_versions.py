@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from analysis.effects import get_effect
-from analysis.model import Model
+from analysis.model.composed import Model
 from app.lab_worker import LabFit
 
 

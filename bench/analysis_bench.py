@@ -13,7 +13,7 @@ def run(workdir: Path) -> list[Row]:
     from analysis.diagnosis.candidates import diagnose
     from analysis.diagnosis.sites import localise
     from analysis.fit.least_squares import FitData
-    from analysis.model import Model
+    from analysis.model.composed import Model
     from analysis.parallel import fit_executor
     from analysis.pipeline import analyze_path
     from analysis.recording.format import read_recording

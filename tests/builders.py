@@ -11,7 +11,7 @@ import pytest
 
 from analysis.drivers import load_driver
 from analysis.effects import parse_effects
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.multitone import design_multitone
 from analysis.synthesis import ChannelNoise, synthesize_recording
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from analysis.effects import parse_effects
 from analysis.effects.base import Effect, Site
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.synthesis import synthesize_recording
 from tests.builders import PAPER, TYPICAL_NOISE, multitone
 

@@ -5,7 +5,7 @@ import pytest
 
 from analysis.effects import parse_effects
 from analysis.effects.user import load_effect_file
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.multitone import design_multitone
 from analysis.recording.format import write_recording
 from analysis.synthesis import synthesize_recording

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from analysis.effects import parse_effects
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.recording.format import write_recording
 from app.cli import main
 from tests.builders import PAPER, TYPICAL_NOISE, recording

@@ -272,9 +272,9 @@ class StoredResult:
                    curves, _user_effects(model), _session(doc))
 
     def model(self):
-        """The analysis.model.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
+        """The analysis.model.composed.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
         from analysis.effects import parse_effects
-        from analysis.model import Model
+        from analysis.model.composed import Model
         return Model(parse_effects(",".join(self.effects) or "none", self.user_effects), self.with_displacement)
 
     def model_curve(self, name: str, freqs: np.ndarray) -> np.ndarray:

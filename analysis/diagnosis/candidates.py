@@ -32,8 +32,8 @@ from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
 from analysis.fit.startvalues import StartContext, phase_slope, start_context
-from analysis.lumped import resonance_frequency
-from analysis.model import Model, ModelError
+from analysis.model.composed import Model, ModelError
+from analysis.model.lumped import resonance_frequency
 
 MAX_STEPS = 6
 # A candidate's refit gets fewer evaluations than a fit of one's choice: every candidate the path takes

@@ -34,8 +34,8 @@ from scipy.optimize import least_squares
 from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
-from analysis.lumped import resonance_frequency
-from analysis.model import Model
+from analysis.model.composed import Model
+from analysis.model.lumped import resonance_frequency
 
 SITES = (Site.BLOCKED, Site.FORCE_FACTOR, Site.MECHANICAL, Site.COMPLIANCE, Site.CURRENT, Site.DISPLACEMENT)
 ROUGHNESS_WEIGHT = 1.0       # on second differences of the coefficients, in noise units per unit of h

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from analysis.default_model import DEFAULT_EFFECTS
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.effects.catalogue import CATALOGUE
 from analysis.errors import LinparError
+from analysis.model.defaults import DEFAULT_EFFECTS
 
 
 def categories() -> dict[str, list[Effect]]:

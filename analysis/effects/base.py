@@ -1,7 +1,7 @@
 """What an effect is: a small object that adds physics to the lumped model.
 
 An effect names its parameters, says where in the model it acts (its site),
-and returns one complex frequency response there. The model (analysis.model)
+and returns one complex frequency response there. The model (analysis.model.composed)
 composes the base lumped model with any number of effects, one per category.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 class Site(Enum):
-    """Where an effect's response enters the model (physics.md section 8; analysis.model composes them).
+    """Where an effect's response enters the model (physics.md section 8; analysis.model.composed composes them).
 
     The member's `key` is the site's name in files, JSON and on screen: the
     same six names are the sites of the catalogue, of the site localisation

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.lumped import resonance_frequency
+from analysis.model.lumped import resonance_frequency
 
 CATEGORY = "creep"
 LAMBDA = ParamSpec("lambda", "1", "-", 1.0, -0.5, 2.0, 0.05,

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.lumped import C_SOUND, RHO, resonance_frequency
+from analysis.model.lumped import C_SOUND, RHO, resonance_frequency
 
 AIR_CATEGORY = "air-load"
 DAMPING_CATEGORY = "damping"

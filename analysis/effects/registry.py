@@ -54,7 +54,7 @@ def clear() -> None:
 def _builtin_names() -> tuple[dict[str, str], frozenset[str]]:
     """Parameter names in use (with their owner, for messages) and effect ids of the built-in catalogue."""
     from analysis.effects.catalogue import CATALOGUE
-    from analysis.model import BASE_PARAMS, BL_PARAM
+    from analysis.model.composed import BASE_PARAMS, BL_PARAM
     taken = {p.name: "the base model" for p in (*BASE_PARAMS, BL_PARAM)}
     for effect in CATALOGUE.values():
         for p in effect.params:

@@ -45,7 +45,7 @@ import numpy as np
 from analysis.effects.base import Effect, ParamSpec, Site, SITE_KEYS
 from analysis.effects.formula import RESERVED, Formula, FormulaError, parse_formula
 from analysis.errors import LinparError
-from analysis.lumped import resonance_frequency
+from analysis.model.lumped import resonance_frequency
 
 
 class EffectFileError(LinparError, ValueError):

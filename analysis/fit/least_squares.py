@@ -32,7 +32,7 @@ from analysis.effects.base import Site
 from analysis.errors import LinparError
 from analysis.fit.stall import StallWatch
 from analysis.fit.startvalues import linear_gain, start_context
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import Spectra, TransferFunction
 
 # A line's uncertainty never counts as less than this fraction of its value:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 
 from analysis.bounds import ADDED_MASS_G
-from analysis.default_model import ADDED_MASS_EFFECTS
+from analysis.model.defaults import ADDED_MASS_EFFECTS
 from app.cli.curves import add_range_options, fit_range
 from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects
 from app.cli.output import print_json

@@ -45,7 +45,7 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
 
 def run_diagnosis(args: argparse.Namespace):
     from analysis.diagnosis.candidates import diagnose
-    from analysis.model import Model
+    from analysis.model.composed import Model
     from analysis.parallel import fit_executor
     start = model_effects(args.start, "--from")     # a bad --from fails before the data are read
     data, sd, drift = _data(args)

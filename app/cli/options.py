@@ -14,8 +14,8 @@ import argparse
 from typing import Callable, Sequence
 
 from analysis.bounds import SD, Bound, BoundsError, parse_size_limit
-from analysis.default_model import DEFAULT_EFFECTS
 from analysis.errors import LinparError
+from analysis.model.defaults import DEFAULT_EFFECTS
 
 
 class CliError(LinparError):
@@ -62,7 +62,7 @@ def add_json_option(parser, what: str = "print one JSON object") -> None:
 def model_effects(text: str | None, option: str = "--model"):
     """The effects an option names (the default model for None); ModelError that names the option."""
     from analysis.effects import UnknownEffectError, parse_effects
-    from analysis.model import ModelError
+    from analysis.model.composed import ModelError
     try:
         return parse_effects(text)
     except UnknownEffectError as exc:

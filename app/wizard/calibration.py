@@ -28,7 +28,7 @@ from typing import Mapping
 import numpy as np
 
 from analysis.errors import LinparError
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import Spectra, estimate_spectra
 from instruments.audio.config import Calibration
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from analysis.effects import Effect, Site
 from analysis.fit.least_squares import FitData, fit_model, start_values
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra, naming_the_file
 from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra

@@ -198,7 +198,7 @@ def default_driver(name_or_path: str = "paper", sample_rate: int = 48000, effect
     """The LinearBlockDriver of a driver file; ``effects`` replaces the file's effect ids."""
     from analysis.drivers import load_driver
     from analysis.effects import parse_effects
-    from analysis.model import Model
+    from analysis.model.composed import Model
     from instruments.simulation.linear_driver import LinearBlockDriver
 
     definition = load_driver(name_or_path)

@@ -1,7 +1,7 @@
 """Simulated loudspeakers that stream block by block (the virtual rig's drivers).
 
 ``BlockDriver`` is the interface; ``LinearBlockDriver`` is the small-signal
-model of analysis.model as FIR filters. Other implementations (a nonlinear
+model of analysis.model.composed as FIR filters. Other implementations (a nonlinear
 time-domain driver) live in their own modules and are imported from there,
 not re-exported here, so that importing this package stays cheap.
 """

@@ -39,7 +39,7 @@ from typing import Callable, Mapping
 import numpy as np
 import scipy.fft
 
-from analysis.model import Model
+from analysis.model.composed import Model
 from instruments.simulation.block_driver import DriverBlock
 
 DEFAULT_FIR_LENGTH = 65536

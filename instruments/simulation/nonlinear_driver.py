@@ -29,7 +29,7 @@ How it is integrated: exact linear part + integrated nonlinear part
 The state is split, s = s_lin + s_nl. s_lin is the small-signal response to
 u, from frequency-sampled FIRs (instruments.simulation.linear_driver: exact
 for a periodic excitation whose period divides fir_length, no latency), with
-the whole analysis.model: LR-2 if values hold L2 and R2, log creep if they
+the whole analysis.model.composed: LR-2 if values hold L2 and R2, log creep if they
 hold "lambda". s_nl obeys the linearised equations driven by what the linear
 model leaves out,
 
@@ -73,7 +73,7 @@ import numpy as np
 import scipy.linalg
 
 from analysis.effects import parse_effects
-from analysis.model import Model
+from analysis.model.composed import Model
 from instruments.simulation.block_driver import DriverBlock
 from instruments.simulation.linear_driver import (
     DEFAULT_FIR_LENGTH, DEFAULT_PARTITION, PartitionedConvolver, frequency_sampled_fir)

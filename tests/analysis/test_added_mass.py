@@ -8,7 +8,7 @@ from analysis.curve_fit import CurveFitError
 from analysis.derived import ParameterValue
 from analysis.effects import parse_effects
 from analysis.effects.base import Site
-from analysis.model import Model, ModelError
+from analysis.model.composed import Model, ModelError
 from analysis.spectra import TransferFunction
 from tests.builders import electrical
 

@@ -9,7 +9,7 @@ from analysis.effects import CATALOGUE, DEFAULT_EFFECTS, UnknownEffectError, cat
 from analysis.effects.base import Site
 from analysis.errors import LinparError
 from analysis.fit.startvalues import StartContext
-from analysis.model import Model, ModelError
+from analysis.model.composed import Model, ModelError
 from tests.analysis.test_effects import BASE
 
 REQUIRED_CATEGORIES = {"inductance", "creep", "electrical-channel", "displacement-sensor", "breakup"}

@@ -5,7 +5,7 @@ import pytest
 from analysis.curve_fit import curve_data
 from analysis.curve_noise import estimated_std, with_estimated_noise
 from analysis.effects import parse_effects
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import TransferFunction
 from tests.builders import DRIVERS
 

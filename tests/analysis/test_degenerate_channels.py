@@ -135,7 +135,7 @@ def test_a_refit_that_fits_takes_the_misfit_finding_away(misfit):
     """The Model lab's versions: the validity goes with the fit, not with the model first fitted."""
     from analysis.effects import parse_effects
     from analysis.fit.least_squares import FitData, fit_model
-    from analysis.model import Model
+    from analysis.model.composed import Model
     from analysis.validity.fit import qa_blocker, rejudged
     better = fit_model(FitData.from_spectra(misfit.spectra), Model(parse_effects("lr2,creep-log,delay-current")))
     assert max(better.chi2_red_by_channel().values()) < 2

@@ -5,7 +5,7 @@ import pytest
 from analysis.derived import derived_from_values, parameter_table
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData, fit_model
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 

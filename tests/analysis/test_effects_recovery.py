@@ -11,7 +11,7 @@ import pytest
 from analysis.effects import CATALOGUE, get_effect
 from analysis.fit.least_squares import FitData, fit_model
 from analysis.fit.startvalues import start_context
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 

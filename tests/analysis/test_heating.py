@@ -8,7 +8,7 @@ from analysis.diagnosis.words import drift_from_validity, verdict_text
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData, fit_model
 from analysis.heating import COPPER_PER_K, coil_heating
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.pipeline import analyze_recording
 from analysis.spectra import estimate_spectra
 from analysis.synthesis import synthesize_recording

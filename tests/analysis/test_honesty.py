@@ -15,7 +15,7 @@ from analysis.diagnosis import acceptance
 from analysis.diagnosis.candidates import diagnose
 from analysis.effects import get_effect, parse_effects
 from analysis.fit.least_squares import FitData, FitResult
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER
 from tests.odd_physics import ODD, odd_recording

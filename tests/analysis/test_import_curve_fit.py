@@ -9,7 +9,7 @@ from analysis.curve_fit import (FitRange, CurveFitError, covariance_with_bounds,
 from analysis.derived import parameter_table
 from analysis.effects import parse_effects
 from analysis.importers import read_curve
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import TransferFunction
 from tests.builders import DRIVERS, PAPER
 

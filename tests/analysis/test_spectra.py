@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from analysis.effects import parse_effects
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.recording.format import make_recording
 from analysis.spectra import estimate_spectra, period_spectra, pooling_window
 from analysis.synthesis import ChannelNoise

@@ -13,7 +13,7 @@ from analysis.effects.base import Site
 from analysis.effects.formula import FUNCTIONS, FormulaError, parse_formula
 from analysis.effects.user import EffectFileError, UserEffect, effect_from_text, load_effect_file
 from analysis.fit.least_squares import FitData, fit_model
-from analysis.model import Model, ModelError
+from analysis.model.composed import Model, ModelError
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, REPO_ROOT, TYPICAL_NOISE, recording
 

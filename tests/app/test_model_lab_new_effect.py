@@ -23,7 +23,7 @@ def rms_result():
     """The paper's driver with Rms(f) = Rms*sqrt(f/fs) (the example effect file), fitted with lr2,creep-log."""
     from analysis.effects import parse_effects
     from analysis.effects.user import load_effect_file
-    from analysis.model import Model
+    from analysis.model.composed import Model
     from analysis.synthesis import synthesize_recording
     from tests.builders import PAPER, TYPICAL_NOISE, multitone
     truth = {**PAPER.parameters}

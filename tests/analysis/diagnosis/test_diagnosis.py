@@ -12,7 +12,7 @@ import pytest
 from analysis.diagnosis.candidates import diagnose
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 

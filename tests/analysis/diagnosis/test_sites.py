@@ -11,7 +11,7 @@ from analysis.diagnosis.words import tied_sites
 from analysis.effects import parse_effects
 from analysis.effects.base import Effect, Site
 from analysis.fit.least_squares import FitData, fit_model
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER
 from tests.odd_physics import odd_recording

@@ -6,7 +6,7 @@ import pytest
 
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitCancelled, FitData, fit_model
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from analysis.synthesis import ChannelNoise
 from tests.builders import DRIVERS, PAPER, TYPICAL_NOISE, multitone, recording
