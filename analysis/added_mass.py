@@ -36,7 +36,7 @@ import numpy as np
 import uncertainties
 from scipy.optimize import minimize_scalar
 
-from analysis.curve_fit import (CurveFitError, FitRange, covariance_with_bounds, curve_validity, fit_curves,
+from analysis.curves.fitting import (CurveFitError, FitRange, covariance_with_bounds, curve_validity, fit_curves,
                                 relative_residual)
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects

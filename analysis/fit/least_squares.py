@@ -153,7 +153,7 @@ class FitResult:
 
 
 # Curves without a noise estimate (imported ones get one from their local
-# scatter, analysis.curve_noise; the added-mass fits do without) are weighted
+# scatter, analysis.curves.noise; the added-mass fits do without) are weighted
 # relatively: every line as if it carried this relative uncertainty. Their
 # parameter uncertainties are then scaled by the scatter of the residual.
 ASSUMED_RELATIVE_STD = 0.01

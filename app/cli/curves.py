@@ -45,7 +45,7 @@ def wants_curves(args: argparse.Namespace) -> bool:
 
 
 def fit_range(args, hx_f_max=None):
-    from analysis.curve_fit import LINES_PER_DECADE, FitRange
+    from analysis.curves.fitting import LINES_PER_DECADE, FitRange
     return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
 
 
@@ -79,7 +79,7 @@ def load_curves(args: argparse.Namespace):
 
 
 def analyze_curves(args: argparse.Namespace) -> int:
-    from analysis.curve_fit import curve_json, fit_curves
+    from analysis.curves.fitting import curve_json, fit_curves
     z, hx, notes = load_curves(args)
     result = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes)
     if args.json:

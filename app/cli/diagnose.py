@@ -34,7 +34,7 @@ def _data(args: argparse.Namespace) -> tuple[FitData, float | None, str | None]:
     from analysis.pipeline import judged_fit_data, resolve_sd
     from analysis.recording.format import read_recording
     if curves.wants_curves(args):
-        from analysis.curve_fit import curve_data
+        from analysis.curves.fitting import curve_data
         z, hx, notes = curves.load_curves(args)
         data, _ = curve_data(z, hx, curves.fit_range(args, args.hx_fmax), notes)
         return data, args.sd, None

@@ -4,7 +4,7 @@ import pytest
 
 from analysis.added_mass import (AddedMassResult, MassCurve, compare_with_laser, joint_added_mass,
                                  model_free_dual_mass, single_added_mass)
-from analysis.curve_fit import CurveFitError
+from analysis.curves.fitting import CurveFitError
 from analysis.derived import ParameterValue
 from analysis.effects import parse_effects
 from analysis.effects.base import Site

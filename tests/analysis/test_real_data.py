@@ -11,7 +11,7 @@ import pytest
 
 from analysis.added_mass import (MassCurve, compare_with_laser, joint_added_mass, model_free_dual_mass,
                                  single_added_mass)
-from analysis.curve_fit import FitRange, fit_curves
+from analysis.curves.fitting import FitRange, fit_curves
 from analysis.importers import read_curve, read_uiv
 from tests.builders import REAL_DATA
 

@@ -17,7 +17,7 @@ chi-square (Wilson-Hilferty), then scaled back by |H|^2.
 
 What it cannot know: a tool that smoothed its export (1/24 octave, say)
 leaves less scatter than its noise, and neighbouring lines whose errors are
-correlated. tests/analysis/test_curve_noise.py checks the estimate on
+correlated. tests/analysis/curves/test_noise.py checks the estimate on
 simulated curves with known noise (unbiased to within 20 %).
 """
 from __future__ import annotations

@@ -14,7 +14,7 @@ frequency range (FitRange):
   below fs.
 
 Imported curves carry no per-line noise estimate of their own: each line's
-noise is estimated from the curve's local scatter (analysis.curve_noise, on
+noise is estimated from the curve's local scatter (analysis.curves.noise, on
 every line of the file, before the lines are thinned), so that chi^2 is in
 units of that noise as for a recording, and the reduced chi^2, BIC, the
 diagnosis's verdict and its sites mean the same. The parameter
@@ -30,7 +30,7 @@ from typing import Callable, Mapping, Sequence
 
 import numpy as np
 
-from analysis.curve_noise import describe_noise, with_estimated_noise
+from analysis.curves.noise import describe_noise, with_estimated_noise
 from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec

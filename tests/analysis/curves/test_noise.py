@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from analysis.curve_fit import curve_data
-from analysis.curve_noise import estimated_std, with_estimated_noise
+from analysis.curves.fitting import curve_data
+from analysis.curves.noise import estimated_std, with_estimated_noise
 from analysis.effects import parse_effects
 from analysis.model.composed import Model
 from analysis.spectra import TransferFunction

@@ -4,7 +4,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from analysis.curve_fit import (FitRange, CurveFitError, covariance_with_bounds, curve_data, curve_json,
+from analysis.curves.fitting import (FitRange, CurveFitError, covariance_with_bounds, curve_data, curve_json,
                                 fit_curves, log_thinned, weighted_residual)
 from analysis.derived import parameter_table
 from analysis.effects import parse_effects
