@@ -13,12 +13,12 @@ from app.job_book import failure_text
 from app.job_controls import JobControls
 from app.large_signal_page import LargeSignalPage
 from app.menus import Menus
-from app.model_lab import ModelLab
+from app.model_lab.page import ModelLab
 from app.placeholders import PlaceholderPage
 from app.production_page import ProductionPage
 from app.qa_view import QAView
-from app.series_page import SeriesPage
 from app.results_view import ResultsView
+from app.series_page import SeriesPage
 from app.settings import Settings
 from app.staged_fanout import StagedFanOut
 from app.wizard import MeasureWizard

@@ -25,11 +25,11 @@ from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
 from app.job_controls import JobControls
 from app.lab_worker import DiagnosisOutcome, LabFit, LabWorker
-from app.model_lab_candidates import APPLY_TIP, CandidatesPanel, fit_words
-from app.model_lab_catalogue import EffectCatalogue
-from app.model_lab_plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
-from app.model_lab_sites import SitePanel
-from app.model_lab_versions import LabVersion, changed_model, move_text
+from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
+from app.model_lab.catalogue import EffectCatalogue
+from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
+from app.model_lab.sites import SitePanel
+from app.model_lab.versions import LabVersion, changed_model, move_text
 from app.parameter_table import titled_parameter_table
 from app.result_curves import result_curves
 from app.workers import AnalysisOutcome
@@ -256,7 +256,7 @@ class ModelLab(QWidget):
     @Slot()
     def on_new_effect(self) -> None:
         """The "New effect…" dialog, previewing on the current version; a saved effect joins the catalogue."""
-        from app.model_lab_new_effect import NewEffectDialog
+        from app.model_lab.new_effect import NewEffectDialog
         dialog = NewEffectDialog(self.current.fitted.fit if self.current is not None else None, parent=self)
         dialog.saved.connect(self.on_effect_saved)
         self.new_effect_dialog = dialog

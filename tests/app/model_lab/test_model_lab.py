@@ -23,12 +23,12 @@ from analysis.fit.least_squares import FitCancelled, FitError
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app import style
-from app.model_lab import ModelLab
-from app.model_lab_candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
-from app.model_lab_catalogue import EFFECT_ROLE
+from app.model_lab.candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
+from app.model_lab.catalogue import EFFECT_ROLE
+from app.model_lab.page import ModelLab
 from app.parameter_table import VALUE
 
-from .conftest import ANALYSIS_TIMEOUT_MS, PAPER, open_and_wait
+from tests.app.conftest import ANALYSIS_TIMEOUT_MS, PAPER, open_and_wait
 
 CLOSE_WAIT_MS = 10_000
 

@@ -9,13 +9,13 @@ from PySide6.QtCore import Qt
 
 from analysis.effects import registry
 from analysis.pipeline import analyze_recording
-from app.model_lab import ModelLab
-from app.model_lab_catalogue import EFFECT_ROLE
-from app.model_lab_new_effect import NewEffectDialog
+from app.model_lab.catalogue import EFFECT_ROLE
+from app.model_lab.new_effect import NewEffectDialog
+from app.model_lab.page import ModelLab
 from tests.analysis.test_user_effects import EXAMPLE
 
-from .conftest import ANALYSIS_TIMEOUT_MS
-from .test_model_lab import CLOSE_WAIT_MS, _toggle
+from tests.app.conftest import ANALYSIS_TIMEOUT_MS
+from tests.app.model_lab.test_model_lab import CLOSE_WAIT_MS, _toggle
 
 
 @pytest.fixture(scope="module")

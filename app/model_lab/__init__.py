@@ -1,0 +1,41 @@
+"""The Model lab page and its parts: the candidates' table, the effects' catalogue, a new effect's editor, the plots, the sites and the versions.
+
+ModelLab (app.model_lab.page) is importable from the package itself; it is loaded on first use.
+"""
+from __future__ import annotations
+
+import importlib
+
+# Where each public name lives; a name is imported on first use only, so that
+# importing one submodule of the package does not load the rest.
+_HOME = {
+    "APPLY_TIP": "page",
+    "CandidatesPanel": "page",
+    "ChartPoint": "page",
+    "ChiSquareChart": "page",
+    "EMPTY_TEXT": "page",
+    "EffectCatalogue": "page",
+    "LabVersion": "page",
+    "ModelLab": "page",
+    "ResidualPanel": "page",
+    "SitePanel": "page",
+    "changed_model": "page",
+    "chi2_text": "page",
+    "fit_words": "page",
+    "move_text": "page",
+}
+
+__all__ = sorted(_HOME)
+
+
+def __getattr__(name: str):
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{home}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOME))
