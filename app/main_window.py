@@ -8,7 +8,7 @@ from PySide6.QtCore import QTimer, Signal, Slot
 from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTabWidget
 
 from app import style
-from app.archive_page import ArchivePage
+from app.archive.page import ArchivePage
 from app.job_book import failure_text
 from app.job_controls import JobControls
 from app.large_signal_page import LargeSignalPage

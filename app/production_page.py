@@ -21,8 +21,8 @@ from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QFileDialog, QHBoxL
 
 from analysis.archive.backends import shown
 from app import style
-from app.archive_filter import NO_DATE, date_edit
-from app.archive_page import archive_source
+from app.archive.filter import NO_DATE, date_edit
+from app.archive.page import archive_source
 from app.job_controls import JobControls
 from app.parameter_table import display_name
 from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit

@@ -16,12 +16,12 @@ from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording, write_recording
 from analysis.report import report_for_measurement, report_for_recording, write_report
 from analysis.session import software
-from app.archive_page import ROOT_KEY
-from app.archive_table import FIRST_PARAMETER, HEADERS
+from app.archive.page import ROOT_KEY
+from app.archive.table import FIRST_PARAMETER, HEADERS
 from tests.builders import DRIVERS, TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
-from .conftest import ANALYSIS_TIMEOUT_MS
-from .test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
+from tests.app.conftest import ANALYSIS_TIMEOUT_MS
+from tests.app.test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
 
 # key: (builders driver, driver name, serial, operator, measured_at)
 STORED = {

@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter
                                QVBoxLayout, QWidget)
 
 from analysis.report.numbers import format_number, format_std, pretty_unit
-from app.archive_table import date_text
+from app.archive.table import date_text
 from app.plots import LogFrequencyAxis, style_plot
 
 # Eight colours told apart on white paper (Tableau 10 without its grey and olive).
@@ -186,7 +186,7 @@ class CompareView(QWidget):
         self.heading.setText(EMPTY_TEXT)
 
     def set_data(self, data) -> None:
-        """An app.archive_worker.ComparisonData."""
+        """An app.archive.worker.ComparisonData."""
         self.data = data
         c = data.comparison
         labels = [f"{i + 1}. {label}" for i, label in enumerate(c.labels)]

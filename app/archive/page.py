@@ -5,7 +5,7 @@ names one (it then wins over the folder chosen here, as on the command line).
 A folder's list is read on the GUI thread: the index answers 1000 entries in ~0.1 s
 (a stale index on a read-only archive is rebuilt in memory from the folders
 each time, 0.4 s for 1000: rare, and then the page is slow to filter); a
-server's is read in app.archive_worker, since the network may be slow or
+server's is read in app.archive.worker, since the network may be slow or
 gone. Storing, comparing (it reads every results file) and rebuilding the
 index (for a server: sending the station's queue) run there too. Open hands the stored recording to the main window,
 which analyses it again like any opened file: the Results page, the Model lab
@@ -25,10 +25,10 @@ from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QS
 from analysis.archive import MAX_COMPARED, ArchiveError, archive_spec, is_url, open_archive
 from analysis.archive.backends import URL_ENV, shown
 from app import style
-from app.archive_filter import FilterBar
-from app.archive_overlay import CompareView
-from app.archive_table import ArchiveTable
-from app.archive_worker import ArchiveWorker
+from app.archive.filter import FilterBar
+from app.archive.overlay import CompareView
+from app.archive.table import ArchiveTable
+from app.archive.worker import ArchiveWorker
 from app.job_book import failure_text
 from app.job_controls import JobControls
 
@@ -55,7 +55,7 @@ class ArchivePage(QWidget):
     listed = Signal(int)                    # the number of measurements the table now shows
     stored = Signal(str, str)               # the id of a measurement stored, the recording it was stored from
     store_failed = Signal(str, str)         # why a measurement was not stored (one line), its recording
-    comparison_shown = Signal(object)       # app.archive_worker.ComparisonData
+    comparison_shown = Signal(object)       # app.archive.worker.ComparisonData
     rebuilt = Signal(str)                   # the rebuild's report
 
     def __init__(self, settings, parent=None):
