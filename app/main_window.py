@@ -15,7 +15,7 @@ from app.large_signal_page import LargeSignalPage
 from app.menus import Menus
 from app.model_lab.page import ModelLab
 from app.placeholders import PlaceholderPage
-from app.production_page import ProductionPage
+from app.production.page import ProductionPage
 from app.qa_view import QAView
 from app.results_view import ResultsView
 from app.series_page import SeriesPage
@@ -80,7 +80,7 @@ class MainWindow(QMainWindow):
         self.archive.stored.connect(self.on_archived)
         self.archive.store_failed.connect(self.on_archive_failed)
         self._titles: dict[Path, str] = {}      # recording path -> what the title bar calls it (archived ones)
-        # Statistics over the archive's units: the line's drift, Cpk, the stations (app/production_page.py).
+        # Statistics over the archive's units: the line's drift, Cpk, the stations (app/production/page.py).
         self.production = ProductionPage(self.settings)
         built = {"Measure": self.wizard, "Results": self.results, "Model lab": self.model_lab,
                  "Series": self.series, "Large signal": self.large_signal, "QA": self.qa,

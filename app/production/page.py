@@ -6,7 +6,7 @@ parameter chosen in the table, the individuals/moving-range chart with the
 Western Electric alarms in red, and the histogram with the limits. The alarms
 tab names each alarm's rule and its measurements; the stations tab says which
 station reads high. The numbers are analysis.production's; they are computed
-in app.production_worker (a server may be slow), and exported from here to
+in app.production.worker (a server may be slow), and exported from here to
 CSV, JSON or Q-DAS AQDEF.
 """
 from __future__ import annotations
@@ -25,8 +25,8 @@ from app.archive.filter import NO_DATE, date_edit
 from app.archive.page import archive_source
 from app.job_controls import JobControls
 from app.parameter_table import display_name
-from app.production_charts import ALARM, ControlChartView, HistogramView, display_unit
-from app.production_worker import ProductionRequest, ProductionWorker
+from app.production.charts import ALARM, ControlChartView, HistogramView, display_unit
+from app.production.worker import ProductionRequest, ProductionWorker
 
 FILTER_DELAY_MS = 300
 STATS_COLUMNS = ("Parameter", "n", "Mean", "σ", "Limit", "Cp", "Cpk", "Pp", "Ppk", "Yield", "Alarms")
@@ -64,7 +64,7 @@ def _table(columns) -> QTableWidget:
 
 
 class ProductionPage(QWidget):
-    computed = Signal(object)           # app.production_worker.ProductionData, once shown
+    computed = Signal(object)           # app.production.worker.ProductionData, once shown
     failed = Signal(str)
 
     def __init__(self, settings, parent=None):
