@@ -11,7 +11,7 @@ from app import style
 from app.archive.page import ArchivePage
 from app.job_book import failure_text
 from app.job_controls import JobControls
-from app.large_signal_page import LargeSignalPage
+from app.large_signal.page import LargeSignalPage
 from app.menus import Menus
 from app.model_lab.page import ModelLab
 from app.placeholders import PlaceholderPage

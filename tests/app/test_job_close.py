@@ -11,7 +11,7 @@ import threading
 
 from PySide6.QtCore import QCoreApplication, QEvent
 
-import app.large_signal_page
+import app.large_signal.page
 import app.main_window
 import app.series_page
 
@@ -28,7 +28,7 @@ def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, 
             return result(*args, **kwargs)
         return work
     monkeypatch.setattr(app.series_page, "analyze_path", held(real_analyze_path))
-    monkeypatch.setattr(app.large_signal_page, "large_signal", held(lambda paths: object()))
+    monkeypatch.setattr(app.large_signal.page, "large_signal", held(lambda paths: object()))
     raised = []
     monkeypatch.setattr(sys, "excepthook", lambda kind, exc, tb: raised.append(exc))
     monkeypatch.setattr(threading, "excepthook", lambda args: raised.append(args.exc_value))
@@ -59,8 +59,8 @@ def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(
     def slow(stems):
         release.wait(10)
         return late
-    monkeypatch.setattr(app.large_signal_page, "large_signal", slow)
-    page = app.large_signal_page.LargeSignalPage()
+    monkeypatch.setattr(app.large_signal.page, "large_signal", slow)
+    page = app.large_signal.page.LargeSignalPage()
     qtbot.addWidget(page)
     finished = []
     monkeypatch.setattr(page, "on_finished", finished.append)

@@ -19,9 +19,9 @@ from PySide6.QtWidgets import (QComboBox, QFileDialog, QGridLayout, QHBoxLayout,
                                QVBoxLayout, QWidget)
 
 from analysis.large_signal import LargeSignalResult, large_signal
-from app.large_signal_plots import CurvePlot, DistortionPlot
 from app.job_book import JobRunner, failure_text
 from app.job_controls import JobControls
+from app.large_signal.plots import CurvePlot, DistortionPlot
 from app.style import VALIDITY_COLOURS
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"

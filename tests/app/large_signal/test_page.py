@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from analysis.large_signal import large_signal
-from app.large_signal_page import LargeSignalPage, summary_html
+from app.large_signal.page import LargeSignalPage, summary_html
 from tests.large_signal_truth import write_steps
 
 

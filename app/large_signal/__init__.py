@@ -1,0 +1,2 @@
+"""The Large-signal page and its plots.
+"""
