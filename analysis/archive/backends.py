@@ -11,7 +11,7 @@ wins over the environment; $LINPAR_ARCHIVE_URL wins over $LINPAR_ARCHIVE, so
 that a station configured for the line's server never stores into its local
 folder by mistake.
 
-Every back end offers `ArchiveBackend`; tests/analysis/test_archive_backends.py
+Every back end offers `ArchiveBackend`; tests/analysis/archive/test_archive_backends.py
 runs one suite against each.
 """
 from __future__ import annotations

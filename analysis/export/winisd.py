@@ -96,7 +96,7 @@ numbers written with 17 digits (its own writer uses 15); how WinISD treats a
 file without Vas (no laser), which cannot be simulated, while OpenISD reports
 WinISD crashing on some sparse drivers. Nobody has opened this exporter's
 files in WinISD for this project. The test
-(tests/analysis/test_export_driver.py) checks every field against the real
+(tests/analysis/export/test_export_driver.py) checks every field against the real
 files' key list and units.
 """
 from __future__ import annotations

@@ -15,7 +15,7 @@ written as a difference: lgamma(a) alone is ~a ln a and its rounding would
 cost ~1e-9 of p at df = 1e7.
 
 Accuracy, against scipy.special.stdtr over t in [0, 1e5] and df in [0.5, 1e9]
-(tests/analysis/test_student_t.py): relative 1e-13 up to df ~1e3; beyond, the
+(tests/analysis/production/test_student_t.py): relative 1e-13 up to df ~1e3; beyond, the
 continued fraction loses about df/2 ulps near t ~ 2 (5e-12 at df 1e5, 6e-11
 at 1e6): a p value's tenth significant digit at most, where a Welch test's
 own assumptions matter far more.

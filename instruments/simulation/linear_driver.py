@@ -11,7 +11,7 @@ whose period divides ``fir_length`` (every multitone of 2**k samples up to
 is then exact to rounding, whatever the length of the true impulse response
 (its tail folds back onto the same bins). A window would trade that exactness
 for smaller errors between the bins, which only a non-dividing period sees;
-tests/instruments/test_linear_driver.py measures both cases.
+tests/instruments/simulation/test_linear_driver.py measures both cases.
 
 DC: the creep laws diverge at w = 0 (log10(w) -> -inf), so bin 0 takes the
 real part of bin 1 (at 48 kHz and 65,536 taps, 0.73 Hz). Nyquist: the real

@@ -9,7 +9,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt
 
 from .conftest import ANALYSIS_TIMEOUT_MS
-from .test_wizard_helpers import JOB_TIMEOUT_MS, choose_simulator, skip_to_measure, to_hardware
+from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, choose_simulator, skip_to_measure, to_hardware
 
 
 def _shows_work(progress, cancel, text: str) -> None:

@@ -9,7 +9,7 @@ from analysis.live import LiveAccumulator
 from app.live_panels import MIN_REPAINT_GAP_S, LivePanels, LogBuckets
 from instruments.simulation import faults
 
-from .test_wizard_helpers import plain
+from tests.app.wizard.test_wizard_helpers import plain
 
 
 def frames_of(recording, n: int | None = None):

@@ -14,7 +14,7 @@ from instruments.simulation import faults
 from tests.builders import needs_pdftotext, pdf_text
 
 from .conftest import open_and_wait
-from .test_wizard_helpers import plain
+from tests.app.wizard.test_wizard_helpers import plain
 
 LIMITS = {"format": "linpar-limits/1", "name": "paper QA", "parameters": {
     "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},

@@ -1,6 +1,6 @@
 """The laser's byte stream as hostile input: any bytes, split anywhere, never a crash, a hang or a lost byte.
 
-tests/instruments/test_laser_frames.py splits one clean reference stream
+tests/instruments/laser/test_laser_frames.py splits one clean reference stream
 anywhere. Here the bytes themselves are random or a real stream damaged
 (garbage, cut frames, error-code floods, text where none is awaited), and
 what is checked are the parser's promises for ANY input: every byte is
@@ -21,8 +21,8 @@ from hypothesis import strategies as st
 
 from instruments.laser.ild1420.commands import parse_info, parse_output_info
 from instruments.laser.ild1420.frames import FrameParser, RawMeasurements, Reply, encode_measurements, value_slots
-from instruments.laser.sensor import LaserError
 from instruments.laser.ild1420.values import COUNTER_MODULUS, CounterUnwrapper, LaserErrorCode, block_from_raw
+from instruments.laser.sensor import LaserError
 from tests.pace import paced
 from tests.reliability.fuzzing import FUZZ, FUZZ_MANY
 

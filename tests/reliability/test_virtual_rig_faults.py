@@ -1,6 +1,6 @@
 """Faults on the virtual rig (JACK, the laser emulator on the rig's pty): the workstation stays usable.
 
-tests/instruments/test_measure_rig.py shows that an xrun, a closed laser pty
+tests/instruments/measurement/test_measure_rig.py shows that an xrun, a closed laser pty
 and a killed JACK client each end a measurement within 2 s keeping its
 periods. Here: after an xrun and after a closed pty, the next measurement in
 the same process completes; and with the JACK server killed under `linpar

@@ -21,7 +21,7 @@ from app.archive.table import FIRST_PARAMETER, HEADERS
 from tests.builders import DRIVERS, TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
 from tests.app.conftest import ANALYSIS_TIMEOUT_MS
-from tests.app.test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
+from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
 
 # key: (builders driver, driver name, serial, operator, measured_at)
 STORED = {

@@ -12,7 +12,7 @@ from analysis.pipeline import analyze_recording
 from app.model_lab.catalogue import EFFECT_ROLE
 from app.model_lab.new_effect import NewEffectDialog
 from app.model_lab.page import ModelLab
-from tests.analysis.test_user_effects import EXAMPLE
+from tests.analysis.effects.test_user_effects import EXAMPLE
 
 from tests.app.conftest import ANALYSIS_TIMEOUT_MS
 from tests.app.model_lab.test_model_lab import CLOSE_WAIT_MS, _toggle

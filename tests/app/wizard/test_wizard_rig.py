@@ -5,7 +5,7 @@ import pytest
 
 from app.wizard import MeasureWizard
 
-from .test_wizard_helpers import JOB_TIMEOUT_MS, fill_driver, parameter_errors, plain, run_job
+from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, fill_driver, parameter_errors, plain, run_job
 
 pytestmark = pytest.mark.rig
 

@@ -12,7 +12,7 @@ import pytest
 from app.cli import rig as cli_rig
 from app.cli import build_parser, main
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def run(capsys, *argv):

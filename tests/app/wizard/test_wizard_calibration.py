@@ -18,7 +18,7 @@ from instruments.audio.config import ChannelMap
 from instruments.audio.stream_core import InputBlock
 from instruments.rig.engine import RIG_CALIBRATION
 
-from .test_wizard_helpers import choose_simulator, plain, run_job, to_hardware
+from tests.app.wizard.test_wizard_helpers import choose_simulator, plain, run_job, to_hardware
 
 FS, PERIOD = 48000, 4096
 

@@ -15,7 +15,7 @@ from instruments.laser import (
     open_laser)
 from instruments.laser.factory import register_laser_model
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 class ToyPhysics:

@@ -5,7 +5,7 @@ import pytest
 
 from app.wizard import MeasureWizard, hardware, hardware_page
 
-from .test_wizard_helpers import plain, to_hardware
+from tests.app.wizard.test_wizard_helpers import plain, to_hardware
 
 
 @pytest.fixture
@@ -39,7 +39,7 @@ def test_off_linux_the_page_offers_the_simulator_and_not_the_rig(qtbot, settings
 
 
 def windows_cards():
-    from tests.instruments.test_host_apis import WINDOWS
+    from tests.instruments.audio.test_host_apis import WINDOWS
     return WINDOWS
 
 

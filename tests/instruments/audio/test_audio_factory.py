@@ -12,7 +12,7 @@ import pytest
 from instruments.audio import AudioError, AudioInterface, AudioSpec, ChannelMap, audio_backends, factory, open_audio
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_the_simulated_back_end_takes_the_spec_and_its_options():

@@ -10,7 +10,7 @@ from analysis.multitone import design_multitone
 from analysis.recording.format import write_recording
 from analysis.synthesis import synthesize_recording
 from app.cli import main
-from tests.analysis.test_user_effects import BAD_FILES, EXAMPLE
+from tests.analysis.effects.test_user_effects import BAD_FILES, EXAMPLE
 from tests.builders import PAPER, TYPICAL_NOISE
 
 

@@ -21,7 +21,7 @@ from instruments.rig.jackd import registered_servers
 from instruments.rig.manager import find_rig, start_rig, stop_rig
 from instruments.rig.state import pid_alive
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 pytestmark = pytest.mark.rig
 
 
@@ -54,7 +54,7 @@ def child_capture() -> None:
 
 def run_child_and(break_rig, name: str, runtime_dir: Path) -> tuple[dict, float, subprocess.Popen]:
     child = subprocess.Popen(
-        [sys.executable, "-c", "from tests.instruments.test_rig_faults import child_capture; child_capture()",
+        [sys.executable, "-c", "from tests.instruments.rig.test_rig_faults import child_capture; child_capture()",
          name, str(runtime_dir)], cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     try:
         line = child.stdout.readline()

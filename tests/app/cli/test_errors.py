@@ -17,7 +17,7 @@ import app.cli.effects
 from analysis.errors import LinparError, is_user_error, user_message
 from app.cli import main
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[3]
 
 
 def run(capsys, *argv):

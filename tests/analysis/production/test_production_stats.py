@@ -197,7 +197,7 @@ def test_qa_stats_with_stored_limits_imports_no_scipy(tmp_path):
     import sys
     from pathlib import Path
     root = tmp_path / "archive"
-    example = Path(__file__).resolve().parents[2] / "resources" / "limits" / "example.json"
+    example = Path(__file__).resolve().parents[3] / "resources" / "limits" / "example.json"
     store = subprocess.run([sys.executable, "-m", "app.cli", "qa", "limits", "--store", str(example), "--root",
                             str(root)], capture_output=True, text=True, timeout=120)
     assert store.returncode == 0, store.stderr

@@ -8,7 +8,7 @@ import pytest
 from app.wizard import MeasureWizard
 from app.wizard.calibration_page import settings_key
 
-from .test_wizard_helpers import (
+from tests.app.wizard.test_wizard_helpers import (
     JOB_TIMEOUT_MS, choose_simulator, fill_driver, parameter_errors, plain, run_job, skip_to_measure, to_hardware)
 
 

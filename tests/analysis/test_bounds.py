@@ -12,7 +12,7 @@ from analysis.bounds import (BOUNDS, SAMPLE_RATE, SD, BoundsError, GiB, MiB, mar
                              size_limit, size_limits_set)
 from tests.reliability.fuzzing import FUZZ
 
-DOC = Path(__file__).resolve().parent.parent / "docs" / "bounds.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "bounds.md"
 EXTREMES = [0, -0.0, 5e-324, -5e-324, 1e-310, 1e-300, -1e-300, 1e300, -1e300, 1.7976931348623157e308,
             math.inf, -math.inf, math.nan, 10**400, -(10**400), True, "1", None]
 

@@ -10,7 +10,7 @@ from analysis.effects.base import Site
 from analysis.errors import LinparError
 from analysis.fit.startvalues import StartContext
 from analysis.model.composed import Model, ModelError
-from tests.analysis.test_effects import BASE
+from tests.analysis.effects.test_effects import BASE
 
 REQUIRED_CATEGORIES = {"inductance", "creep", "electrical-channel", "displacement-sensor", "breakup"}
 # Categories with a single effect, and why.
