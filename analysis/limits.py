@@ -41,17 +41,12 @@ from typing import TYPE_CHECKING, Mapping
 from analysis.errors import LinparError
 from analysis.files import read_text
 from analysis.fit_error import FIT_ERROR_DEFAULTS
+from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN
 
 if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file
     from analysis.derived import ParameterValue
 
 FORMAT = "linpar-limits/1"
-# The interval a parameter is judged by: value +- INTERVAL_K x std. With a std that covers what the model misses,
-# two of them hold the truth about 95 times in 100 (a normal error); the realistic recordings' acceptance is
-# "truth within 2 reported std" (issue 29), and a PASS then says the unit is inside its limits with that
-# confidence, while a unit whose value only just clears a bound is not passed on the luck of its noise.
-INTERVAL_K = 2.0
-PASS, FAIL, UNCERTAIN = "pass", "fail", "uncertain"
 FIT_ERROR_CHANNELS = ("impedance", "displacement")
 ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
 # Spellings of units that mean the same thing.
@@ -290,14 +285,6 @@ def _fit_error_tolerance(entry, text: str, path: Path) -> dict[str, float]:
             raise LimitsError(f"{where}.{channel}: found {str(value)[:40]!r}, expected a positive number of %")
         tolerance[channel] = float(value)
     return tolerance
-
-
-def verdict_of(verdicts) -> str:
-    """FAIL when any parameter fails, else UNCERTAIN when any interval straddles a limit, else PASS."""
-    outcomes = {v.outcome for v in verdicts}
-    return FAIL if FAIL in outcomes else UNCERTAIN if UNCERTAIN in outcomes else PASS
-
-
 def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
     """The QA verdict as JSON (analysis.qa_verdict): "pass", "fail", "uncertain", "invalid" (the measurement
     itself is red) or "not judged" (the model misses a curve by more than the file's fit-error tolerance);
@@ -320,7 +307,7 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
     """A table for the terminal: each limit in its file's unit, the measured interval, pass, FAIL or uncertain."""
     from analysis.qa_verdict import judge, outcome_word
     judgement = judge(limits, parameters, validity)
-    lines = [f"QA limits: {limits.name} ({limits.path}); each parameter judged by value ± {INTERVAL_K:g} std"]
+    lines = [f"QA limits: {limits.name} ({limits.path}); each parameter judged by value ± {INTERVAL_K:g} σ"]
     for limit, v in zip(limits.limits, judgement.verdicts):
         unit = "" if _unit(limit.unit) == "1" else limit.unit
         shown = "n/a" if v.value is None else f"{v.value / limit.to_si:.5g} {unit}".rstrip()

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Mapping
 
-from analysis.limits import FAIL, INTERVAL_K, PASS, UNCERTAIN, Limits, Verdict, verdict_of
+from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN, verdict_of
 from analysis.report.numbers import pretty_unit
 from analysis.validity_fit import VERDICT_HEADLINES, qa_blocker
 
@@ -22,7 +22,7 @@ from analysis.validity_fit import VERDICT_HEADLINES, qa_blocker
 class QAJudgement:
     verdict: str                        # pass | fail | uncertain | invalid | not judged
     why: str
-    verdicts: tuple[Verdict, ...]       # one per limit, in the file's order
+    verdicts: tuple                     # analysis.limits.Verdict, one per limit, in the file's order
     judged: bool                        # False: invalid or not judged, no parameter judged against its limit
     fit_error_percent: Mapping[str, float]
 
@@ -31,12 +31,12 @@ class QAJudgement:
         return VERDICT_HEADLINES[self.verdict]
 
 
-def _unit(verdict: Verdict) -> str:
+def _unit(verdict) -> str:
     unit = verdict.limit.unit.strip()
     return "" if unit in ("", "-", "1") else pretty_unit(unit)
 
 
-def margin_text(verdict: Verdict) -> str:
+def margin_text(verdict) -> str:
     """"0.8 Hz above max", "inside by 0.3 Hz" (the value's distance to its nearest bound), or ""."""
     margin = verdict.margin()
     if margin is None:
@@ -46,22 +46,23 @@ def margin_text(verdict: Verdict) -> str:
     return f"inside by {shown}" if distance >= 0 else f"{shown} {'below min' if side == 'min' else 'above max'}"
 
 
-def outcome_word(verdict: Verdict, judged: bool = True) -> str:
+def outcome_word(verdict, judged: bool = True) -> str:
     """What a table's result column reads for one parameter."""
     if not judged:
         return "not judged"
     return {PASS: "pass", FAIL: "FAIL", UNCERTAIN: "uncertain"}.get(verdict.outcome, verdict.outcome)
 
 
-def _straddle_text(verdict: Verdict) -> str:
+def _straddle_text(verdict) -> str:
     lo, hi = verdict.interval
     scale, unit = verdict.limit.to_si, _unit(verdict)
     return f"{verdict.limit.name} {lo / scale:.4g} .. {hi / scale:.4g} {unit}".rstrip() + f" across {verdict.limit.text}"
 
 
-def judge(limits: Limits, parameters: Mapping, validity: Mapping | str) -> QAJudgement:
+def judge(limits, parameters: Mapping, validity: Mapping | str) -> QAJudgement:
     """The verdict of `parameters` (name -> analysis.derived.ParameterValue) with their `validity` (as JSON, or
-    the overall light alone) against `limits`."""
+    the overall light alone) against `limits` (analysis.limits.Limits, which imports this module: not imported
+    here)."""
     validity = {"overall": validity} if isinstance(validity, str) else validity
     verdicts = limits.judge(parameters)
     errors = dict(validity.get("fit_error_percent") or {})
@@ -76,10 +77,10 @@ def judge(limits: Limits, parameters: Mapping, validity: Mapping | str) -> QAJud
             for v in failed)
     elif verdict == UNCERTAIN:
         straddling = [v for v in verdicts if v.outcome == UNCERTAIN]
-        why = (f"{', '.join(_straddle_text(v) for v in straddling)}: the interval (value ± {INTERVAL_K:g} std) "
+        why = (f"{', '.join(_straddle_text(v) for v in straddling)}: the interval (value ± {INTERVAL_K:g} σ) "
                "straddles the limit; measure again (more periods narrow it)")
     else:
-        why = f"all {len(verdicts)} parameters within their limits (value ± {INTERVAL_K:g} std)"
+        why = f"all {len(verdicts)} parameters within their limits (value ± {INTERVAL_K:g} σ)"
         if validity.get("overall") == "yellow":
             why += "; the measurement is doubtful: read the yellow findings"
     return QAJudgement(verdict, why, verdicts, True, errors)

@@ -291,10 +291,19 @@ class QAView(QWidget):
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "
                                          f"border: 1px solid {text}; border-radius: 4px; }}")
         self.verdict_label.setText(f"<span style='font-size:20pt'><b>{html.escape(title)}</b></span><br>"
-                                   f"{html.escape(why)}")
+                                   f"{html.escape(why)}{self._fit_error_line()}")
         if verdict != self.verdict:
             self.verdict = verdict
             self.verdict_changed.emit(verdict)
+
+    def _fit_error_line(self) -> str:
+        """Each curve's fit error against the limits' tolerance: what decided that the unit could be judged."""
+        if self.judgement is None or not self.judgement.fit_error_percent or self.judgement.verdict == "invalid":
+            return ""
+        tolerance = self.limits.fit_error_percent
+        said = ", ".join(f"{name} {err:.2g} % (tolerance {tolerance.get(name, float('nan')):g} %)"
+                         for name, err in self.judgement.fit_error_percent.items())
+        return f"<br><small>Fit error (rms misfit of each curve): {html.escape(said)}</small>"
 
     # -- export ------------------------------------------------------------------
     def _update_export(self) -> None:

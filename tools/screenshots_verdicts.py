@@ -70,6 +70,7 @@ def verdict_screenshots(app: QApplication, window, folder: Path, out: Path) -> l
                              ("qa-fail", {**around_truth(15), "Bl": {"min": 5.5, "unit": "T*m"}})):
         window.qa.load_limits(limits_file(folder, f"W18 QA {stem.removeprefix('qa-')}", parameters))
         written += grab_small_and_large(app, window, out, stem)
+    window.qa.load_limits(limits_file(folder, "W18 QA pass", around_truth(15)))
     window.open_path(real_unit(folder, broken_current=True))
     if wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
         window.pages.setCurrentWidget(window.qa)

@@ -34,6 +34,7 @@ from typing import Mapping
 
 from analysis.fit import FitResult
 from analysis.fit_error import FIT_ERROR_DEFAULTS, fit_error_percent
+from analysis.qa_interval import FAIL, PASS, UNCERTAIN
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import ABSENT, Validity
 from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
@@ -46,7 +47,7 @@ FIT_SIGNAL = {"impedance": "current", "displacement": "displacement"}
 # its own word (never a FAIL: the unit was not judged, and an operator reads the big word); UNCERTAIN: a
 # parameter's interval straddles a limit. The archive stores each under analysis.archive.record.QA_VERDICTS
 # (STORED_VERDICT): production statistics leave out all but pass and fail.
-PASS, FAIL, UNCERTAIN, INVALID, NOT_JUDGED = "pass", "fail", "uncertain", "invalid", "not judged"
+INVALID, NOT_JUDGED = "invalid", "not judged"
 VERDICT_HEADLINES = {PASS: "PASS", FAIL: "FAIL", UNCERTAIN: "UNCERTAIN: measure again",
                      INVALID: "INVALID: measure again", NOT_JUDGED: "NOT JUDGED"}
 # The archive's CHECK constraint knows pass, fail, invalid and not judged: an uncertain unit is stored as not

@@ -113,6 +113,7 @@ def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limi
     verdict = plain(qa.verdict_label)
     assert verdict.startswith("FAIL") and "Bl 0.27 T·m below min" in verdict, verdict
     assert "value ± 2 σ" in qa.table.item(0, 3).toolTip()
+    assert "Fit error (rms misfit of each curve): impedance" in verdict and "(tolerance 5 %)" in verdict
     assert window.settings.qsettings.value("qa/limits_file") == str(limits_file)
     looser = copy.deepcopy(LIMITS)          # the module's LIMITS stay as other tests expect them
     looser["parameters"]["Bl"] = {"min": 5.0, "unit": "T*m"}

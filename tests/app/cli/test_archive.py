@@ -116,7 +116,7 @@ def test_analyze_limits_exit_codes(capsys, rec_path, red_path, tmp_path):
                       Mms={"min": 11, "max": 13, "unit": "g"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", ok)
     assert code == 0 and "QA: PASS" in out
-    assert "fit error: impedance" in out and "judged by value ± 2 std" in out
+    assert "fit error: impedance" in out and "judged by value ± 2 σ" in out
     bad = write_limits(tmp_path, fs={"nominal": 50, "tolerance": "2%", "unit": "Hz"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", bad, "--json")
     doc = json.loads(out)
