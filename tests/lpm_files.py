@@ -41,8 +41,8 @@ def lpm_text(kind: str, measured: np.ndarray | None, fitted: np.ndarray | None =
     curves = [(g, c) for g, c in (("Measured", measured), ("Fitted", fitted)) if c is not None]
     lines = [f'"{TITLES[kind]}"', "\t\t".join(f'"{g}"' for g, _ in curves) + "\t",
              "\t".join(f'"Frequency [Hz]"\t"[{unit}]"' for _ in curves) + "\t"]
-    for i, f in enumerate(freqs):
-        lines.append("\t".join(f"{f:.6f}\t{c[i] * scale:.6g}" for _, c in curves) + "\t")
+    for i, f in enumerate(freqs):      # a shorter curve leaves its pair of fields empty
+        lines.append("\t".join(f"{f:.6f}\t{c[i] * scale:.6g}" if i < len(c) else "\t" for _, c in curves) + "\t")
     return "\r\n".join(lines) + "\r\n"
 
 

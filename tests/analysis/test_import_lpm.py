@@ -44,6 +44,12 @@ def test_the_measured_columns_give_the_driver_back_not_the_fitted_ones(exports):
     assert 0.1 < result.validity["fit_error_percent"]["impedance"] < 1.0       # the 0.3 % noise, not the model
 
 
+def test_a_shorter_fitted_curve_leaves_its_fields_empty_and_is_read(tmp_path):
+    path = write_lpm(tmp_path / "Z.txt", "impedance", Z[:40], Z[:25], FREQS[:40])
+    curve_read = read_curve(path, "impedance")
+    assert len(curve_read.transfer.freqs) == 40 and len(curve_read.reference.freqs) == 25
+
+
 def test_an_hx_export_given_as_impedance_says_which_option(exports):
     with pytest.raises(ImportFormatError, match=r"HX.txt: a Klippel export of Hx .* give it as --hx"):
         read_curve(exports[1], "impedance")
@@ -88,3 +94,32 @@ def test_bad_exports_give_one_line_naming_the_file_and_the_line(tmp_path, what, 
 def test_the_tools_own_fit_error_is_said(tmp_path):
     path = write_lpm(tmp_path / "Z.txt", "impedance", Z, Z * 1.02)
     assert "misses the measured curve by 2 % rms (its fit error)" in read_curve(path, "impedance").describe()
+
+
+def test_a_mangled_export_is_read_or_refused_in_one_line_never_crashes(tmp_path):
+    """300 exports with lines dropped, fields cut, characters replaced: each is read whole or gives one line."""
+    rng = np.random.default_rng(7)
+    base = lpm_text("impedance", Z[:40], Z[:30], FREQS[:40]).split("\r\n")
+    path = tmp_path / "Z.txt"
+    refused = 0
+    for _ in range(300):
+        lines = list(base)
+        for _ in range(int(rng.integers(1, 4))):
+            i = int(rng.integers(0, len(lines)))
+            kind = rng.integers(0, 4)
+            if kind == 0:
+                del lines[i]
+            elif kind == 1 and lines[i]:
+                lines[i] = lines[i][: int(rng.integers(0, len(lines[i])))]
+            elif kind == 2 and lines[i]:
+                j = int(rng.integers(0, len(lines[i])))
+                lines[i] = lines[i][:j] + str(rng.choice(list('\t"x-.e[]0;, '))) + lines[i][j + 1:]
+            else:
+                lines.insert(i, lines[int(rng.integers(0, len(lines)))])
+        path.write_text("\r\n".join(lines), encoding="latin-1")
+        try:
+            read_curve(path, "impedance")
+        except ImportFormatError as exc:
+            refused += 1
+            assert "\n" not in str(exc) and str(exc).startswith(str(path))
+    assert 30 < refused < 300
