@@ -24,7 +24,7 @@ inside the limits, FAIL when it lies wholly outside, "uncertain" when it
 straddles a limit (measure again). An optional top-level
 `"fit_error_percent": {"impedance": 3, "displacement": 10}` sets how far (rms
 misfit in %) the model may miss each curve before the unit is not judged
-(defaults: analysis.fit_error.FIT_ERROR_DEFAULTS).
+(defaults: analysis.fit.error.FIT_ERROR_DEFAULTS).
 
 A limits file that breaks these rules raises LimitsError, whose one-line
 message names the file, the line and key, and what was expected.
@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Mapping
 
 from analysis.errors import LinparError
 from analysis.files import read_text
-from analysis.fit_error import FIT_ERROR_DEFAULTS
+from analysis.fit.error import FIT_ERROR_DEFAULTS
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN
 
 if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file

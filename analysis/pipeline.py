@@ -23,8 +23,9 @@ import numpy as np
 from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
-from analysis.fit import FitCancelled, FitData, FitError, FitResult, fit_model
-from analysis.fit_error import fit_error_percent
+from analysis.fit.error import fit_error_percent
+from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.model.composed import Model, ModelError
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths

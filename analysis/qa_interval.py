@@ -2,7 +2,7 @@
 
 A module of its own, with no imports, so that reading a limits file
 (analysis.limits), the verdict every output shows (analysis.qa_verdict)
-and the validity's QA codes (analysis.validity_fit) share these words
+and the validity's QA codes (analysis.validity.fit) share these words
 without importing one another.
 """
 from __future__ import annotations

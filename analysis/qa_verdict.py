@@ -1,6 +1,6 @@
 """One QA verdict for a result against limits, as every output shows it (the QA page, reports, the CLI, the archive).
 
-The measurement first (analysis.validity_fit.qa_blocker): a red one is
+The measurement first (analysis.validity.fit.qa_blocker): a red one is
 INVALID (measure again), one whose model misses a curve by more than the
 limits file's fit-error tolerance is NOT JUDGED. Then the parameters, each by
 its interval (analysis.limits.Limit.judge): FAIL when any lies wholly outside
@@ -15,7 +15,7 @@ from typing import Mapping
 
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN, verdict_of
 from analysis.report.numbers import pretty_unit
-from analysis.validity_fit import VERDICT_HEADLINES, qa_blocker
+from analysis.validity.fit import VERDICT_HEADLINES, qa_blocker
 
 
 @dataclass(frozen=True)

@@ -58,8 +58,8 @@ def display(value: float | None, parameter) -> str:
 
 
 def qa_verdict(validity: Mapping | str) -> tuple[str, str]:
-    """(verdict, why) without limits loaded: the measurement's validity alone (analysis.validity_fit.qa_blocker)."""
-    from analysis.validity_fit import qa_blocker
+    """(verdict, why) without limits loaded: the measurement's validity alone (analysis.validity.fit.qa_blocker)."""
+    from analysis.validity.fit import qa_blocker
     validity = {"overall": validity} if isinstance(validity, str) else validity
     blocker = qa_blocker(validity)
     if blocker is not None:

@@ -35,9 +35,10 @@ from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
-from analysis.fit import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
-from analysis.fit_error import fit_error_percent, rms_relative_residual
-from analysis.model import Model
+from analysis.fit.error import fit_error_percent, rms_relative_residual
+from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
+from analysis.fit.startvalues import start_context
+from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
 

@@ -74,7 +74,7 @@ def _excluded_reason(validity: str, verdict: str | None) -> str | None:
     if validity == "red":
         return "validity red (the measurement is invalid)"
     if verdict in NOT_JUDGEABLE:
-        # "not judged" also holds the uncertain units (analysis.validity_fit.STORED_VERDICT): measured again.
+        # "not judged" also holds the uncertain units (analysis.validity.fit.STORED_VERDICT): measured again.
         why = ("the measurement is invalid" if verdict == "invalid" else
                "the model does not describe the measurement, or a parameter's interval straddles a limit")
         return f"not judgeable ({verdict}: {why})"

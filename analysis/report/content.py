@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
-from analysis.fit_report import fit_report_rows
+from analysis.fit.report import fit_report_rows
 from analysis.report.numbers import format_number, format_std, parameter_cells, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 

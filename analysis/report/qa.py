@@ -15,7 +15,7 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue
 from analysis.report.numbers import format_number, pretty_unit
-from analysis.validity_fit import FAIL, INVALID, NOT_JUDGED, PASS, UNCERTAIN, VERDICT_HEADLINES
+from analysis.validity.fit import FAIL, INVALID, NOT_JUDGED, PASS, UNCERTAIN, VERDICT_HEADLINES
 
 # (background, text) of the verdict banner, also the QA page's. INVALID has its own colour (violet), not FAIL's
 # red: a broken measurement says nothing of the unit, and an operator reads the colour first.

@@ -18,7 +18,7 @@ the measurement's analysis step, the GUI), in three steps:
 3. `qa_blocker(validity, tolerance)`: a red measurement is INVALID: not a
    PASS, not a FAIL (the unit was not judged; production yield leaves it
    out), with the honest reason and what to do: measure again. One whose
-   fit error (analysis.fit_error, the rms misfit in % of a curve) exceeds
+   fit error (analysis.fit.error, the rms misfit in % of a curve) exceeds
    the limits file's tolerance is NOT JUDGED, with that reason. A model-misfit
    finding (reduced chi^2 far above 1) alone does not block QA: a real driver
    measured with little noise always has one, at a fit error of a few %.
@@ -32,8 +32,8 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from analysis.fit import FitResult
-from analysis.fit_error import FIT_ERROR_DEFAULTS, fit_error_percent
+from analysis.fit.error import FIT_ERROR_DEFAULTS, fit_error_percent
+from analysis.fit.least_squares import FitResult
 from analysis.qa_interval import FAIL, PASS, UNCERTAIN
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import ABSENT, Validity
@@ -133,7 +133,7 @@ def qa_blocker(validity: Mapping, tolerance: Mapping[str, float] | None = None) 
     """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None.
 
     tolerance: channel -> the largest fit error in % at which the model is taken to describe the measurement
-    (analysis.fit_error.FIT_ERROR_DEFAULTS when None). A result stored before the fit error was computed (no
+    (analysis.fit.error.FIT_ERROR_DEFAULTS when None). A result stored before the fit error was computed (no
     "fit_error_percent") is judged by its model-misfit finding, as it was then."""
     if validity.get("overall") == "red":
         return INVALID, (f"measurement invalid: {red_findings_text(validity)}, and measure again; the unit "

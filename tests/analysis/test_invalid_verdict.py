@@ -17,7 +17,7 @@ from analysis.recording import make_recording
 from analysis.report import build_report
 from analysis.report.html import render_html
 from analysis.report.qa import VERDICT_COLOURS
-from analysis.validity_fit import FAIL, INVALID, VERDICT_HEADLINES
+from analysis.validity.fit import FAIL, INVALID, VERDICT_HEADLINES
 from tests.builders import TYPICAL_NOISE, recording
 
 LIMITS_DOC = {"format": "linpar-limits/1", "name": "woofer QA", "parameters": {

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from analysis.curve_fit import FitRange, fit_curves
+from analysis.curves.fitting import FitRange, fit_curves
 from analysis.importers import ImportFormatError, read_curve
 from tests.builders import PAPER
 from tests.lpm_files import FREQS, curve, lpm_text, write_lpm
