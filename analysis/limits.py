@@ -18,6 +18,14 @@ parameter's SI unit or its customary one (mH or H, g or kg, l or m^3, ...),
 so that a limit can never be read in the wrong unit. A parameter that the
 measurement could not give (Bl without the laser) fails, with the reason.
 
+A parameter is judged by its interval, value +- INTERVAL_K x std (its total
+standard uncertainty, noise and model parts): pass when the interval lies
+inside the limits, FAIL when it lies wholly outside, "uncertain" when it
+straddles a limit (measure again). An optional top-level
+`"fit_error_percent": {"impedance": 3, "displacement": 10}` sets how far (rms
+misfit in %) the model may miss each curve before the unit is not judged
+(defaults: analysis.fit.error.FIT_ERROR_DEFAULTS).
+
 A limits file that breaks these rules raises LimitsError, whose one-line
 message names the file, the line and key, and what was expected.
 """
@@ -26,17 +34,20 @@ from __future__ import annotations
 import json
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Mapping
 
 from analysis.errors import LinparError
 from analysis.files import read_text
+from analysis.fit.error import FIT_ERROR_DEFAULTS
+from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN
 
 if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file
     from analysis.derived import ParameterValue
 
 FORMAT = "linpar-limits/1"
+FIT_ERROR_CHANNELS = ("impedance", "displacement")
 ENTRY_KEYS = {"nominal", "tolerance", "min", "max", "unit", "note"}
 # Spellings of units that mean the same thing.
 _ALIASES = {"Ω": "ohm", "ohms": "ohm", "µF": "uF", "μF": "uF", "L": "l", "m3": "m^3", "": "1", "-": "1",
@@ -80,9 +91,15 @@ class Limit:
     def judge(self, p: ParameterValue | None) -> "Verdict":
         if p is None or p.value is None:
             why = p.reason if p is not None else "not in this measurement's results"
-            return Verdict(self, None, False, f"not measured: {why}")
-        ok = (self.low is None or p.value >= self.low) and (self.high is None or p.value <= self.high)
-        return Verdict(self, p.value, ok, "")
+            return Verdict(self, None, False, f"not measured: {why}", FAIL)
+        known = p.std is not None and math.isfinite(p.std)
+        half = INTERVAL_K * abs(p.std) if known else 0.0
+        lo, hi = p.value - half, p.value + half
+        inside = (self.low is None or lo >= self.low) and (self.high is None or hi <= self.high)
+        outside = (self.low is not None and hi < self.low) or (self.high is not None and lo > self.high)
+        outcome = PASS if inside else FAIL if outside else UNCERTAIN
+        note = "" if known else "no uncertainty estimated: judged on the value alone"
+        return Verdict(self, p.value, outcome == PASS, note, outcome, (lo, hi))
 
 
 @dataclass(frozen=True)
@@ -91,6 +108,8 @@ class Verdict:
     value: float | None       # SI
     passed: bool
     note: str
+    outcome: str = ""         # PASS, FAIL or UNCERTAIN (the interval straddles a limit)
+    interval: tuple[float, float] | None = None      # value +- INTERVAL_K x std, SI
 
     def margin(self) -> tuple[float, str] | None:
         """(distance to the nearest bound in SI, "min" or "max"): positive inside, negative outside.
@@ -114,7 +133,9 @@ class Verdict:
     def as_json(self) -> dict:
         return {"parameter": self.limit.name, "value": self.value, "low": self.limit.low, "high": self.limit.high,
                 "unit": parameter_units()[self.limit.name][0], "limit": self.limit.text,
-                "pass": self.passed, **({"note": self.note} if self.note else {})}
+                "pass": self.passed, "outcome": self.outcome,
+                **({"interval": list(self.interval), "k": INTERVAL_K} if self.interval is not None else {}),
+                **({"note": self.note} if self.note else {})}
 
 
 @dataclass(frozen=True)
@@ -122,6 +143,7 @@ class Limits:
     path: Path
     name: str
     limits: tuple[Limit, ...]
+    fit_error_percent: Mapping[str, float] = field(default_factory=lambda: dict(FIT_ERROR_DEFAULTS))
 
     def judge(self, parameters: Mapping[str, ParameterValue]) -> tuple[Verdict, ...]:
         return tuple(limit.judge(parameters.get(limit.name)) for limit in self.limits)
@@ -243,47 +265,60 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
         if not all(math.isfinite(v) for v in (lo_si, hi_si) if v is not None):
             fail(line, key, f"the limits overflow ({said}): expected finite bounds")
         limits.append(Limit(name, unit, to_si, lo_si, hi_si, said))
-    return Limits(path, str(doc.get("name") or path.stem), tuple(limits))
+    tolerance = _fit_error_tolerance(doc.get("fit_error_percent"), text, path)
+    return Limits(path, str(doc.get("name") or path.stem), tuple(limits), tolerance)
 
 
-def verdict_of(verdicts) -> str:
-    return "pass" if all(v.passed for v in verdicts) else "fail"
-
-
-def _blocker(validity: Mapping | str) -> tuple[str, str] | None:
-    from analysis.validity.fit import qa_blocker
-    return qa_blocker({"overall": validity} if isinstance(validity, str) else validity)
-
-
+def _fit_error_tolerance(entry, text: str, path: Path) -> dict[str, float]:
+    """The file's "fit_error_percent" over the defaults: channel -> largest fit error in % that is judged."""
+    tolerance = dict(FIT_ERROR_DEFAULTS)
+    if entry is None:
+        return tolerance
+    line = _line_of(text, "fit_error_percent")
+    where = f"{path}: line {line}: fit_error_percent" if line else f"{path}: fit_error_percent"
+    if not isinstance(entry, dict):
+        raise LimitsError(f"{where}: expected an object such as {{\"impedance\": 3, \"displacement\": 10}} (%)")
+    for channel, value in entry.items():
+        if channel not in FIT_ERROR_CHANNELS:
+            raise LimitsError(f"{where}: {str(channel)[:40]!r}: unknown curve: expected {' or '.join(FIT_ERROR_CHANNELS)}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not _finite(value) or value <= 0:
+            raise LimitsError(f"{where}.{channel}: found {str(value)[:40]!r}, expected a positive number of %")
+        tolerance[channel] = float(value)
+    return tolerance
 def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
-    """The QA verdict as JSON: "pass", "fail", "invalid" when the measurement itself is red (shown as FAIL), or
-    "not judged" when the model does not describe it (analysis.validity.fit.qa_blocker; `validity`: the result's
-    validity, or its overall light alone).
+    """The QA verdict as JSON (analysis.qa_verdict): "pass", "fail", "uncertain", "invalid" (the measurement
+    itself is red) or "not judged" (the model misses a curve by more than the file's fit-error tolerance);
+    `validity`: the result's validity, or its overall light alone.
 
-    A red measurement's parameters are worthless (physics.md section 5): none
-    of them is judged against its limit; the unit fails the test, and the why
-    says it is the measurement that must be repeated.
+    Neither an invalid nor a not-judged result has its parameters judged against
+    their limits (physics.md section 5): the why says what to do.
     """
-    verdicts = limits.judge(parameters)
-    blocker = _blocker(validity)
-    doc = {"file": str(limits.path), "name": limits.name, "verdict": blocker[0] if blocker else verdict_of(verdicts),
-           "parameters": [v.as_json() for v in verdicts]}
-    if blocker:
-        doc["why"] = blocker[1]
+    from analysis.qa_verdict import judge
+    judgement = judge(limits, parameters, validity)
+    doc = {"file": str(limits.path), "name": limits.name, "verdict": judgement.verdict, "why": judgement.why,
+           "interval_k": INTERVAL_K, "fit_error_tolerance_percent": dict(limits.fit_error_percent),
+           "parameters": [v.as_json() for v in judgement.verdicts]}
+    if judgement.fit_error_percent:
+        doc["fit_error_percent"] = dict(judgement.fit_error_percent)
     return doc
 
 
 def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> str:
-    """A table for the terminal: each limit in its file's unit, the measured value, pass or FAIL."""
-    doc = judge_result(limits, parameters, validity)
-    lines = [f"QA limits: {limits.name} ({limits.path})"]
-    for limit, v in zip(limits.limits, limits.judge(parameters)):
+    """A table for the terminal: each limit in its file's unit, the measured interval, pass, FAIL or uncertain."""
+    from analysis.qa_verdict import judge, outcome_word
+    judgement = judge(limits, parameters, validity)
+    lines = [f"QA limits: {limits.name} ({limits.path}); each parameter judged by value ± {INTERVAL_K:g} σ"]
+    for limit, v in zip(limits.limits, judgement.verdicts):
         unit = "" if _unit(limit.unit) == "1" else limit.unit
         shown = "n/a" if v.value is None else f"{v.value / limit.to_si:.5g} {unit}".rstrip()
-        mark = "pass" if v.passed else "FAIL"
-        lines.append(f"  {limit.name:<14}{shown:>18}   limit {limit.text:<28} {mark}"
+        if v.interval is not None and v.interval[0] != v.interval[1]:
+            shown += f" ({v.interval[0] / limit.to_si:.4g} .. {v.interval[1] / limit.to_si:.4g})"
+        mark = outcome_word(v, judgement.judged)
+        lines.append(f"  {limit.name:<14}{shown:>34}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))
-    from analysis.validity.fit import VERDICT_HEADLINES
-    why = f" — {doc['why']}" if doc.get("why") else ""
-    lines.append(f"QA: {VERDICT_HEADLINES[doc['verdict']]}{why}")
+    if judgement.fit_error_percent:
+        lines.append("  fit error: " + ", ".join(
+            f"{name} {err:.2g} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
+            for name, err in judgement.fit_error_percent.items()))
+    lines.append(f"QA: {judgement.headline} — {judgement.why}")
     return "\n".join(lines)

@@ -23,6 +23,7 @@ import numpy as np
 from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, unmeasured_table
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
+from analysis.fit.error import fit_error_percent
 from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult, fit_model
 from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
@@ -126,6 +127,7 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
         spectra = corrected
         fit = fit_model(FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
     judged = validity.with_findings(misfit_findings(fit)).as_json()
+    judged["fit_error_percent"] = fit_error_percent(fit)       # what QA judges the model's misfit by
     if heating is not None:
         judged["heating"] = heating.as_json()
     parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)

@@ -25,6 +25,14 @@ def model_words(result: AnalysisResult) -> str:
     return "the lumped model" + (" with " + ", ".join(titles) if titles else " alone")
 
 
+def fit_error_words(result: AnalysisResult) -> str:
+    """"impedance 2.1 %, displacement 3.4 % (rms misfit)": each curve's fit error, what QA judges the model by."""
+    errors = (result.validity or {}).get("fit_error_percent") or {}
+    if not errors:
+        return ""
+    return ", ".join(f"{name} {value:.2g} %" for name, value in errors.items()) + " (rms misfit of each curve)"
+
+
 def headline_html(result: AnalysisResult) -> str:
     fit = result.fit
     if fit is None:
@@ -33,6 +41,9 @@ def headline_html(result: AnalysisResult) -> str:
     colour = OK_COLOUR if fit_is_at_noise(fit) else MISS_COLOUR
     text = (f"<b>Model</b>: {html.escape(model_words(result))}.<br>"
             f"<span style='color:{colour}'><b>{html.escape(fit_headline(fit))}</b></span>")
+    errors = fit_error_words(result)
+    if errors:
+        text += f"<br><b>Fit error</b>: {html.escape(errors)}"
     if not fit.success:
         text += (f"<br><span style='color:{ERROR_COLOUR}'><b>The fit did not converge</b>: "
                  f"{html.escape(fit.message)}</span>")

@@ -91,6 +91,16 @@ def format_value(p: ParameterValue, all_digits: bool = True) -> tuple[str, str]:
     return f"{value:.{decimals}f}", f"{std:.{decimals}f}"
 
 
+def uncertainty_parts(p: ParameterValue) -> str:
+    """"±0.12 g noise, ±0.9 g model": the two parts of the uncertainty where the analysis estimated them, or ""."""
+    unit = pretty_unit(p.display_unit)
+    unit = "" if unit in ("", "-", "1") else f" {unit}"
+    parts = [f"±{std * abs(p.display_scale):.2g}{unit} {what}" for std, what in ((p.std_noise, "noise"),
+                                                                                (p.std_model, "model"))
+             if std is not None and math.isfinite(std)]
+    return ", ".join(parts)
+
+
 def value_with_unit(p: ParameterValue) -> str:
     """"3.02 Ω": the value as the table rounds it (at most 4 digits) and its unit, for a page with one cell."""
     if p.value is None:
@@ -219,6 +229,9 @@ class ParameterModel(QAbstractTableModel):
             unit = pretty_unit(p.display_unit)
             spread = f" ± {std}" if std not in ("", "–") else ""
             text += f"\n= {value}{spread} {unit}".rstrip()
+            parts = uncertainty_parts(p)
+            if parts:
+                text += f"\nof which {parts}"
             if spread:
                 text += "\n± is one standard deviation: the true value lies within it with about 68 % probability."
         if p.value is None:

@@ -6,9 +6,12 @@ file (analysis.limits), and the report export (analysis.report). Both come
 from other packages: when one is not installed its button stays disabled and
 says why, rather than pretending.
 
-A red measurement FAILS the test, with a reason that says it is the
-measurement that is broken (measure again; the unit itself was not judged);
-one the model does not describe is NOT JUDGED (analysis.validity.fit).
+The verdict is the one every output gives (analysis.qa_verdict): a red
+measurement is INVALID in its own word and colour (measure again; the unit
+itself was not judged), one whose model misses a curve by more than the
+fit-error tolerance is NOT JUDGED; otherwise each parameter is judged by its
+interval (value ± 2 σ): PASS, FAIL naming the failing parameters with their
+margins, or UNCERTAIN (measure again) when an interval straddles a limit.
 """
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ from pathlib import Path
 from typing import Mapping
 
 from PySide6.QtCore import QSettings, Qt, Signal
+from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxLayout, QHeaderView, QLabel,
                                QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
@@ -53,20 +57,14 @@ def display(value: float | None, parameter) -> str:
     return value_with_unit(parameter)
 
 
-def qa_verdict(validity: Mapping | str, limits_verdict: str | None) -> tuple[str, str]:
-    """(verdict, why): the measurement's validity first (analysis.validity.fit.qa_blocker), then the limits."""
+def qa_verdict(validity: Mapping | str) -> tuple[str, str]:
+    """(verdict, why) without limits loaded: the measurement's validity alone (analysis.validity.fit.qa_blocker)."""
     from analysis.validity.fit import qa_blocker
     validity = {"overall": validity} if isinstance(validity, str) else validity
-    validity_overall = str(validity.get("overall", "unknown"))
     blocker = qa_blocker(validity)
     if blocker is not None:
         return blocker
-    if limits_verdict is None:
-        return "none", "no limits loaded: only the measurement's validity is judged"
-    if limits_verdict == "fail":
-        return "fail", "a parameter is outside its limits"
-    doubt = " (the measurement is doubtful: read the yellow findings)" if validity_overall == "yellow" else ""
-    return "pass", "every parameter within its limits" + doubt
+    return "none", "no limits loaded: only the measurement's validity is judged"
 
 
 def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> str:
@@ -88,8 +86,19 @@ def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> s
     return ", ".join(str(p) for p in write_report(content, **kind))
 
 
+def _interval_tip(verdict) -> str:
+    """The interval a parameter was judged by, in the limits file's unit, for the row's tooltip."""
+    from analysis.limits import INTERVAL_K
+    from analysis.qa_verdict import margin_text
+    if verdict.interval is None:
+        return verdict.note
+    lo, hi = (x / verdict.limit.to_si for x in verdict.interval)
+    return (f"judged by value ± {INTERVAL_K:g} σ: {lo:.4g} .. {hi:.4g} against {verdict.limit.text}; "
+            f"the value is {margin_text(verdict)}" + (f"; {verdict.note}" if verdict.note else ""))
+
+
 class QAView(QWidget):
-    verdict_changed = Signal(str)       # "pass" | "fail" | "invalid" | "not judged" | "none"
+    verdict_changed = Signal(str)       # "pass" | "fail" | "uncertain" | "invalid" | "not judged" | "none"
     report_written = Signal(str)
 
     def __init__(self, settings: QSettings | None = None, parent=None):
@@ -98,6 +107,7 @@ class QAView(QWidget):
         self.result: AnalysisResult | None = None
         self.limits = None
         self.verdicts: tuple = ()
+        self.judgement = None           # analysis.qa_verdict.QAJudgement against the loaded limits
         self.verdict = "none"
         self.worker = JobRunner(self, max_threads=1)     # one report at a time
 
@@ -226,6 +236,7 @@ class QAView(QWidget):
     def _show_limits(self, keep_text: bool) -> None:
         self.table.setRowCount(0)
         self.verdicts = ()
+        self.judgement = None
         if not available(LIMITS_MODULE):
             self.load_button.setEnabled(False)
             self.load_button.setToolTip(NO_LIMITS)
@@ -240,48 +251,59 @@ class QAView(QWidget):
         self.limits_label.setText(f"<b>{html.escape(self.limits.name)}</b> ({html.escape(str(self.limits.path))})")
         if self.result is None:
             return
-        self.verdicts = self.limits.judge(self.result.parameters)
+        from analysis.qa_verdict import judge, outcome_word
+        self.judgement = judge(self.limits, self.result.parameters, self.result.validity)
+        self.verdicts = self.judgement.verdicts
         # Parameters of an invalid measurement, or of a model that does not describe it, are worthless
         # (physics.md section 5): no parameter is judged against its limit (the verdict says why).
-        from analysis.validity.fit import qa_blocker
-        invalid = qa_blocker(self.result.validity) is not None
+        judged = self.judgement.judged
+        colours = {"pass": Qt.darkGreen, "FAIL": Qt.darkRed, "uncertain": QColor("#8a4300")}
         self.table.setRowCount(len(self.verdicts))
         for row, v in enumerate(self.verdicts):
             parameter = self.result.parameters.get(v.limit.name)
             # Why a value is missing is long (the finding and its remedy): in the tooltip, so that the
             # Limit and Result columns stay in view.
             measured = display(v.value, parameter) if v.value is not None else "not measured"
-            outcome = "not judged" if invalid else ("pass" if v.passed else "FAIL")
+            outcome = outcome_word(v, judged)
             cells = (display_name(v.limit.name), measured, v.limit.text, outcome)
+            tip = v.note if v.value is None else _interval_tip(v)
             for col, text in enumerate(cells):
                 item = QTableWidgetItem(text)
-                if v.value is None and v.note:
-                    item.setToolTip(v.note)
-                if invalid:
+                if tip:
+                    item.setToolTip(tip)
+                if not judged:
                     item.setForeground(Qt.gray)
                 elif col == 3:
-                    item.setForeground(Qt.darkGreen if v.passed else Qt.darkRed)
+                    item.setForeground(colours.get(outcome, Qt.black))
                 self.table.setItem(row, col, item)
 
     def _show_verdict(self, overall: str) -> None:
-        limits_verdict = None
-        if self.verdicts:
-            from analysis.limits import verdict_of
-            limits_verdict = verdict_of(self.verdicts)
         if self.result is None:
             verdict, why = "none", "nothing to judge yet"
+        elif self.judgement is not None:
+            verdict, why = self.judgement.verdict, self.judgement.why
         else:
-            verdict, why = qa_verdict(self.result.validity, limits_verdict)
+            verdict, why = qa_verdict(self.result.validity)
         from analysis.report.qa import VERDICT_COLOURS
         from analysis.validity.fit import VERDICT_HEADLINES
         background, text = VERDICT_COLOURS.get(verdict, NO_VERDICT)
         title = VERDICT_HEADLINES.get(verdict, "NO VERDICT")
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "
                                          f"border: 1px solid {text}; border-radius: 4px; }}")
-        self.verdict_label.setText(f"<span style='font-size:20pt'><b>{title}</b></span><br>{html.escape(why)}")
+        self.verdict_label.setText(f"<span style='font-size:20pt'><b>{html.escape(title)}</b></span><br>"
+                                   f"{html.escape(why)}{self._fit_error_line()}")
         if verdict != self.verdict:
             self.verdict = verdict
             self.verdict_changed.emit(verdict)
+
+    def _fit_error_line(self) -> str:
+        """Each curve's fit error against the limits' tolerance: what decided that the unit could be judged."""
+        if self.judgement is None or not self.judgement.fit_error_percent or self.judgement.verdict == "invalid":
+            return ""
+        tolerance = self.limits.fit_error_percent
+        said = ", ".join(f"{name} {err:.2g} % (tolerance {tolerance.get(name, float('nan')):g} %)"
+                         for name, err in self.judgement.fit_error_percent.items())
+        return f"<br><small>Fit error (rms misfit of each curve): {html.escape(said)}</small>"
 
     # -- export ------------------------------------------------------------------
     def _update_export(self) -> None:

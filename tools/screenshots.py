@@ -27,6 +27,8 @@ production-1280x720.png and production-1920x1080.png: the Production page
 over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
 station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
+--only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
+(tools/screenshots_verdicts.py).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
 --only hardware: the Hardware page's sound-card and serial-port lists at both sizes, this machine's and a
 Windows PC's as an example (tools/screenshots_hardware.py).
@@ -476,9 +478,15 @@ def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     return written
 
 
+def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_verdicts import verdict_screenshots
+    return verdict_screenshots(app, window, folder, out)
+
+
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
-        "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots}
+        "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
+        "verdicts": verdicts_screenshots}
 
 
 def main(argv: list[str]) -> int:

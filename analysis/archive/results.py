@@ -78,6 +78,9 @@ def results_document(result, recording=None) -> dict:
         parameters[name] = {"value": _num(p.value), "std": _num(p.std), "unit": p.unit,
                             "display_unit": p.display_unit, "display_scale": p.display_scale,
                             "reason": p.reason, "fitted": p.fitted}
+        # The uncertainty's two parts, when estimated (issue 29): QA, reports and exports read them back.
+        parameters[name].update({k: _num(v) for k, v in (("std_noise", p.std_noise), ("std_model", p.std_model))
+                                 if v is not None})
     doc = {
         "format": FORMAT,
         "parameters": parameters,
@@ -241,7 +244,9 @@ class StoredResult:
             parameters[name] = ParameterValue(name, _number(p.get("value"), where + "value"),
                                               _number(p.get("std"), where + "std"), _get(p, "unit", str, where),
                                               _get(p, "display_unit", str, where), scale,
-                                              None if reason is None else str(reason), bool(p.get("fitted", False)))
+                                              None if reason is None else str(reason), bool(p.get("fitted", False)),
+                                              _number(p.get("std_noise"), where + "std_noise"),
+                                              _number(p.get("std_model"), where + "std_model"))
         model = _get(doc, "model", dict, "")
         effects = tuple(str(e) for e in _get(model, "effects", list, "model."))
         values = {}

@@ -35,6 +35,7 @@ from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
+from analysis.fit.error import fit_error_percent, rms_relative_residual
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
 from analysis.fit.startvalues import start_context
 from analysis.model.composed import Model
@@ -164,18 +165,6 @@ def _with_noise(tf: TransferFunction, notes: list[str]) -> TransferFunction:
     return out
 
 
-def rms_relative_residual(fit: FitResult) -> dict[str, float]:
-    """sqrt(mean(|model - measured|^2 / |measured|^2)) per channel: how far the model misses, in words of %."""
-    out = {}
-    for name, ch in fit.channels.items():
-        model = ch.model if ch.has_phase else np.abs(ch.model)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            rel = np.abs(model - ch.measured) ** 2 / np.abs(ch.measured) ** 2
-        rel = rel[np.isfinite(rel)]
-        out[name] = float(np.sqrt(np.mean(rel))) if rel.size else float("nan")
-    return out
-
-
 def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
                    curves: Sequence[TransferFunction], notes: Sequence[str]) -> dict:
     """The 'validity' object for imported curves: nothing checked, and how far to trust the numbers."""
@@ -184,6 +173,7 @@ def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
         "note": VALIDITY_NOTE,
         "uncertainties": UNCERTAINTY_NOTE,
         "rms_relative_residual": rms_relative_residual(fit),
+        "fit_error_percent": fit_error_percent(fit),
         "magnitude_only": [tf.name for tf in curves if not tf.has_phase],
         "ranges_hz": {name: list(r) for name, r in ranges.items()},
         "notes": list(notes),

@@ -13,7 +13,9 @@ import numpy as np
 
 from analysis.bounds import FREQUENCY, HX, IMPEDANCE, Bound
 from analysis.importers.columns import HX_UNITS, assign_columns, hx_unit, phase_unit
-from analysis.importers.table import Table, read_table
+from analysis.importers import lpm
+from analysis.importers.errors import ImportFormatError
+from analysis.importers.table import Table, parse_table, read_text
 from analysis.spectra import TransferFunction
 
 KINDS = {"impedance": ("ohm", "|Z| in ohm"), "displacement": ("m/V", "|Hx| in m/V")}
@@ -34,6 +36,8 @@ class ImportedCurve:
     transfer: TransferFunction
     path: Path
     notes: tuple[str, ...]          # each decision taken while reading: the phase unit and why, etc.
+    # The exporting tool's own fitted curve, when the file has one (Klippel dB-Lab): an overlay, never fitted.
+    reference: TransferFunction | None = None
 
     def describe(self) -> str:
         t = self.transfer
@@ -55,8 +59,44 @@ def read_curve(path: str | Path, kind: str = "impedance", phase: str | None = No
         raise ValueError(f"phase must be 'deg' or 'rad', not {phase!r}")
     if unit is not None and (kind != "displacement" or unit not in HX_UNITS):
         raise ValueError(f"unit applies to Hx only and must be one of {sorted(HX_UNITS)}, not {unit!r}")
-    table = read_table(path)
-    return curve_from_table(table, kind, phase, unit)
+    text = read_text(path)
+    if lpm.recognises(text):
+        return lpm_curve(lpm.read_lpm(path, text), kind, unit)
+    return curve_from_table(parse_table(path, text), kind, phase, unit)
+
+
+def lpm_curve(export: lpm.LpmExport, kind: str, unit: str | None = None) -> ImportedCurve:
+    """The measured curve of a Klippel dB-Lab export (magnitude only), its fitted curve kept as the reference."""
+    path = export.path
+    if export.kind != kind:
+        option = "--impedance" if export.kind == "impedance" else "--hx"
+        raise ImportFormatError(path, None, f"a Klippel export of {'an impedance' if export.kind == 'impedance' else 'Hx'}"
+                                f" ({export.title!r}, in {export.unit}) where {KINDS[kind][1]} was expected: give it "
+                                f"as {option}")
+    if unit is not None and unit.lower() != export.unit.lower().replace("µ", "u").replace("μ", "u"):
+        raise ImportFormatError(path, None, f"the export's units line says {export.unit}, the option {unit}: "
+                                "drop the option (the file's unit is used)")
+    si_unit, value_name = KINDS[kind]
+    curves = []
+    for curve in (export.measured, export.fitted):
+        if curve is None:
+            curves.append(None)
+            continue
+        table = export.table(curve)
+        check_frequencies(table, curve.freqs)
+        _check_positive(table, curve.values, "magnitude")
+        check_bound(table, curve.values, HX if kind == "displacement" else IMPEDANCE, value_name.split(" in ")[0])
+        n = len(curve.freqs)
+        curves.append(TransferFunction(kind, si_unit, curve.freqs.copy(), np.arange(n), curve.values.astype(complex),
+                                       np.full(n, np.nan), has_phase=False, noise_known=False))
+    measured, fitted = curves
+    notes = [f"Klippel dB-Lab export {export.title!r}: the {export.measured.group!r} curve, magnitude only (the "
+             f"export has no phase: |{'Z' if kind == 'impedance' else 'Hx'}| alone is fitted)",
+             f"magnitude in {export.unit} (from the file's units line)"]
+    if fitted is not None:
+        notes.append(f"the {export.fitted.group!r} curve (the tool's own fit) kept for comparison, not fitted; it "
+                     f"misses the measured curve by {100 * reference_misfit(measured, fitted):.2g} % rms (its fit error)")
+    return ImportedCurve(measured, path, tuple(notes), fitted)
 
 
 def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: str | None = None) -> ImportedCurve:
@@ -94,6 +134,15 @@ def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: st
     tf = TransferFunction(kind, si_unit, freqs.copy(), np.arange(n), value, np.full(n, np.nan),
                           has_phase=has_phase, noise_known=False)
     return ImportedCurve(tf, table.path, tuple(notes))
+
+
+def reference_misfit(measured: TransferFunction, reference: TransferFunction) -> float:
+    """rms of |reference / measured| - 1 over the measured lines the reference spans (interpolated in log f)."""
+    inside = (measured.freqs >= reference.freqs[0]) & (measured.freqs <= reference.freqs[-1])
+    if not inside.any():
+        return float("nan")
+    at = np.interp(np.log(measured.freqs[inside]), np.log(reference.freqs), np.abs(reference.value))
+    return float(np.sqrt(np.mean((at / np.abs(measured.value[inside]) - 1) ** 2)))
 
 
 def check_bound(table: Table, values: np.ndarray, bound: Bound, what: str) -> None:

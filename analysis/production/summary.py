@@ -74,7 +74,10 @@ def _excluded_reason(validity: str, verdict: str | None) -> str | None:
     if validity == "red":
         return "validity red (the measurement is invalid)"
     if verdict in NOT_JUDGEABLE:
-        return f"not judgeable ({verdict}: the model does not describe the measurement)"
+        # "not judged" also holds the uncertain units (analysis.validity.fit.STORED_VERDICT): measured again.
+        why = ("the measurement is invalid" if verdict == "invalid" else
+               "the model does not describe the measurement, or a parameter's interval straddles a limit")
+        return f"not judgeable ({verdict}: {why})"
     return None
 
 

@@ -14,7 +14,7 @@ from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
 from analysis.fit.report import fit_report_rows
-from analysis.report.numbers import format_number, parameter_cells, pretty_unit
+from analysis.report.numbers import format_number, format_std, parameter_cells, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
@@ -105,6 +105,14 @@ def _user_effect_rows(result: StoredResult) -> list[tuple[str, str]]:
             for e in result.user_effects.values() if e.id in result.effects]
 
 
+def uncertainty_parts(p) -> str:
+    """"± 0.12 g noise, ± 0.9 g model" for the note column, where the analysis estimated the two parts."""
+    unit = pretty_unit(p.display_unit)
+    unit = "" if unit in ("", "-", "1") else f" {unit}"
+    return ", ".join(f"± {format_std(std * abs(p.display_scale))}{unit} {what}"
+                     for std, what in ((p.std_noise, "noise"), (p.std_model, "model")) if std is not None)
+
+
 def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     if result.not_fitted:
         return (("Model", "nothing fitted"), ("Why", result.not_fitted))
@@ -114,6 +122,8 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     rows = [("Model", "lumped model of physics.md" + (" with Hx (laser)" if result.with_displacement else
                                                        ", impedance only")),
             ("Effects", effects)] + _user_effect_rows(result)
+    for channel, value in (result.validity.get("fit_error_percent") or {}).items():
+        rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))
     for channel, value in chi.items():
         rows.append((f"Reduced χ² ({channel})", format_number(value) if value is not None else "n/a"))
     for key, label in (("aic", "AIC"), ("bic", "BIC")):
@@ -173,7 +183,7 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     params = []
     for p in result.parameters.values():
         value, std, unit, rel = parameter_cells(p)
-        params.append(ParameterRow(p.name, value, std, unit, rel, p.reason or "", p.fitted))
+        params.append(ParameterRow(p.name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted))
     peak = result.validity.get("peak_displacement_m")
     peak_text = f"{peak * 1e3:.3g} mm" if isinstance(peak, (int, float)) else "not measured"
     cal: list[tuple[str, str]] = []

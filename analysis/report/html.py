@@ -9,6 +9,7 @@ from html import escape
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
 from analysis.report.plots import figures, svg_of
+from analysis.limits import INTERVAL_K
 from analysis.report.qa import VERDICT_COLOURS, QASection
 
 LIGHT_COLOURS = {"green": "#2e9d44", "yellow": "#e0b000", "red": "#d23a2c", "absent": "#b8b8b8",
@@ -31,6 +32,7 @@ figure { margin: 1em 0; } figure svg { width: 100%; height: auto; } figcaption {
 .verdict { border: 2px solid; border-radius: 6px; padding: 0.4em 0.8em; margin: 0.6em 0; }
 .verdict .headline { font-size: 1.6em; font-weight: bold; margin-right: 0.6em; }
 table.params td.fail { color: #8e1b1b; font-weight: bold; } table.params td.pass { color: #1b5e20; }
+table.params td.uncertain { color: #8a4300; font-weight: bold; }
 """
 
 
@@ -54,11 +56,13 @@ def _verdict_banner(qa: QASection) -> str:
 def _qa_table(qa: QASection) -> str:
     parts = [f"<h2>QA limits</h2><p>Limits file <b>{escape(qa.file)}</b> ({escape(qa.name)}): "
              f"<b>{escape(qa.headline)}</b>. Values in the file's units; “tolerance used” is the distance "
-             "from the middle of a two-sided limit as a share of its half-width (over 100 % fails).</p>",
+             "from the middle of a two-sided limit as a share of its half-width. Each parameter is judged by "
+             f"its value ± {INTERVAL_K:g} σ: pass inside the limit, FAIL wholly outside, uncertain across it.</p>"
+             + (f"<p>Fit error (rms misfit of each curve): {escape(qa.fit_error)}.</p>" if qa.fit_error else ""),
              "<table class='params'><tr><th>parameter</th><th>result</th><th class='num'>measured</th>"
              "<th class='num'>tolerance used</th><th>limit</th><th>margin</th></tr>"]
     for r in qa.rows:
-        css = {"pass": "pass", "FAIL": "fail"}.get(r.outcome, "")
+        css = {"pass": "pass", "FAIL": "fail", "uncertain": "uncertain"}.get(r.outcome, "")
         parts.append(f"<tr><td>{escape(r.name)}</td><td class='{css}'>{escape(r.outcome)}</td>"
                      f"<td class='num'>{escape(r.value)}</td><td class='num'>{escape(r.used)}</td>"
                      f"<td>{escape(r.limit)}</td><td>{escape(r.margin or r.note)}</td></tr>")

@@ -27,6 +27,7 @@ from matplotlib.textpath import TextPath
 from analysis.report.content import CHANNEL_TITLES, ReportContent
 from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
+from analysis.limits import INTERVAL_K
 from analysis.report.qa import VERDICT_COLOURS, QASection
 
 A4 = (8.27, 11.69)
@@ -206,7 +207,10 @@ def _validity(pages: _Pages, c: ReportContent) -> None:
 def _qa_table(pages: _Pages, qa: QASection) -> None:
     pages.heading("QA limits")
     pages.wrapped(f"Limits file {qa.file} ({qa.name}): {qa.headline}. Values in the file's units; "
-                  "tolerance used: distance from the middle of a two-sided limit as a share of its half-width.")
+                  "tolerance used: distance from the middle of a two-sided limit as a share of its half-width. "
+                  f"Each parameter is judged by its value ± {INTERVAL_K:g} σ: pass inside, FAIL wholly outside, uncertain across.")
+    if qa.fit_error:
+        pages.wrapped(f"Fit error (rms misfit of each curve): {qa.fit_error}.")
     cols = (0.0, 0.95, 2.75, 3.4, 3.55, 5.05)   # name | result | measured (right) | used (right) | limit | margin
     widths = {4: _chars(cols[5] - cols[4] - 0.1), 5: _chars(A4[0] - 2 * MARGIN - cols[5])}
     pages.line("", gap=0.5)
@@ -215,13 +219,13 @@ def _qa_table(pages: _Pages, qa: QASection) -> None:
                          (cols[3], "tol. used", {"ha": "right"}), (cols[4], "limit", {}), (cols[5], "margin", {})):
         pages.text(x, title, weight="bold", **kw)
     pages.line("")
-    colours = {"pass": "#1b5e20", "FAIL": "#8e1b1b"}
+    colours = {"pass": "#1b5e20", "FAIL": "#8e1b1b", "uncertain": "#8a4300"}
     for row in qa.rows:
         limit = textwrap.wrap(row.limit, widths[4]) or [""]
         margin = textwrap.wrap(row.margin or row.note, widths[5]) or [""]
         pages._room(LINE * max(len(limit), len(margin)))
         pages.text(cols[0], row.name)
-        pages.text(cols[1], row.outcome, weight="bold" if row.outcome == "FAIL" else "normal",
+        pages.text(cols[1], row.outcome, weight="bold" if row.outcome in ("FAIL", "uncertain") else "normal",
                    color=colours.get(row.outcome, "#555555"))
         pages.text(cols[2], row.value, ha="right", family="DejaVu Sans Mono")
         pages.text(cols[3], row.used, ha="right")

@@ -15,13 +15,16 @@ the measurement's analysis step, the GUI), in three steps:
    finding: the model does not describe this measurement. Its findings go on
    the signal the fitted channel answers with: the impedance's on the current
    (Z = U / I, the current's response to the voltage), Hx's on the displacement.
-3. `qa_blocker(validity)`: a red measurement FAILS the QA test (the unit does
-   not pass it) with the honest reason: the measurement is broken, the unit
-   itself was not judged, and what to do. A misfit one (a valid measurement
-   the model does not describe) is NOT JUDGED, with the reason. Neither is
-   judged against the limits parameter by parameter. Every place that shows a
-   QA verdict (the QA page, reports, `linpar analyze --limits`) takes its
-   headline from VERDICT_HEADLINES.
+3. `qa_blocker(validity, tolerance)`: a red measurement is INVALID: not a
+   PASS, not a FAIL (the unit was not judged; production yield leaves it
+   out), with the honest reason and what to do: measure again. One whose
+   fit error (analysis.fit.error, the rms misfit in % of a curve) exceeds
+   the limits file's tolerance is NOT JUDGED, with that reason. A model-misfit
+   finding (reduced chi^2 far above 1) alone does not block QA: a real driver
+   measured with little noise always has one, at a fit error of a few %.
+   Neither blocked case is judged against the limits parameter by parameter.
+   Every place that shows a QA verdict (the QA page, reports, `linpar analyze
+   --limits`) takes its headline from VERDICT_HEADLINES.
 """
 from __future__ import annotations
 
@@ -29,7 +32,9 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
+from analysis.fit.error import FIT_ERROR_DEFAULTS, fit_error_percent
 from analysis.fit.least_squares import FitResult
+from analysis.qa_interval import FAIL, PASS, UNCERTAIN
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import ABSENT, Validity
 from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
@@ -38,10 +43,16 @@ from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Fi
 UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)
 # The signal channel whose light a fitted channel's findings go on.
 FIT_SIGNAL = {"impedance": "current", "displacement": "displacement"}
-# The QA verdicts' codes (as stored in the archive and written in JSON) and what a user reads for each: a broken
-# measurement keeps its own code, so production statistics leave it out, but it is shown as a FAIL.
+# The QA verdicts' codes (as written in JSON) and what a user reads for each. A broken measurement is INVALID in
+# its own word (never a FAIL: the unit was not judged, and an operator reads the big word); UNCERTAIN: a
+# parameter's interval straddles a limit. The archive stores each under analysis.archive.record.QA_VERDICTS
+# (STORED_VERDICT): production statistics leave out all but pass and fail.
 INVALID, NOT_JUDGED = "invalid", "not judged"
-VERDICT_HEADLINES = {"pass": "PASS", "fail": "FAIL", INVALID: "FAIL", NOT_JUDGED: "NOT JUDGED"}
+VERDICT_HEADLINES = {PASS: "PASS", FAIL: "FAIL", UNCERTAIN: "UNCERTAIN: measure again",
+                     INVALID: "INVALID: measure again", NOT_JUDGED: "NOT JUDGED"}
+# The archive's CHECK constraint knows pass, fail, invalid and not judged: an uncertain unit is stored as not
+# judged (it must be measured again, and counts in no yield).
+STORED_VERDICT = {UNCERTAIN: NOT_JUDGED}
 MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar diagnose') and fit again; if no effect "
                  "helps, check the wiring and the channels' findings")
 
@@ -104,7 +115,7 @@ def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT
                           "status": str(worst(Severity(f["severity"]) for f in findings))}
     lights = [Severity(ch["status"]) for ch in channels.values() if ch.get("status") in set(Severity)]
     return {**validity, "channels": channels, "overall": str(worst(lights)) if channels else
-            validity.get("overall", "unknown")}
+            validity.get("overall", "unknown"), "fit_error_percent": fit_error_percent(fit)}
 
 
 def red_findings_text(validity: Mapping) -> str:
@@ -118,13 +129,25 @@ def red_findings_text(validity: Mapping) -> str:
     return f"{first.get('message')} [{first.get('code')}]{more}: {first.get('remedy')}"
 
 
-def qa_blocker(validity: Mapping) -> tuple[str, str] | None:
+def qa_blocker(validity: Mapping, tolerance: Mapping[str, float] | None = None) -> tuple[str, str] | None:
     """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None.
 
-    INVALID is shown as FAIL (VERDICT_HEADLINES): the why says it is the measurement that is broken."""
+    tolerance: channel -> the largest fit error in % at which the model is taken to describe the measurement
+    (analysis.fit.error.FIT_ERROR_DEFAULTS when None). A result stored before the fit error was computed (no
+    "fit_error_percent") is judged by its model-misfit finding, as it was then."""
     if validity.get("overall") == "red":
         return INVALID, (f"measurement invalid: {red_findings_text(validity)}, and measure again; the unit "
                          "itself was not judged")
+    errors = validity.get("fit_error_percent")
+    if errors is not None:
+        tolerance = FIT_ERROR_DEFAULTS if tolerance is None else tolerance
+        over = [(name, err, tolerance[name]) for name, err in errors.items()
+                if name in tolerance and not err <= tolerance[name]]
+        if not over:
+            return None
+        said = "; ".join(f"the {name} by {err:.3g} % rms (tolerance {limit:g} %)" for name, err, limit in over)
+        return NOT_JUDGED, (f"the model does not describe this measurement: it misses {said}; its parameters "
+                            f"judge nothing; {MISFIT_REMEDY}")
     for channel in (validity.get("channels") or {}).values():
         for finding in channel.get("findings") or ():
             if finding.get("code") == MODEL_MISFIT:

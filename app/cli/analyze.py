@@ -49,5 +49,6 @@ def analyze_recording(args: argparse.Namespace) -> int:
             print("\n" + qa.format_verdicts(limits, result.parameters, result.validity))
     if limits is None:
         return 0
-    # 0 pass, 1 fail, 2 (an error: the measurement must be repeated, or its model found) when not judged.
+    # 0 pass, 1 fail, 2 when the unit was not judged: invalid or uncertain (measure again), or not judged (the
+    # model misses the measurement by more than the fit-error tolerance: find the model).
     return {"pass": 0, "fail": EXIT_QA_FAIL}.get(doc["limits"]["verdict"], 2)

@@ -87,8 +87,8 @@ def analyze_curves(args: argparse.Namespace) -> int:
         return 0
     print(format_result(result))
     ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
-    rms = ", ".join(f"{k} {100 * v:.2g} %" for k, v in result.validity["rms_relative_residual"].items())
-    print(f"fitted: {ranges}; rms relative misfit: {rms}")
+    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity["fit_error_percent"].items())
+    print(f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)")
     print(f"note: {result.validity['note']}; {result.validity['uncertainties']}")
     for note in result.notes:
         print(f"  {note}")

@@ -20,14 +20,24 @@ def format_value(p: ParameterValue) -> tuple[str, str]:
     return f"{v:.6g}", "-"
 
 
+def _part(std: float | None, p: ParameterValue) -> str:
+    return "-" if std is None else f"{std * abs(p.display_scale):.2g}"
+
+
 def format_result(result) -> str:
     """The parameter table, the fit's summary, what is not reported and why, the validity, then the fit's report
     (FitResult.report: statistics, fitted parameters with sigma, correlations, parameters on a bound)."""
-    lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"]
+    # The uncertainty's two parts (noise, model), when the analysis estimated them; the 1-sigma is their total.
+    parts = any(p.std_noise is not None or p.std_model is not None for p in result.parameters.values())
+    lines = [f"{'parameter':<14}{'value':>14}  {'1-sigma':>10}  unit"
+             + (f"{'noise':>10}  {'model':>10}" if parts else "")]
     missing: dict[str, list[str]] = {}      # reason -> the parameters it keeps out
     for p in result.parameters.values():
         value, std = format_value(p)
-        lines.append(f"{p.name:<14}{value:>14}  {std:>10}  {p.display_unit}")
+        row = f"{p.name:<14}{value:>14}  {std:>10}  {p.display_unit}"
+        if parts and p.value is not None:
+            row = f"{row:<46}" + "".join(f"{_part(x, p):>10}  " for x in (p.std_noise, p.std_model)).rstrip()
+        lines.append(row)
         if p.value is None:
             missing.setdefault(str(p.reason), []).append(p.name)
     notes = [f"  {', '.join(names)}: {reason}" for reason, names in missing.items()]
@@ -39,6 +49,10 @@ def format_result(result) -> str:
         chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
         lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
                       f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
+        errors = (result.validity or {}).get("fit_error_percent") or {}
+        if errors:
+            lines.append("fit error: " + ", ".join(f"{k} {v:.2g} %" for k, v in errors.items())
+                         + " (rms misfit of each curve in its fitted band)")
         if not fit.success:
             lines.append(f"warning: the fit did not converge: {fit.message}")
         report = fit.report()

@@ -85,7 +85,7 @@ def test_a_channel_that_copies_another_is_a_red_wiring_finding_never_green_never
     assert f"a scaled copy of the {onto}" in finding["message"] and "wiring" in finding["remedy"]
     judged = judge_result(LIMITS, result.parameters, result.validity)
     assert judged["verdict"] == "invalid"
-    assert qa_section(LIMITS, result.parameters, result.validity).headline == "FAIL"
+    assert qa_section(LIMITS, result.parameters, result.validity).headline == "INVALID: measure again"
 
 
 def test_current_equal_to_voltage_gives_no_fit_and_no_pass(good):

@@ -17,8 +17,10 @@ def limits_doc(**parameters):
     return {"format": "linpar-limits/1", "name": "test", "parameters": parameters}
 
 
-def pv(name, value, unit, display_unit, scale, reason=None):
-    return ParameterValue(name, value, None if value is None else 0.01 * abs(value), unit, display_unit, scale, reason)
+def pv(name, value, unit, display_unit, scale, reason=None, rel_std=0.001):
+    """A parameter measured to 0.1 % (1 sigma), well inside the tolerances below: its interval decides as its value."""
+    return ParameterValue(name, value, None if value is None else rel_std * abs(value), unit, display_unit, scale,
+                          reason)
 
 
 PARAMS = {"RE": pv("RE", 3.02, "ohm", "ohm", 1.0), "fs": pv("fs", 70.5, "Hz", "Hz", 1.0),
@@ -34,9 +36,9 @@ def verdicts(tmp_path, validity="green", **parameters):
 
 def test_nominal_and_percent_or_absolute_tolerance(tmp_path):
     assert verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "1%", "unit": "ohm"}) == ("pass", {"RE": True})
-    assert verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "0.5%", "unit": "ohm"}) == ("fail", {"RE": False})
-    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.5, "unit": "Hz"})[0] == "pass"
-    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.4, "unit": "Hz"})[0] == "fail"
+    assert verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "0.3%", "unit": "ohm"}) == ("fail", {"RE": False})
+    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.7, "unit": "Hz"})[0] == "pass"
+    assert verdicts(tmp_path, fs={"nominal": 70, "tolerance": 0.3, "unit": "Hz"})[0] == "fail"
 
 
 def test_customary_and_si_units_give_the_same_verdict(tmp_path):
@@ -110,3 +112,82 @@ def test_margin_is_the_distance_to_the_nearest_bound_signed_inside_positive(tmp_
     assert mms.margin()[1] == "max" and mms.margin()[0] == pytest.approx(-0.87e-3)       # 11.87 g > 11 g: outside
     assert le.margin() == pytest.approx((0.032e-3, "min")) and le.tolerance_used() is None
     assert bl.margin() is None and bl.tolerance_used() is None                            # not measured
+
+
+# --- the interval rule (value +- 2 std) and the fit-error tolerance --------------------------------------------
+
+def judged_re(tmp_path, value, std, validity="green", **extra):
+    """The verdict of an RE of `value` +- `std` ohm against 3.0 ohm +- 5 % (2.85 .. 3.15)."""
+    doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})
+    doc.update(extra)
+    params = {"RE": ParameterValue("RE", value, std, "ohm", "ohm", 1.0)}
+    return judge_result(load_limits(write(tmp_path, doc)), params, validity)
+
+
+def test_a_parameter_is_judged_by_its_interval_pass_fail_or_uncertain_across_a_limit(tmp_path):
+    assert judged_re(tmp_path, 3.10, 0.02)["verdict"] == "pass"           # 3.06 .. 3.14 inside
+    across = judged_re(tmp_path, 3.10, 0.04)                               # 3.02 .. 3.18 straddles 3.15
+    assert across["verdict"] == "uncertain" and across["parameters"][0]["outcome"] == "uncertain"
+    assert "measure again" in across["why"] and "RE 3.02 .. 3.18" in across["why"]
+    assert across["parameters"][0]["interval"] == pytest.approx([3.02, 3.18]) and across["interval_k"] == 2
+    assert judged_re(tmp_path, 3.20, 0.04)["verdict"] == "uncertain"      # value outside, interval 3.12 .. 3.28
+    failed = judged_re(tmp_path, 3.30, 0.04)                               # 3.22 .. 3.38 wholly above
+    assert failed["verdict"] == "fail" and "RE 0.15 Ω above max" in failed["why"]
+    assert judged_re(tmp_path, 2.80, 0.01)["verdict"] == "fail"
+    alone = judged_re(tmp_path, 3.14, None)                                # no std: the value alone
+    assert alone["verdict"] == "pass" and "no uncertainty" in alone["parameters"][0]["note"]
+
+
+def test_one_failing_parameter_fails_the_unit_whatever_the_others_uncertainty(tmp_path):
+    doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"}, fs={"min": 80, "unit": "Hz"})
+    params = {"RE": ParameterValue("RE", 3.14, 0.02, "ohm", "ohm", 1.0),      # straddles
+              "fs": ParameterValue("fs", 70.0, 0.5, "Hz", "Hz", 1.0)}          # wholly below 80
+    judged = judge_result(load_limits(write(tmp_path, doc)), params, "green")
+    assert judged["verdict"] == "fail" and "fs 10 Hz below min" in judged["why"] and "RE" not in judged["why"]
+
+
+def misfit_validity(impedance, displacement=None):
+    """A yellow measurement with a model-misfit finding (reduced chi^2 1e5) and the curves' fit errors in %."""
+    errors = {"impedance": impedance, **({"displacement": displacement} if displacement is not None else {})}
+    finding = {"code": "model-misfit", "severity": "yellow", "message": "impedance: reduced chi^2 1e+05",
+               "remedy": "find the effect", "value": 1e5}
+    return {"overall": "yellow", "fit_error_percent": errors,
+            "channels": {"current": {"status": "yellow", "findings": [finding]}}}
+
+
+def test_a_fit_error_of_a_few_percent_is_judged_whatever_the_reduced_chi2(tmp_path):
+    judged = judged_re(tmp_path, 3.05, 0.02, misfit_validity(2.5, 6.0))
+    assert judged["verdict"] == "pass" and judged["fit_error_percent"] == {"impedance": 2.5, "displacement": 6.0}
+    assert judged["fit_error_tolerance_percent"] == {"impedance": 5.0, "displacement": 10.0}
+
+
+def test_only_a_fit_error_above_the_tolerance_is_not_judged_with_that_reason(tmp_path):
+    over = judged_re(tmp_path, 3.05, 0.02, misfit_validity(7.3))
+    assert over["verdict"] == "not judged"
+    assert "misses the impedance by 7.3 % rms (tolerance 5 %)" in over["why"]
+    strict = judged_re(tmp_path, 3.05, 0.02, misfit_validity(2.5, 6.0),
+                       fit_error_percent={"impedance": 2, "displacement": 10})
+    assert strict["verdict"] == "not judged" and "tolerance 2 %" in strict["why"]
+    loose = judged_re(tmp_path, 3.05, 0.02, misfit_validity(7.3), fit_error_percent={"impedance": 8})
+    assert loose["verdict"] == "pass"
+
+
+def test_a_result_stored_without_fit_errors_is_judged_by_its_misfit_finding_as_before(tmp_path):
+    old = misfit_validity(2.0)
+    del old["fit_error_percent"]
+    assert judged_re(tmp_path, 3.05, 0.02, old)["verdict"] == "not judged"
+
+
+@pytest.mark.parametrize("entry, message", [
+    ([3, 10], r"fit_error_percent: expected an object"),
+    ({"voltage": 3}, r"fit_error_percent: 'voltage': unknown curve: expected impedance or displacement"),
+    ({"impedance": 0}, r"fit_error_percent.impedance: found '0', expected a positive number of %"),
+    ({"impedance": "3%"}, r"fit_error_percent.impedance: found '3%'"),
+])
+def test_a_bad_fit_error_tolerance_gives_one_line(tmp_path, entry, message):
+    doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})
+    doc["fit_error_percent"] = entry
+    path = write(tmp_path, doc)
+    with pytest.raises(LimitsError, match=message) as err:
+        load_limits(path)
+    assert str(err.value).startswith(str(path)) and "\n" not in str(err.value)

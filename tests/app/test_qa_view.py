@@ -47,10 +47,13 @@ def test_a_faulty_recording_shows_a_red_light_and_its_message(qtbot, window, fau
     assert finding["message"] in shown and finding["remedy"] in shown
     assert current.details.isVisible() and current.details.width() > 100
     assert qa.channels["voltage"].light.status == "green"
-    # A broken measurement FAILS the test, and the verdict says it is the measurement, not necessarily the unit.
+    # A broken measurement is INVALID in its own word and colour (not FAIL's red): the unit was not judged.
     assert qa.verdict == "invalid"
     verdict = plain(qa.verdict_label)
-    assert verdict.startswith("FAIL") and "measurement invalid" in verdict and "measure again" in verdict
+    assert verdict.startswith("INVALID: measure again") and "measurement invalid" in verdict and "FAIL" not in verdict
+    from analysis.report.qa import VERDICT_COLOURS
+    assert VERDICT_COLOURS["invalid"][0] in qa.verdict_label.styleSheet()
+    assert VERDICT_COLOURS["fail"][0] not in qa.verdict_label.styleSheet()
     assert "the unit itself was not judged" in verdict
 
 
@@ -81,7 +84,7 @@ def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_curren
     assert qa.load_limits(limits_file)
     assert {qa.table.item(r, 3).text() for r in range(qa.table.rowCount())} == {"not judged"}
     verdict = plain(qa.verdict_label)
-    assert verdict.startswith("FAIL") and "NOT JUDGED" not in verdict
+    assert verdict.startswith("INVALID: measure again") and "NOT JUDGED" not in verdict
     assert "measurement invalid: current" in verdict and f"[{NO_SIGNAL}]" in verdict
     assert "check the current sense" in verdict and "the unit itself was not judged" in verdict
     # The report of the broken measurement is written, and says why.
@@ -91,7 +94,7 @@ def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_curren
         qa.export_to(target)
     assert "Written" in qa.export_label.text()
     text = " ".join(pdf_text(target).split())
-    assert "QA: FAIL" in text and "measurement invalid: current" in text and f"{NO_SIGNAL}: current: only 0%" in text
+    assert "QA: INVALID: measure again" in text and "QA: FAIL" not in text and "measurement invalid: current" in text and f"{NO_SIGNAL}: current: only 0%" in text
     assert "the unit itself was not judged" in text
     assert "Remedy: check the current sense" in text and "Nothing was fitted" in text
 
@@ -106,6 +109,11 @@ def test_limits_give_pass_and_fail_per_parameter(qtbot, window, recordings, limi
     rows = {qa.table.item(r, 0).text(): qa.table.item(r, 3).text() for r in range(qa.table.rowCount())}
     assert rows == {"Re": "pass", "fs": "pass", "Bl": "FAIL"}          # the paper's Bl is 5.23 T*m
     assert qa.verdict == "fail"
+    # The FAIL banner names the failing parameter with its margin, in the limits file's unit.
+    verdict = plain(qa.verdict_label)
+    assert verdict.startswith("FAIL") and "Bl 0.27 T·m below min" in verdict, verdict
+    assert "value ± 2 σ" in qa.table.item(0, 3).toolTip()
+    assert "Fit error (rms misfit of each curve): impedance" in verdict and "(tolerance 5 %)" in verdict
     assert window.settings.qsettings.value("qa/limits_file") == str(limits_file)
     looser = copy.deepcopy(LIMITS)          # the module's LIMITS stay as other tests expect them
     looser["parameters"]["Bl"] = {"min": 5.0, "unit": "T*m"}

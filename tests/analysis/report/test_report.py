@@ -145,7 +145,8 @@ def test_passing_limits_give_pass_with_margins_in_the_files_units(stored, tmp_pa
 
 def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
     c = build_report(stored, HEADER, limits=limits_file(tmp_path, **FAILING))
-    assert c.qa.verdict == "fail" and "3 of 4" in c.qa.why and "fs, Mms, Bl" in c.qa.why
+    assert c.qa.verdict == "fail" and "3 of 4" in c.qa.why
+    assert "fs 19.6 Hz above max, Mms 0.844 g above max, Bl 0.27 T·m below min" in c.qa.why    # with the margins
     rows = {r.name: r for r in c.qa.rows}
     assert rows["RE"].outcome == "pass" and rows["fs"].outcome == "FAIL" and rows["Mms"].outcome == "FAIL"
     assert rows["fs"].margin == "19.6 Hz above max"    # 70.56 Hz against 50 Hz ± 1 Hz
@@ -156,8 +157,9 @@ def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
 
 def test_a_red_measurement_fails_unjudged_and_a_missing_parameter_fails(stored, faulty, tmp_path):
     c = build_report(faulty, HEADER, limits=limits_file(tmp_path, **PASSING))
-    # FAIL, because the measurement is broken: no parameter is judged, and the why says so.
-    assert c.qa.verdict == "invalid" and c.qa.headline == "FAIL" and {r.outcome for r in c.qa.rows} == {"not judged"}
+    # INVALID, its own verdict: the measurement is broken, no parameter is judged, and the why says so.
+    assert c.qa.verdict == "invalid" and c.qa.headline == "INVALID: measure again"
+    assert {r.outcome for r in c.qa.rows} == {"not judged"}
     assert c.qa.why.startswith("measurement invalid: ") and "the unit itself was not judged" in c.qa.why
     rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=10, displacement=False)
     no_laser = StoredResult.from_json(results_document(analyze_recording(rec), rec))

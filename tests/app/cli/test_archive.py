@@ -116,12 +116,19 @@ def test_analyze_limits_exit_codes(capsys, rec_path, red_path, tmp_path):
                       Mms={"min": 11, "max": 13, "unit": "g"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", ok)
     assert code == 0 and "QA: PASS" in out
+    assert "fit error: impedance" in out and "judged by value ± 2 σ" in out
     bad = write_limits(tmp_path, fs={"nominal": 50, "tolerance": "2%", "unit": "Hz"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", bad, "--json")
     doc = json.loads(out)
     assert code == 1 and doc["limits"]["verdict"] == "fail" and doc["limits"]["parameters"][0]["pass"] is False
     code, out, err = run(capsys, "analyze", red_path, "--limits", ok)
-    assert code == 2 and "QA: FAIL — measurement invalid" in out
+    # INVALID in its own word (issue 32), never FAIL: the unit was not judged, the measurement must be repeated.
+    assert code == 2 and "QA: INVALID: measure again — measurement invalid" in out and "QA: FAIL" not in out
+    code, out, err = run(capsys, "analyze", red_path, "--limits", ok, "--json")
+    assert code == 2 and json.loads(out)["limits"]["verdict"] == "invalid"
+    code, out, err = run(capsys, "report", red_path, "--html", tmp_path / "red.html", "--limits", ok)
+    assert code == 0 and out.startswith("QA: INVALID: measure again")
+    assert "QA: INVALID: measure again" in (tmp_path / "red.html").read_text()
     broken = write_limits(tmp_path, fs={"nominal": 50, "unit": "Hz"})
     code, out, err = run(capsys, "analyze", rec_path, "--limits", broken)
     assert code == 2 and out == ""
