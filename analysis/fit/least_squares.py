@@ -64,6 +64,12 @@ class FitData:
     def channel(self, name: str) -> TransferFunction | None:
         return self.impedance if name == "impedance" else self.displacement
 
+    @functools.cached_property
+    def same_lines(self) -> bool:
+        """Both channels at the same lines (the usual case): the model is then evaluated once for both."""
+        x = self.displacement
+        return x is not None and np.array_equal(x.freqs, self.impedance.freqs)
+
 
 def _usable(tf: TransferFunction) -> TransferFunction:
     keep = np.isfinite(tf.value) & (tf.freqs > 0)
@@ -176,6 +182,10 @@ def _channel_residual(model_values: np.ndarray, tf: TransferFunction, sigma: np.
 def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x: bool,
                      sigmas: dict[str, np.ndarray]) -> np.ndarray:
     z = data.impedance
+    if use_x and data.same_lines:    # both channels from one pass through the model
+        Z, Hx = model.responses(2j * np.pi * z.freqs, p)
+        return np.concatenate(_channel_residual(Z, z, sigmas["impedance"])
+                              + _channel_residual(Hx, data.displacement, sigmas["displacement"]))
     parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"])
     if use_x:
         x = data.displacement
