@@ -219,8 +219,10 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
 
 def _minimize(model, params, data, use_x, sigmas, cancel,
               per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
+    names = [(lm_name, _our_name(lm_name)) for lm_name in params]    # worked out once, not per evaluation
+
     def residual(prm):
-        r = _residual_vector(model, _values(prm), data, use_x, sigmas)
+        r = _residual_vector(model, {ours: prm[lm_name].value for lm_name, ours in names}, data, use_x, sigmas)
         # A parameter set where the model is undefined is simply very bad:
         # a fixed size keeps MINPACK's bookkeeping intact.
         return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
