@@ -37,7 +37,7 @@ COLUMNS = ("name", "unit", "start", "min", "max")
 CHANGE_COLOUR = "#1f6fb4"
 MISFIT_COLOUR = "#9a9a9a"
 OK_COLOUR, BAD_COLOUR = "#1b6e20", "#8e1b1b"
-CHANNEL_TITLES = {"impedance": "impedance Z", "displacement": "displacement Hx"}
+CHANNEL_TITLES = {"impedance": "Z", "displacement": "Hx"}
 NAMES_HINT = ("Names: s (= jω), w (ω), f (Hz), ws (2π·fs of the fit), j, pi and the parameters below. Functions: "
               + " ".join(FUNCTIONS) + ".")
 
@@ -53,10 +53,10 @@ class SignaturePlot(pg.PlotWidget):
         style_plot(plot, "change of size (%)" if part == "size" else "change of phase (°)", bottom="frequency (Hz)")
         plot.setMenuEnabled(False)
         plot.getAxis("left").enableAutoSIPrefix(False)
+        # Short: two plots share the width, and a title wider than its plot pushes the plot out of view.
         plot.setTitle(f"{CHANNEL_TITLES.get(channel, channel)}, {part}: "
-                      f"<span style='color:{MISFIT_COLOUR}'>● misfit now</span>"
-                      f" &nbsp; <span style='color:{CHANGE_COLOUR}'>━ the new effect at its start values</span>",
-                      size="9pt")
+                      f"<span style='color:{MISFIT_COLOUR}'>● misfit</span>"
+                      f" <span style='color:{CHANGE_COLOUR}'>━ new effect</span>", size="9pt")
         plot.addItem(pg.InfiniteLine(pos=0.0, angle=0, movable=False, pen=pg.mkPen(style.GUIDE, width=1)))
         self.misfit = pg.PlotDataItem(pen=None, symbol="o", symbolSize=3, symbolPen=None,
                                       symbolBrush=pg.mkBrush(MISFIT_COLOUR))
