@@ -1,4 +1,5 @@
-"""Model.responses: both channels from one pass give what impedance() and displacement() give apart."""
+"""analysis.model.composed: Model.responses (both channels from one pass) gives what impedance() and
+displacement() give apart."""
 from __future__ import annotations
 
 import numpy as np
