@@ -1,4 +1,4 @@
-"""The Model lab on a real-like woofer, and the New effect… dialog it leads to (tools/screenshots.py --only real-like).
+"""The Model lab on a real-like woofer, and the New effect… dialog it leads to (screenshots.py --only real-like).
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] --only real-like
 

@@ -5,7 +5,8 @@ physics and the parameters with their unit, start and bounds. Every change is tu
 text and read back by the same checks the command line uses, so the dialog says the same one line a
 bad file would get. While the effect is valid, its signature on the current data is drawn beside the
 misfit the current version leaves (analysis.effect_preview), in size and in phase: the user sees whether
-the formula bends the model where the data need it. The site starts at the one the diagnosis named. Saving writes ID.toml to the user folder and registers the effect.
+the formula bends the model where the data need it. The site starts at the one the diagnosis named.
+Saving writes ID.toml to the user folder and registers the effect.
 """
 from __future__ import annotations
 

@@ -131,7 +131,8 @@ def test_the_preview_has_a_phase_panel_beside_the_size_one(qtbot, lab):
     assert set(dialog.phase_plots) == {"impedance", "displacement"}
     size_plot, phase_plot = dialog.plots["impedance"], dialog.phase_plots["impedance"]
     assert size_plot.isVisible() and phase_plot.isVisible()
-    assert phase_plot.mapToGlobal(phase_plot.rect().topLeft()).x() > size_plot.mapToGlobal(size_plot.rect().topLeft()).x()
+    left = lambda widget: widget.mapToGlobal(widget.rect().topLeft()).x()
+    assert left(phase_plot) > left(size_plot)          # beside it, on its right
     _, change = phase_plot.change.getData()
     _, misfit = phase_plot.misfit.getData()
     # Damping rising with frequency turns Z's phase near fs: a change in degrees, and a misfit the same.
