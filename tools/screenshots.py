@@ -21,6 +21,8 @@ model-lab-new-effect-1280x720.png and -1920x1080.png: the "New effect…" dialog
 with the effect a recording lacks written in it (damping rising as sqrt(f)),
 and model-lab-own-effect-*.png: the lab once it is saved and checked, reduced
 chi^2 down to 1 (--only new-effect: just these).
+--only real-like: the Model lab on a real-like woofer and the New effect… dialog with its phase panel
+(tools/screenshots_real_like.py).
 large-signal-1280x720.png and -1920x1080.png: the Large-signal page on the
 known-polynomial driver at three levels (--only large-signal: just these).
 production-1280x720.png and production-1920x1080.png: the Production page
@@ -435,6 +437,11 @@ def hardware_screenshots(app: QApplication, window, folder: Path, out: Path) -> 
     return shots(app, window, folder, out)
 
 
+def real_like_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_real_like import real_like_screenshots as shots
+    return shots(app, window, folder, out, open_in_lab)
+
+
 def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_pages import every_page_screenshots
     return every_page_screenshots(app, window, folder, out)
@@ -486,7 +493,7 @@ def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> 
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
         "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
-        "verdicts": verdicts_screenshots}
+        "verdicts": verdicts_screenshots, "real-like": real_like_screenshots}
 
 
 def main(argv: list[str]) -> int:

@@ -31,6 +31,10 @@ class Site(Enum):
     CURRENT = "current channel"                   # multiplies the measured Z = U / I
     DISPLACEMENT = "displacement channel"         # multiplies the measured Hx = X / U
 
+    # Members are singletons: hashed by identity, not by Enum's Python-level hash of the name (a fit looks
+    # the model's effects up by site hundreds of thousands of times).
+    __hash__ = object.__hash__
+
     @property
     def key(self) -> str:
         return SITE_KEYS[self]

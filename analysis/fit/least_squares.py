@@ -64,6 +64,12 @@ class FitData:
     def channel(self, name: str) -> TransferFunction | None:
         return self.impedance if name == "impedance" else self.displacement
 
+    @functools.cached_property
+    def same_lines(self) -> bool:
+        """Both channels at the same lines (the usual case): the model is then evaluated once for both."""
+        x = self.displacement
+        return x is not None and np.array_equal(x.freqs, self.impedance.freqs)
+
 
 def _usable(tf: TransferFunction) -> TransferFunction:
     keep = np.isfinite(tf.value) & (tf.freqs > 0)
@@ -176,6 +182,10 @@ def _channel_residual(model_values: np.ndarray, tf: TransferFunction, sigma: np.
 def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x: bool,
                      sigmas: dict[str, np.ndarray]) -> np.ndarray:
     z = data.impedance
+    if use_x and data.same_lines:    # both channels from one pass through the model
+        Z, Hx = model.responses(2j * np.pi * z.freqs, p)
+        return np.concatenate(_channel_residual(Z, z, sigmas["impedance"])
+                              + _channel_residual(Hx, data.displacement, sigmas["displacement"]))
     parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"])
     if use_x:
         x = data.displacement
@@ -209,8 +219,10 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
 
 def _minimize(model, params, data, use_x, sigmas, cancel,
               per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
+    names = [(lm_name, _our_name(lm_name)) for lm_name in params]    # worked out once, not per evaluation
+
     def residual(prm):
-        r = _residual_vector(model, _values(prm), data, use_x, sigmas)
+        r = _residual_vector(model, {ours: prm[lm_name].value for lm_name, ours in names}, data, use_x, sigmas)
         # A parameter set where the model is undefined is simply very bad:
         # a fixed size keeps MINPACK's bookkeeping intact.
         return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)

@@ -20,7 +20,7 @@ _HOME = {
     "ResidualPanel": "page",
     "SitePanel": "page",
     "changed_model": "page",
-    "chi2_text": "page",
+    "chi2_text": "plots",
     "fit_words": "page",
     "move_text": "page",
 }

@@ -4,8 +4,9 @@ The form holds exactly what an effect file holds (analysis.effects.user): id, ti
 physics and the parameters with their unit, start and bounds. Every change is turned into the file's
 text and read back by the same checks the command line uses, so the dialog says the same one line a
 bad file would get. While the effect is valid, its signature on the current data is drawn beside the
-misfit the current version leaves (analysis.effect_preview): the user sees whether the formula bends
-the model where the data need it. Saving writes ID.toml to the user folder and registers the effect.
+misfit the current version leaves (analysis.effect_preview), in size and in phase: the user sees whether
+the formula bends the model where the data need it. The site starts at the one the diagnosis named.
+Saving writes ID.toml to the user folder and registers the effect.
 """
 from __future__ import annotations
 
@@ -37,23 +38,26 @@ COLUMNS = ("name", "unit", "start", "min", "max")
 CHANGE_COLOUR = "#1f6fb4"
 MISFIT_COLOUR = "#9a9a9a"
 OK_COLOUR, BAD_COLOUR = "#1b6e20", "#8e1b1b"
-CHANNEL_TITLES = {"impedance": "impedance Z", "displacement": "displacement Hx"}
+CHANNEL_TITLES = {"impedance": "Z", "displacement": "Hx"}
 NAMES_HINT = ("Names: s (= jω), w (ω), f (Hz), ws (2π·fs of the fit), j, pi and the parameters below. Functions: "
               + " ".join(FUNCTIONS) + ".")
 
 
 class SignaturePlot(pg.PlotWidget):
-    """One channel: the misfit left (grey points) and what the new effect changes (blue line), size in %."""
+    """One channel, one part: the misfit left (grey points) and what the new effect changes (blue line), as a
+    change of size in % or of phase in degrees. A misfit far from 1 may be almost all phase: both are drawn."""
 
-    def __init__(self, channel: str, parent=None):
+    def __init__(self, channel: str, part: str = "size", parent=None):
         super().__init__(parent=parent, axisItems={"bottom": LogFrequencyAxis("bottom")})
+        self.part = part
         plot = self.getPlotItem()
-        style_plot(plot, "change of size (%)", bottom="frequency (Hz)")
+        style_plot(plot, "change of size (%)" if part == "size" else "change of phase (°)", bottom="frequency (Hz)")
         plot.setMenuEnabled(False)
         plot.getAxis("left").enableAutoSIPrefix(False)
-        plot.setTitle(f"{CHANNEL_TITLES.get(channel, channel)}: <span style='color:{MISFIT_COLOUR}'>● misfit now</span>"
-                      f" &nbsp; <span style='color:{CHANGE_COLOUR}'>━ the new effect at its start values</span>",
-                      size="9pt")
+        # Short: two plots share the width, and a title wider than its plot pushes the plot out of view.
+        plot.setTitle(f"{CHANNEL_TITLES.get(channel, channel)}, {part}: "
+                      f"<span style='color:{MISFIT_COLOUR}'>● misfit</span>"
+                      f" <span style='color:{CHANGE_COLOUR}'>━ new effect</span>", size="9pt")
         plot.addItem(pg.InfiniteLine(pos=0.0, angle=0, movable=False, pen=pg.mkPen(style.GUIDE, width=1)))
         self.misfit = pg.PlotDataItem(pen=None, symbol="o", symbolSize=3, symbolPen=None,
                                       symbolBrush=pg.mkBrush(MISFIT_COLOUR))
@@ -61,18 +65,26 @@ class SignaturePlot(pg.PlotWidget):
         plot.addItem(self.misfit)
         plot.addItem(self.change)
 
+    def _shown(self, x: np.ndarray) -> np.ndarray:
+        """x (a ratio less 1) as this plot shows it; the phase of a magnitude-only misfit is unknown (NaN)."""
+        if self.part == "size":
+            return 100.0 * (np.abs(1.0 + x) - 1.0)
+        if not np.iscomplexobj(x):
+            return np.full(len(x), np.nan)
+        return np.degrees(np.angle(1.0 + x))
+
     def draw(self, freqs: np.ndarray, misfit: np.ndarray, change: np.ndarray | None) -> None:
-        """The misfit left and the effect's change (None: not drawn), as changes of size in %."""
-        size = lambda x: 100.0 * (np.abs(1.0 + x) - 1.0)
-        self.misfit.setData(freqs, size(misfit))
-        self.change.setData(freqs, size(change) if change is not None else np.full(len(freqs), np.nan),
+        """The misfit left and the effect's change (None: not drawn)."""
+        self.misfit.setData(freqs, self._shown(misfit), connect="finite")
+        self.change.setData(freqs, self._shown(change) if change is not None else np.full(len(freqs), np.nan),
                             connect="finite")
 
 
 class NewEffectDialog(QDialog):
     saved = Signal(object)          # the UserEffect, once written to the user folder and registered
 
-    def __init__(self, fit: FitResult | None = None, folder: Path | None = None, parent=None):
+    def __init__(self, fit: FitResult | None = None, folder: Path | None = None, parent=None,
+                 site: Site | None = None):
         super().__init__(parent)
         self.setWindowTitle("New effect")
         self.fit = fit
@@ -89,9 +101,10 @@ class NewEffectDialog(QDialog):
         self.title_edit = QLineEdit()
         self.title_edit.setPlaceholderText("what it is, in a few words")
         self.site_combo = QComboBox()
-        for site, key in SITE_KEYS.items():
-            self.site_combo.addItem(f"{key}: {UNITS_AT_SITE[site]}", key)
-        self.site_combo.setCurrentIndex(list(SITE_KEYS).index(Site.MECHANICAL))
+        for each, key in SITE_KEYS.items():
+            self.site_combo.addItem(f"{key}: {UNITS_AT_SITE[each]}", key)
+        # The site the diagnosis named, when there is one: that is where the user is writing an effect for.
+        self.site_combo.setCurrentIndex(list(SITE_KEYS).index(site or Site.MECHANICAL))
         self.formula_edit = QLineEdit()
         mono = QFont("monospace")
         mono.setStyleHint(QFont.TypeWriter)
@@ -135,13 +148,18 @@ class NewEffectDialog(QDialog):
         left.addLayout(buttons_row)
         left.addWidget(self.status)
 
-        self.plots = {name: SignaturePlot(name) for name in (fit.channels if fit is not None else ())}
+        channels = tuple(fit.channels) if fit is not None else ()
+        self.plots = {name: SignaturePlot(name) for name in channels}
+        self.phase_plots = {name: SignaturePlot(name, "phase") for name in channels}
         right = QVBoxLayout()
         self.preview_note = QLabel()
         self.preview_note.setWordWrap(True)
         right.addWidget(self.preview_note)
-        for plot in self.plots.values():
-            right.addWidget(plot, 1)
+        for name in channels:           # size and phase side by side, a row per channel
+            row = QHBoxLayout()
+            row.addWidget(self.plots[name], 1)
+            row.addWidget(self.phase_plots[name], 1)
+            right.addLayout(row, 1)
         if fit is None:
             self.preview_note.setText("Open a recording to see the new effect's signature on its data.")
 
@@ -227,7 +245,8 @@ class NewEffectDialog(QDialog):
             channels = None
         if channels is None:
             for name, ch in self.fit.channels.items():
-                self.plots[name].draw(ch.freqs, channel_misfit(ch), None)
+                for plots in (self.plots, self.phase_plots):
+                    plots[name].draw(ch.freqs, channel_misfit(ch), None)
             if effect is None:
                 self.preview_note.setText("The misfit of the current version; the new effect's change is drawn "
                                           "over it once the form reads as a valid effect.")
@@ -235,7 +254,8 @@ class NewEffectDialog(QDialog):
         self.preview_note.setText(f"What {effect.id} changes at its start values (the rest at the current version's "
                                   f"fit, {self.fit.model.describe()}), over the misfit that version leaves.")
         for ch in channels:
-            self.plots[ch.channel].draw(ch.freqs, ch.misfit, ch.change)
+            for plots in (self.plots, self.phase_plots):
+                plots[ch.channel].draw(ch.freqs, ch.misfit, ch.change)
 
     # -- buttons -------------------------------------------------------------
     @Slot()

@@ -23,11 +23,12 @@ from analysis.errors import LinparError
 from analysis.fit.least_squares import FitData
 from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
+from analysis.diagnosis.refit_words import refit_text
 from app.job_controls import JobControls
 from app.lab_worker import DiagnosisOutcome, LabFit, LabWorker
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
-from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel, chi2_text
+from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
 from app.model_lab.sites import SitePanel
 from app.model_lab.versions import LabVersion, changed_model, move_text
 from app.parameter_table import titled_parameter_table
@@ -257,10 +258,18 @@ class ModelLab(QWidget):
     def on_new_effect(self) -> None:
         """The "New effect…" dialog, previewing on the current version; a saved effect joins the catalogue."""
         from app.model_lab.new_effect import NewEffectDialog
-        dialog = NewEffectDialog(self.current.fitted.fit if self.current is not None else None, parent=self)
+        dialog = NewEffectDialog(self.current.fitted.fit if self.current is not None else None, parent=self,
+                                 site=self._diagnosed_site())
         dialog.saved.connect(self.on_effect_saved)
         self.new_effect_dialog = dialog
         dialog.open()
+
+    def _diagnosed_site(self):
+        """The site the diagnosis of the current version named first (None: no diagnosis, or no site needed)."""
+        if self.diagnosis is None or self.current is None or self.diagnosis_version != self.current.number:
+            return None
+        sites = self.diagnosis.sites
+        return sites[0].site if sites and self.site_panel.shown_site else None
 
     @Slot(object)
     def on_effect_saved(self, effect) -> None:
@@ -309,8 +318,7 @@ class ModelLab(QWidget):
     def on_refit_finished(self, fitted: LabFit) -> None:
         old = self.current
         self._add_version(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
-        self.status_label.setText(f"Refitted: reduced χ² {chi2_text(old.fitted.fit.chi2_red_by_channel())} → "
-                                  f"{chi2_text(fitted.fit.chi2_red_by_channel())}")
+        self.status_label.setText(refit_text(old.fitted.fit, fitted.fit))
 
     def on_diagnosis_finished(self, outcome: DiagnosisOutcome, follow: bool = False) -> None:
         start = self.current.number

@@ -324,6 +324,10 @@ def test_physics_the_catalogue_lacks_ends_unexplained_with_the_site_and_its_corr
     hump = freqs[seen][np.argmax(added[seen])]
     assert 100 < hump < 500 and np.max(added[seen]) > 0.03         # the odd damping: 0.15 kg/s around 250 Hz
     assert "compliance" in lab.site_panel.ranking.text()
+    # The New effect... dialog opens at that site.
+    qtbot.mouseClick(lab.catalogue.new_effect_button, Qt.LeftButton)
+    assert lab.new_effect_dialog.site_combo.currentData() == "mechanical"
+    lab.new_effect_dialog.reject()
 
 
 def test_a_flagged_candidate_is_not_offered_and_the_button_says_how_to_try_it(qtbot, make_lab,

@@ -123,3 +123,28 @@ def test_bad_files_of_the_user_folder_are_said_in_the_branch(qtbot, lab):
     head = lab.catalogue.user_head
     texts = [head.child(i).text(0) + " " + head.child(i).text(1) for i in range(head.childCount())]
     assert any("1 file(s) not read" in text and "bad.toml: site" in text for text in texts)
+
+
+def test_the_preview_has_a_phase_panel_beside_the_size_one(qtbot, lab):
+    dialog = _open_dialog(qtbot, lab)
+    _write(qtbot, dialog, "r * (sqrt(w / ws) - 1)")
+    assert set(dialog.phase_plots) == {"impedance", "displacement"}
+    size_plot, phase_plot = dialog.plots["impedance"], dialog.phase_plots["impedance"]
+    assert size_plot.isVisible() and phase_plot.isVisible()
+    left = lambda widget: widget.mapToGlobal(widget.rect().topLeft()).x()
+    assert left(phase_plot) > left(size_plot)          # beside it, on its right
+    _, change = phase_plot.change.getData()
+    _, misfit = phase_plot.misfit.getData()
+    # Damping rising with frequency turns Z's phase near fs: a change in degrees, and a misfit the same.
+    assert np.isfinite(change).all() and np.abs(change).max() > 0.1
+    assert np.isfinite(misfit).all() and np.abs(misfit).max() > 0.1
+
+
+def test_the_site_starts_at_the_one_the_diagnosis_named(qtbot, rms_result):
+    from analysis.effects.base import Site
+    dialog = NewEffectDialog(rms_result.fit, site=Site.DISPLACEMENT)
+    qtbot.addWidget(dialog)
+    assert dialog.site_combo.currentData() == "displacement"
+    plain = NewEffectDialog(rms_result.fit)
+    qtbot.addWidget(plain)
+    assert plain.site_combo.currentData() == "mechanical"
