@@ -46,13 +46,18 @@ def rig_file_check(items) -> None:
                            f"name its fixture virtual_rig or mark its tests with pytest.mark.rig")
 
 
+def unit_of(nodeid: str, rootpath: Path) -> str:
+    """The unit of work a test belongs to: its file, or RIG_UNIT."""
+    path = nodeid.split("::", 1)[0]
+    return RIG_UNIT if is_rig_file(str(rootpath / path)) else path
+
+
 def make_scheduler(config, log):
     """xdist's loadfile, with every rig file in one unit."""
     from xdist.scheduler import LoadFileScheduling
 
     class FilesAndTheRig(LoadFileScheduling):
         def _split_scope(self, nodeid: str) -> str:
-            path = nodeid.split("::", 1)[0]
-            return RIG_UNIT if is_rig_file(str(Path(config.rootpath) / path)) else path
+            return unit_of(nodeid, Path(config.rootpath))
 
     return FilesAndTheRig(config, log)
