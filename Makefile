@@ -21,8 +21,11 @@ $(STAMP): pyproject.toml
 run: setup
 	@bash tools/run-gui.sh
 
+# Two worker processes (pytest-xdist): a test file stays in one worker, the JACK rig's tests all in one
+# (tests/scheduling.py). TEST_WORKERS=0 runs the tests in this process, one after another.
+TEST_WORKERS ?= 2
 test: setup
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q tests
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile tests
 
 bench: setup
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench

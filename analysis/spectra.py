@@ -127,6 +127,25 @@ def detect_excited_bins(voltage: ChannelSpectrum) -> np.ndarray:
     return bins
 
 
+def excited_lines(recording: Recording, voltage: ChannelSpectrum | None = None) -> np.ndarray:
+    """The excitation's bins, sorted: the sidecar's when it lists them, else found in the voltage spectrum.
+
+    The format makes the list optional (a recording made by a DAQ or a script has none). `voltage`: the
+    voltage's averaged spectrum when the caller has it already. SpectrumError when no line is found.
+    """
+    if recording.excited_bins is not None:
+        excited = np.asarray(recording.excited_bins, dtype=np.int64)
+    else:
+        if voltage is None:
+            if recording.signal("voltage") is None:
+                raise SpectrumError("the recording has no 'voltage' channel: its excited lines are found there")
+            voltage = ChannelSpectrum("voltage", "V", *_mean_and_var(period_spectra(recording.periods("voltage"))))
+        excited = detect_excited_bins(voltage)
+    if excited.size == 0:
+        raise SpectrumError("no excited line found in the voltage spectrum")
+    return np.sort(excited)
+
+
 def pooling_window(n_periods: int) -> int:
     """Lines pooled for each noise estimate, so that it rests on >= MIN_NOISE_DOF degrees of freedom."""
     dof = 2 * (n_periods - 1)
@@ -209,13 +228,7 @@ def estimate_spectra(recording: Recording) -> Spectra:
         channels[ch.signal] = ChannelSpectrum(ch.signal, ch.unit, mean, var_mean)
         per_period[ch.signal] = spec
 
-    if recording.excited_bins is not None:
-        excited = np.asarray(recording.excited_bins, dtype=np.int64)
-    else:
-        excited = detect_excited_bins(channels["voltage"])
-    if excited.size == 0:
-        raise SpectrumError("no excited line found in the voltage spectrum")
-    excited = np.sort(excited)
+    excited = excited_lines(recording, channels["voltage"])
     span = np.arange(excited[0], excited[-1] + 1)
     unexcited = np.setdiff1d(span, excited, assume_unique=True)
 

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import os
 import shutil
+import sys
+from collections import Counter
 
 import pytest
 
@@ -134,3 +136,47 @@ def pytest_runtest_teardown(item):
     gui_gc = sys.modules.get("app.gui_gc")
     if gui_gc is not None:
         gui_gc.collect_if_due()
+
+
+# --- make test runs the tests in worker processes (pytest-xdist, --dist loadfile; tests/scheduling.py) ----------
+
+def pytest_collection_modifyitems(items):
+    from tests.scheduling import rig_file_check
+    rig_file_check(items)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """--dist loadfile with the JACK rig's files as one unit (tests/scheduling.py); any other mode is xdist's."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from tests.scheduling import make_scheduler
+    return make_scheduler(config, log)
+
+
+# --- the CLI's outcomes on hostile input (tests/reliability/cli_outcome.py), summed over the workers ----------
+
+_WORKERS_OUTCOMES: Counter = Counter()
+
+
+def _outcomes_here() -> Counter:
+    module = sys.modules.get("tests.reliability.cli_outcome")
+    return Counter(module.OUTCOMES) if module else Counter()
+
+
+def pytest_sessionfinish(session):
+    if hasattr(session.config, "workeroutput"):         # an xdist worker: its counts go to the controller
+        session.config.workeroutput["cli_outcomes"] = dict(_outcomes_here())
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    _WORKERS_OUTCOMES.update(getattr(node, "workeroutput", {}).get("cli_outcomes", {}))
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The fuzz suites' outcome counts, at the end of the run (issues ask for them in their closing notes)."""
+    outcomes = _outcomes_here() + _WORKERS_OUTCOMES
+    if outcomes:
+        counts = ", ".join(f"{n} x {kind}" for kind, n in sorted(outcomes.items()))
+        terminalreporter.write_line(f"linpar runs on hostile input: {sum(outcomes.values())} ({counts})")

@@ -1,7 +1,9 @@
 """What a large-signal identification reads from a recording: its periods of u, i and x, and their bands.
 
 Each recording gives its analysed periods (P x N) of voltage, current and
-displacement, and the frequencies at which each equation is trusted:
+displacement, the excitation's lines (the sidecar's, or found in the voltage
+spectrum as the linear analysis finds them: the format makes the list
+optional), and the frequencies at which each equation is trusted:
 
 - both equations from the first bin to the highest excited line (the
   excitation's band; beyond it there is only noise), and no higher than
@@ -32,6 +34,7 @@ import numpy as np
 
 from analysis.errors import LinparError
 from analysis.recording.format import MIN_PERIODS, Recording
+from analysis.spectra import SpectrumError, excited_lines
 
 
 class LargeSignalError(LinparError, ValueError):
@@ -78,15 +81,15 @@ def recording_data(recording: Recording, label: str | None = None) -> RecordingD
     if recording.n_periods < MIN_PERIODS:
         raise LargeSignalError(f"{name}: {recording.n_periods} analysed period(s); at least {MIN_PERIODS} are "
                                f"needed for the noise of each line")
-    if recording.excited_bins is None or len(recording.excited_bins) == 0:
-        raise LargeSignalError(f"{name}: the sidecar lists no excited lines; a large-signal identification "
-                               f"needs the multitone's lines (a recording made by linpar has them)")
     u, i, x = (np.array(recording.periods(s), dtype=np.float64) for s in ("voltage", "current", "displacement"))
     for signal, values in (("voltage", u), ("current", i), ("displacement", x)):
         if not np.all(np.isfinite(values)):
             raise LargeSignalError(f"{name}: the {signal} holds samples that are not finite numbers")
     n = recording.period_samples
-    excited = np.sort(np.asarray(recording.excited_bins, dtype=np.int64))
+    try:
+        excited = excited_lines(recording)
+    except SpectrumError as exc:
+        raise LargeSignalError(f"{name}: {exc}") from None
     top = int(excited[-1])
     bin_width = recording.sample_rate / n
     x_max_hz = _displacement_max_hz(recording)

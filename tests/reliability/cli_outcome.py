@@ -2,8 +2,8 @@
 one line, and never a traceback or a crash report.
 
 `outcome(capsys, argv)` runs app.cli.main, checks the rule and counts the outcome in OUTCOMES (printed at
-the end of the session by tests/reliability/conftest.py, for the issue's closing note). The one other exit
-a command gives on purpose is `analyze --limits`'s verdict: 1 for a driver that fails its limits, 2 with
+the end of the session by tests/conftest.py, summed over the workers, for the issue's closing note). The one
+other exit a command gives on purpose is `analyze --limits`'s verdict: 1 for a driver that fails its limits, 2 with
 the JSON (or the table) when the measurement cannot be judged.
 """
 from __future__ import annotations

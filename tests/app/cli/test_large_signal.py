@@ -2,13 +2,15 @@
 from __future__ import annotations
 
 import json
+import shutil
 
 import numpy as np
 import pytest
 
-from analysis.recording.format import make_recording, write_recording
+from analysis.recording.format import make_recording, read_recording, write_recording
+from analysis.spectra import excited_lines
 from app.cli import main
-from tests.large_signal_truth import KNOWN_OFFSET_M, write_steps
+from tests.large_signal_truth import KNOWN_OFFSET_M, known_driver, write_steps
 
 
 @pytest.fixture(scope="module")
@@ -73,6 +75,31 @@ def test_the_report_and_the_curves_are_written_and_never_over_an_input(recording
     before = sidecar.read_bytes()
     code, _, err = run(["large-signal", str(paths[1]), "--csv", str(sidecar)], capsys)
     assert code == 2 and "an input of this command" in err and sidecar.read_bytes() == before
+
+
+def test_a_sidecar_without_its_lines_gives_the_same_curves_from_the_lines_found(recordings, capsys, tmp_path):
+    """The format's minimal sidecar lists no excitation.excited_bins: the lines are found in the voltage spectrum
+    (analysis.spectra, as for the linear analysis), and the identification is the one with the lines listed."""
+    _, paths = recordings
+    listed = paths[1]
+    sidecar = json.loads(listed.with_suffix(".json").read_text())
+    bins = sidecar["excitation"].pop("excited_bins")
+    minimal = tmp_path / listed.name
+    shutil.copyfile(listed, minimal)
+    minimal.with_suffix(".json").write_text(json.dumps(sidecar))
+    assert excited_lines(read_recording(minimal)).tolist() == sorted(bins)
+    docs = []
+    for path in (listed, minimal):
+        code, out, err = run(["large-signal", str(path), "--json"], capsys)
+        assert code == 0, err
+        docs.append(json.loads(out))
+    with_lines, found = docs
+    assert found["offset_m"] == with_lines["offset_m"] == pytest.approx(KNOWN_OFFSET_M, abs=1e-4)
+    for name in ("Bl", "Kms", "Le"):
+        assert found["curves"][name] == with_lines["curves"][name], name
+    bl0 = np.polynomial.polynomial.polyval(0.0, found["curves"]["Bl"]["coefficients"])
+    assert bl0 == pytest.approx(known_driver(8192).values["Bl"], rel=0.01)
+    assert found["validity"]["verdict"] == with_lines["validity"]["verdict"]
 
 
 def test_bad_input_is_one_line_and_exit_2(recordings, capsys, tmp_path):
