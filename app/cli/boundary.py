@@ -49,7 +49,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _check_encoding(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(argv)
         with size_limits_set(**dict(args.size_limit)):
-            if args.command in effects.COMMANDS:
+            if effects.builds_models(args):
                 effects.load(args)      # a bad effect file stops every command that builds models: one line
             return args.run(args)
     except KeyboardInterrupt:
