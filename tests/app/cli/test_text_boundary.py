@@ -19,7 +19,7 @@ from analysis.effects.user import EffectFileError, effect_from_text
 from app.cli import main
 from tests.production_helpers import LIMITS, small_measurement, unit
 
-EFFECT = Path(__file__).parents[1] / "resources" / "effects" / "rms-sqrt-f.toml"
+EFFECT = Path(__file__).resolve().parents[3] / "resources" / "effects" / "rms-sqrt-f.toml"
 HOSTILE = ("A\tB", "A\nB", "A\x1b]0;owned\x07B", "A\x85B", "A\u2028B", "A\x00B")
 
 

@@ -13,7 +13,7 @@ import pytest
 
 from instruments.rig.state import RigPaths, pid_alive, read_pid
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 @pytest.mark.timeout(300)

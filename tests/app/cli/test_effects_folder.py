@@ -6,7 +6,7 @@ import pytest
 
 from app.cli import main
 
-EXAMPLE = Path(__file__).parents[1] / "resources" / "effects" / "rms-sqrt-f.toml"
+EXAMPLE = Path(__file__).resolve().parents[3] / "resources" / "effects" / "rms-sqrt-f.toml"
 
 
 def run(capsys, *argv):
