@@ -25,6 +25,8 @@ from analysis.errors import LinparError
 
 # Below this a file is read into memory; above it, memory-mapped.
 MAP_FROM_BYTES = 16 * 1024 * 1024
+# What a file that grew while being read is read on in.
+GROWTH_CHUNK = 1024 * 1024
 
 
 def _what_it_is(mode: int) -> str | None:
@@ -66,14 +68,22 @@ def regular_file(path: str | Path, kind: str, what: str, error: type[LinparError
 
 def read_bytes(path: str | Path, kind: str, what: str, error: type[LinparError]) -> bytes:
     """The bytes of a regular file within its size limit (see regular_file)."""
-    regular_file(path, kind, what, error)
+    size = regular_file(path, kind, what, error)
+    limit = size_limit(kind)
     try:
         with open(path, "rb") as f:
-            # Read one byte more than the limit: a file that grew since the check is still refused.
-            data = f.read(size_limit(kind) + 1)
+            # Ask for the file's size and one byte, not the limit: read(limit + 1) makes the OS reserve the
+            # whole limit (2 GiB for a recording) for every small file, which Windows commits. A file that
+            # grew since the check is read on in chunks, and refused past the limit.
+            data = f.read(size + 1)
+            while len(data) > size and len(data) <= limit:
+                more = f.read(min(GROWTH_CHUNK, limit + 1 - len(data)))
+                if not more:
+                    break
+                data += more
     except OSError as exc:
         raise error(f"{path}: cannot be read ({exc.strerror or exc}), expected {what}") from None
-    if len(data) > size_limit(kind):
+    if len(data) > limit:
         raise error(f"{path}: grew beyond the limit of {describe_size(size_limit(kind))} while being read")
     return data
 

@@ -42,6 +42,7 @@ from analysis.errors import LinparError
 from analysis.files import read_text
 from analysis.fit.error import FIT_ERROR_DEFAULTS
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN
+from analysis.text_boundary import control_found
 
 if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file
     from analysis.derived import ParameterValue
@@ -200,6 +201,12 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
     if not isinstance(params, dict) or not params:
         fail(_line_of(text, "parameters"), "parameters", "expected an object of parameter limits, "
                                                          "e.g. {\"RE\": {\"nominal\": 3.0, \"tolerance\": \"5%\", \"unit\": \"ohm\"}}")
+    name = doc.get("name")
+    if name is not None:
+        # The name is copied into every judged measurement's record, reports and terminals: one line of text.
+        what = control_found(name) if isinstance(name, str) else f"a {type(name).__name__}"
+        if what:
+            fail(_line_of(text, "name"), "name", f"holds {what}; expected one line of text")
     units = parameter_units()
     start = text.find('"parameters"')
     limits = []

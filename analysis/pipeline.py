@@ -30,6 +30,7 @@ from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.model.composed import Model, ModelError
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
+from analysis.validity.plausibility import plausibility_findings
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
 from analysis.validity.fit import FitChannels, fit_channels, misfit_findings
@@ -64,6 +65,15 @@ def require_fit(result: AnalysisResult, doing: str = "") -> FitResult:
         return result.fit
     where = f"{result.source}: " if result.source is not None else ""
     raise NotAnalysable(f"{where}{'cannot ' + doing + ': ' if doing else ''}{result.not_fitted}")
+
+
+def merged(*findings: dict) -> dict:
+    """Findings by channel from several checks, in one mapping."""
+    out: dict = {}
+    for by_channel in findings:
+        for channel, found in by_channel.items():
+            out.setdefault(channel, []).extend(found)
+    return out
 
 
 def default_effects() -> tuple[Effect, ...]:
@@ -126,11 +136,13 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     if corrected is not spectra:        # the noise estimate was the drift's: fit again on the honest one
         spectra = corrected
         fit = fit_model(FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
-    judged = validity.with_findings(misfit_findings(fit)).as_json()
+    parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
+    # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
+    implausible = plausibility_findings(recording, spectra, parameters, sd, validity.peak_displacement_m)
+    judged = validity.with_findings(merged(misfit_findings(fit), implausible)).as_json()
     judged["fit_error_percent"] = fit_error_percent(fit)       # what QA judges the model's misfit by
     if heating is not None:
         judged["heating"] = heating.as_json()
-    parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
     return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged)
 
 

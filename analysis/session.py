@@ -12,16 +12,16 @@ export shows the same lines.
 """
 from __future__ import annotations
 
-import re
 from datetime import datetime, timezone
 from importlib import metadata
 from typing import Any, Mapping
+
+from analysis.text_boundary import cleaned
 
 SESSION_KEY = "session"
 SESSION_FIELDS = ("operator", "station", "template", "measured_at", "software")
 # The header every report and export carries, in this order.
 HEADER_KEYS = ("driver", "serial", "measured_at", "operator", "station", "template", "software")
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 MAX_TEXT = 200
 
 
@@ -49,7 +49,7 @@ def _text(value: Any) -> str:
     """One line of text from a file's value, or '' when it is not a string (a file is never trusted)."""
     if not isinstance(value, str):
         return ""
-    return _CONTROL.sub(" ", value).strip()[:MAX_TEXT]
+    return cleaned(value, MAX_TEXT)
 
 
 def session_of(recording) -> dict:

@@ -64,7 +64,8 @@ def write_crash_report(exc: BaseException, doing: str = "", argv: Sequence[str] 
         path = folder / f"{PREFIX}{now:%Y%m%d-%H%M%S}-{os.getpid()}{f'-{attempt}' if attempt else ''}.txt"
         try:
             # "x": never overwrite another report (two jobs of the GUI may fail in the same second).
-            with open(path, "x", encoding="utf-8") as f:
+            # backslashreplace: a command line of bytes that were not UTF-8 is written, not lost mid-file.
+            with open(path, "x", encoding="utf-8", errors="backslashreplace") as f:
                 f.write(text)
             return path
         except FileExistsError:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from PySide6.QtCore import QTimer, Signal, Slot
+from PySide6.QtCore import Qt, QTimer, Signal, Slot
 from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTabWidget
 
 from app import style
@@ -108,6 +108,7 @@ class MainWindow(QMainWindow):
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
         self.status_label = QLabel("No recording loaded")
+        self.status_label.setTextFormat(Qt.PlainText)      # it shows file names: a name is never markup
         bar.addWidget(self.status_label, 1)
         # The analysis of an opened recording: its stage, a busy indicator and Cancel.
         self.jobs = JobControls(self.worker, cancel_tip="Stop the analysis; the results shown so far stay",

@@ -112,6 +112,7 @@ class QAView(QWidget):
         self.worker = JobRunner(self, max_threads=1)     # one report at a time
 
         self.source = QLabel("No result yet: measure a driver, or open a recording.")
+        self.source.setTextFormat(Qt.PlainText)             # a recording's file name is never markup
         self.source.setWordWrap(True)
         self.overall_light = TrafficLight(96)
         self.overall_text = QLabel()
@@ -136,6 +137,7 @@ class QAView(QWidget):
         header.setSectionResizeMode(2, QHeaderView.Stretch)
         self.export_button = QPushButton("Export report…")
         self.export_label = QLabel()
+        self.export_label.setTextFormat(Qt.PlainText)       # paths and messages that quote them
         self.export_label.setWordWrap(True)
         self.export_jobs = JobControls(self.worker, cancel_tip="Stop writing the report: nothing is written",
                                        bar_width=160)

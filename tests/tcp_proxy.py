@@ -6,6 +6,7 @@
 """
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 
@@ -16,6 +17,8 @@ class TcpProxy:
         self._lock = threading.Lock()
         self._open: set[socket.socket] = set()
         self._listener: socket.socket | None = None
+        self._kept: list[socket.socket] = []    # the server's sides cut_station_side left open and silent
+        self._upstream: set[socket.socket] = set()      # the server's side of each connection
         self.port = 0
         self.restore()
 
@@ -43,6 +46,26 @@ class TcpProxy:
 
     close = cut
 
+    def cut_station_side(self) -> None:
+        """A cable pulled at the station: its side of every open connection is dropped, the server's side is
+        left open and silent, so the server keeps the session (and its open transaction) until its own
+        timeouts end it. New connections are refused until restore()."""
+        with self._lock:
+            listener, self._listener = self._listener, None
+            sockets, self._open = self._open, set()
+            self._kept += [s for s in sockets if s in self._upstream]
+        if listener is not None:
+            with contextlib.suppress(OSError):
+                listener.shutdown(socket.SHUT_RDWR)     # wakes the accepting thread, so the port is free at once
+            listener.close()
+        for s in sockets:
+            if s not in self._kept:
+                try:
+                    s.shutdown(socket.SHUT_RDWR)        # wakes the pumps; the station reads the end
+                except OSError:
+                    pass
+                s.close()
+
     def _accept(self, listener: socket.socket) -> None:
         while True:
             try:
@@ -61,6 +84,7 @@ class TcpProxy:
                     upstream.close()
                     return
                 self._open |= {client, upstream}
+                self._upstream.add(upstream)
             for a, b in ((client, upstream), (upstream, client)):
                 threading.Thread(target=self._pump, args=(a, b), daemon=True).start()
 
@@ -70,6 +94,8 @@ class TcpProxy:
                 sink.sendall(data)
         except OSError:
             pass
+        if source in self._kept or sink in self._kept:
+            return          # the server is not told: its side stays open, as behind a pulled cable
         for s in (source, sink):
             try:
                 s.shutdown(socket.SHUT_RDWR)

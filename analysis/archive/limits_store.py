@@ -18,6 +18,7 @@ from typing import Any, Mapping
 
 from analysis.archive.names import ArchiveError
 from analysis.archive.record import one_line_text
+from analysis.text_boundary import shown
 
 VERSION_FORMAT = "linpar-limits-version/1"
 MAX_NOTE = 2000
@@ -69,8 +70,12 @@ def version_of_json(doc: Any, where: str) -> LimitsVersion:
     version = doc.get("version")
     if isinstance(version, bool) or not isinstance(version, int) or version < 1:
         raise ArchiveError(f"{where}: version: expected a whole number from 1")
+    stored = doc.get("limits")
+    if isinstance(stored, dict) and isinstance(stored.get("name"), str):
+        # A name stored before linpar refused control characters in it: shown escaped, the version still usable.
+        stored = {**stored, "name": shown(stored["name"])}
     try:
-        document, name = checked_document(doc.get("limits"), f"{where}: limits")
+        document, name = checked_document(stored, f"{where}: limits")
     except ValueError as exc:       # LimitsError
         raise ArchiveError(str(exc)) from None
     return LimitsVersion(version, name, document, one_line_text(doc.get("note", ""), f"{where}: note"),

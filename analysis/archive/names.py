@@ -15,13 +15,13 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from analysis.errors import LinparError
+from analysis.text_boundary import cleaned
 
 ID_PATTERN = re.compile(r"^\d{8}-\d{6}-[0-9a-f]{6}$")
 # What a user may type for an id: its leading part (a unique prefix selects).
 ID_PREFIX_PATTERN = re.compile(r"^[0-9a-f-]{1,22}$")
 SLUG_MAX = 40
 _NOT_SLUG = re.compile(r"[^a-z0-9]+")
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
 
 
 class ArchiveError(LinparError, RuntimeError):
@@ -65,7 +65,7 @@ def clean_text(value, field: str, max_len: int = 200) -> str:
         return ""
     if not isinstance(value, str):
         raise ArchiveError(f"meta.{field}: expected text, found {type(value).__name__}")
-    return _CONTROL.sub(" ", value).strip()[:max_len]
+    return cleaned(value, max_len)     # the class every reader of a record checks (analysis.text_boundary)
 
 
 def inside(root: Path, relative: str) -> Path:

@@ -19,7 +19,6 @@ skipped, never printed as it is.
 from __future__ import annotations
 
 import json
-import re
 from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import Any
 from analysis.archive.names import ArchiveError, check_id
 from analysis.bounds import PARAMETER, SD, YEAR
 from analysis.files import read_text
+from analysis.text_boundary import CONTROL, one_line, shown
 
 RECORD_FORMAT = "linpar-measurement/1"
 RECORD_FILE = "measurement.json"
@@ -35,7 +35,6 @@ TEXT_FIELDS = ("driver", "serial", "operator", "station")
 VALIDITY_STATES = ("green", "yellow", "red", "unknown")
 # analysis.limits.judge_result's verdicts: each stored verdict names the limits version that judged it.
 QA_VERDICTS = ("pass", "fail", "invalid", "not judged")
-_CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
 @dataclass(frozen=True)
@@ -84,12 +83,7 @@ def checked_qa(verdict, version, where: str) -> tuple[str | None, int | None]:
 
 def one_line_text(value, where: str) -> str:
     """A string without control characters (line breaks, NUL, escapes): it is printed on one line."""
-    if not isinstance(value, str):
-        raise ArchiveError(f"{where}: found {type(value).__name__}, expected a string")
-    bad = _CONTROL.search(value)
-    if bad:
-        raise ArchiveError(f"{where}: holds the control character {bad.group()!r}: expected one line of text")
-    return value
+    return one_line(value, where, ArchiveError)
 
 
 def iso_date(value, where: str) -> str:
@@ -143,8 +137,52 @@ def checked_entry(values: dict[str, Any], where: str) -> dict[str, Any]:
     return values
 
 
+def _flagged_text(holder: dict, key, where: str, flags: list[str]) -> None:
+    """holder[key] with refused characters shown visibly (\\t, \\x1b), and a flag saying so: a name that
+    broke the rule when it was stored (by an older linpar, or another program) is shown, never dropped."""
+    value = holder.get(key) if isinstance(holder, dict) else None
+    if isinstance(value, str) and CONTROL.search(value):
+        holder[key] = shown(value)
+        flags.append(f"{where} held characters that are not text; shown escaped: {holder[key][:60]}")
+
+
+def _flagged_number(holder: dict, key, where: str, bound, flags: list[str]) -> None:
+    """holder[key] set to None, with a flag, when it is not a number within `bound`."""
+    if not isinstance(holder, dict) or holder.get(key) is None:
+        return
+    try:
+        bound.check(holder[key], where, ArchiveError)
+    except ArchiveError as exc:
+        holder[key] = None
+        flags.append(f"{exc}; not shown")
+
+
+def _flag_bad_values(doc: dict) -> list[str]:
+    """The record's names and numbers that would make it unreadable, made readable; what was changed."""
+    flags: list[str] = []
+    for key in (*TEXT_FIELDS, "notes"):
+        _flagged_text(doc, key, key, flags)
+    if isinstance(doc.get("qa"), dict):
+        _flagged_text(doc["qa"], "limits_name", "qa.limits_name", flags)
+    if isinstance(doc.get("effects"), list):
+        for i in range(len(doc["effects"])):
+            _flagged_text(doc["effects"], i, f"effects[{i}]", flags)
+    params = doc.get("key_parameters")
+    if isinstance(params, dict):
+        for name, p in params.items():
+            for key in ("value", "std"):
+                _flagged_number(p, key, f"key_parameters.{shown(str(name))}.{key}", PARAMETER, flags)
+            _flagged_text(p, "unit", f"key_parameters.{shown(str(name))}.unit", flags)
+    _flagged_number(doc, "sd_m2", "sd_m2", SD, flags)
+    return flags
+
+
 def read_record(folder: Path) -> dict:
-    """The checked measurement.json of a folder; ArchiveError naming the file and key otherwise."""
+    """The checked measurement.json of a folder; ArchiveError naming the file and key otherwise.
+
+    A name or number that breaks the rules but does not make the record unusable (the id, the folder,
+    the dates and the files do) is shown flagged: the record's "flags" list says what was changed.
+    """
     path = folder / RECORD_FILE
     text = read_text(path, "archive", "a measurement record (JSON)", ArchiveError)
     try:
@@ -159,6 +197,7 @@ def read_record(folder: Path) -> dict:
         raise ArchiveError(f"{path}: a string holds half of a UTF-16 surrogate pair, expected Unicode text") from None
     if not isinstance(doc, dict) or doc.get("format") != RECORD_FORMAT:
         raise ArchiveError(f"{path}: format: expected {RECORD_FORMAT!r}")
+    flags = _flag_bad_values(doc)
     checked_entry(doc, str(path))
     if doc["folder"] != folder.name:
         raise ArchiveError(f"{path}: folder: {doc['folder']!r} but the file is in {folder.name!r}")
@@ -176,4 +215,7 @@ def read_record(folder: Path) -> dict:
         one_line_text(role, f"{path}: files")
         one_line_text(name, f"{path}: files.{role}")
     doc["sd_m2"] = number_or_null(doc.get("sd_m2"), f"{path}: sd_m2", SD)
+    doc.pop("flags", None)          # what the file says of itself is not a finding
+    if flags:
+        doc["flags"] = flags
     return doc

@@ -46,6 +46,7 @@ from analysis.effects.base import Effect, ParamSpec, Site, SITE_KEYS
 from analysis.effects.formula import RESERVED, Formula, FormulaError, parse_formula
 from analysis.errors import LinparError
 from analysis.model.lumped import resonance_frequency
+from analysis.text_boundary import CONTROL, CONTROL_BUT_NEWLINE, control_found
 
 
 class EffectFileError(LinparError, ValueError):
@@ -60,6 +61,7 @@ REQUIRED = ("id", "title", "site", "formula", "physics")
 OPTIONAL = ("category", "signature", "typical", "reference", "parameters")
 PARAMETER_REQUIRED = ("unit", "start", "min", "max")
 PARAMETER_OPTIONAL = ("description", "typical")
+MULTI_LINE = ("physics", "signature", "typical", "reference", "formula")
 ID_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]*\Z")
 NAME_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 MAX_FILE_BYTES = 64 * 1024
@@ -130,6 +132,10 @@ def _string(doc: dict, key: str, source: str, required: bool = True) -> str:
     value = doc[key]
     if not isinstance(value, str) or not value.strip():
         raise _fail(source, key, "expected a non-empty string")
+    # Titles and ids are printed on one line (terminals, menus); descriptions may span lines, no more.
+    what = control_found(value.strip(), CONTROL_BUT_NEWLINE if key in MULTI_LINE else CONTROL)
+    if what:
+        raise _fail(source, key, f"holds {what}; expected text")
     return value.strip()
 
 
@@ -164,8 +170,8 @@ def _parameter(name: str, table, source: str, taken: dict[str, str]) -> ParamSpe
         if key not in table:
             raise _fail(source, f"{where}.{key}", "missing; a parameter needs unit, start, min and max")
     unit = table["unit"]
-    if not isinstance(unit, str) or not unit.strip():
-        raise _fail(source, f"{where}.unit", "expected a string such as \"kg/s\" or \"1\"")
+    if not isinstance(unit, str) or not unit.strip() or control_found(unit):
+        raise _fail(source, f"{where}.unit", "expected one line of text such as \"kg/s\" or \"1\"")
     lo, hi = _number(table, "min", where, source), _number(table, "max", where, source)
     start = _number(table, "start", where, source)
     if not lo < hi:
@@ -181,8 +187,8 @@ def _parameter(name: str, table, source: str, taken: dict[str, str]) -> ParamSpe
             raise _fail(source, f"{where}.typical", "expected [low, high], two finite numbers, low < high")
         typical = (float(pair[0]), float(pair[1]))
     description = table.get("description", "parameter of the user effect's formula")
-    if not isinstance(description, str):
-        raise _fail(source, f"{where}.description", "expected a string")
+    if not isinstance(description, str) or control_found(description, CONTROL_BUT_NEWLINE):
+        raise _fail(source, f"{where}.description", "expected text without control characters")
     unit = unit.strip()
     return ParamSpec(name, unit, unit, 1.0, lo, hi, start, description, typical)
 
@@ -199,6 +205,9 @@ def effect_from_text(text: str, source: str, taken: dict[str, str] | None = None
     except tomllib.TOMLDecodeError as exc:
         raise EffectFileError(f"{source}: not a TOML file ({exc}); expected key = value lines and "
                               "[parameters.NAME] tables") from None
+    except RecursionError:          # tomllib recurses once per nested array or table
+        raise EffectFileError(f"{source}: nested too deeply to be an effect file; expected key = value lines "
+                              "and [parameters.NAME] tables") from None
     unknown = sorted(set(doc) - set(REQUIRED) - set(OPTIONAL))
     if unknown:
         raise _fail(source, unknown[0], "not a key of an effect file; expected " + ", ".join(REQUIRED)

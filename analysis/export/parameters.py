@@ -25,6 +25,7 @@ from typing import Mapping
 from analysis.archive.results import StoredResult
 from analysis.export.registry import Exporter
 from analysis.session import comment_lines
+from analysis.text_boundary import spreadsheet_cell
 
 JSON_FORMAT = "linpar-parameters/1"
 CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note")
@@ -45,7 +46,7 @@ def parameters_csv(result: StoredResult, header: Mapping | None = None) -> str:
         writer.writerow([p.name, _num(p.value), _num(p.std), p.unit,
                          _num(p.value * p.display_scale) if ok else "",
                          _num(p.std * abs(p.display_scale)) if ok and p.std is not None else "",
-                         p.display_unit, p.reason or ""])
+                         p.display_unit, spreadsheet_cell(p.reason or "")])
     return buf.getvalue()
 
 

@@ -29,6 +29,7 @@ import re
 from dataclasses import dataclass, field
 
 from analysis.errors import LinparError
+from analysis.text_boundary import cleaned, spreadsheet_cell
 
 ENCODING = "cp1252"
 VALID, INVALID, PLACEHOLDER = 0, 129, 255
@@ -42,8 +43,8 @@ _LINE = re.compile(r"^K(\d{4})(?:/(\d+))?(?: (.*))?$")
 
 
 def _text(value, key: str) -> str:
-    text = re.sub(r"[\x00-\x1f\x7f]", " ", str(value)).strip()
-    return text[: LENGTHS.get(key, 255)]
+    # One line per K-field, and no cell a spreadsheet would run as a formula when the .dfq is opened as text.
+    return spreadsheet_cell(cleaned(str(value), 10**6))[: LENGTHS.get(key, 255)]
 
 
 def ascii_unit(unit: str) -> str:

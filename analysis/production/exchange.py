@@ -14,6 +14,7 @@ import csv
 import io
 
 from analysis.session import comment_lines
+from analysis.text_boundary import spreadsheet_cell
 
 CSV_COLUMNS = ("id", "measured_at", "station", "driver", "serial", "operator", "validity", "verdict",
                "limits_version", "parameter", "value", "std", "unit")
@@ -34,8 +35,10 @@ def population_csv(population) -> str:
     writer.writerow(CSV_COLUMNS)
     units = _units(population.values)
     for u, mid in enumerate(population.ids):
-        head = (mid, population.measured_at[u], population.stations[u], population.drivers[u],
-                population.serials[u], population.operators[u], population.validity[u],
+        # Names people typed: never a formula when the QA engineer opens the file in a spreadsheet.
+        head = (mid, population.measured_at[u], *(spreadsheet_cell(t) for t in (
+                population.stations[u], population.drivers[u], population.serials[u], population.operators[u])),
+                population.validity[u],
                 population.verdicts[u] or "", "" if population.limits_versions[u] is None
                 else population.limits_versions[u])
         for name in population.values:

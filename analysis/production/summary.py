@@ -57,10 +57,13 @@ class ProductionStats:
     verdicts_by_version: dict[int, dict[str, int]]
     parameters: dict[str, ParameterStats] = field(default_factory=dict)
 
+    # (units that passed their first test, units whose first test was judged): a retest is not a first pass.
+    first_tests: tuple[int, int] = (0, 0)
+
     @property
     def first_pass_yield(self) -> float | None:
-        judged = self.verdicts.get("pass", 0) + self.verdicts.get("fail", 0)
-        return self.verdicts.get("pass", 0) / judged if judged else None
+        passed, judged = self.first_tests
+        return passed / judged if judged else None
 
     def as_json(self) -> dict:
         return {"selection": self.selection, "measurements": self.n_measurements, "excluded": self.excluded,
@@ -116,6 +119,23 @@ def _counts(population) -> tuple[np.ndarray, dict, dict, dict]:
     return keep, dict(excluded), dict(verdicts), {k: dict(v) for k, v in sorted(by_version.items())}
 
 
+def first_tests(population) -> tuple[int, int]:
+    """(passed, judged) over each unit's first test: a unit is a driver and serial (in time order, the first
+    measurement of it); a measurement without a serial is a unit of its own. A retest neither adds a pass
+    nor hides the first test's fail."""
+    seen: set = set()
+    passed = judged = 0
+    for driver, serial, verdict in zip(population.drivers, population.serials, population.verdicts):
+        if serial:
+            if (driver, serial) in seen:
+                continue
+            seen.add((driver, serial))
+        if verdict in ("pass", "fail"):
+            judged += 1
+            passed += verdict == "pass"
+    return passed, judged
+
+
 def production_stats(population, limits_version=None, baseline: int = DEFAULT_BASELINE,
                      names=None, selection: str = "") -> ProductionStats:
     """The statistics of an analysis.archive.population.Population against one limits version (or none)."""
@@ -142,4 +162,5 @@ def production_stats(population, limits_version=None, baseline: int = DEFAULT_BA
         out[name] = ParameterStats(name, si, display, scale, counted, capability(x, low, high),
                                    control_chart(x, baseline), _histogram(x, low, high),
                                    compare_station_codes(x, stations.subset(use)), limit.text if limit else None)
-    return ProductionStats(selection, len(population), excluded, limits_version, verdicts, by_version, out)
+    return ProductionStats(selection, len(population), excluded, limits_version, verdicts, by_version, out,
+                           first_tests(population))

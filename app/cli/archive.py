@@ -11,7 +11,7 @@ import sys
 from analysis.bounds import LIST_LIMIT
 from app.cli import archive_server, effects
 from app.cli.archive_server import add_archive_options, say_notes
-from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects, number
+from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects, name_text, number
 from app.cli.output import print_json
 
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
@@ -25,7 +25,7 @@ def register(sub) -> None:
 
     ls = verbs.add_parser("list", help="list stored measurements, newest first")
     for name in ("driver", "serial", "operator", "station"):
-        ls.add_argument(f"--{name}", metavar="TEXT", help=f"only measurements whose {name} contains TEXT")
+        ls.add_argument(f"--{name}", metavar="TEXT", type=name_text, help=f"only measurements whose {name} contains TEXT")
     ls.add_argument("--validity", choices=("green", "yellow", "red"))
     ls.add_argument("--since", metavar="DATE", help="measured on or after DATE (ISO, e.g. 2024-05-01)")
     ls.add_argument("--until", metavar="DATE", help="measured on or before DATE")
@@ -43,7 +43,7 @@ def register(sub) -> None:
     store = verbs.add_parser("store", help="analyse a recording and store it in the archive")
     store.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
     for name in ("driver", "serial", "operator", "station", "notes"):
-        store.add_argument(f"--{name}", metavar="TEXT", default="")
+        store.add_argument(f"--{name}", metavar="TEXT", type=name_text, default="")
     store.add_argument("--measured-at", metavar="DATE", help="when it was measured (ISO 8601; default: now)")
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
     add_sd_option(store)
@@ -107,6 +107,8 @@ def run(args: argparse.Namespace) -> int:
             value, std = p.get("value"), p.get("std")
             text = "n/a" if value is None else f"{value:.6g}" + ("" if std is None else f" ± {std:.2g}")
             print(f"  {name:<14} {text} {p.get('unit', '')}")
+        for flag in r.get("flags", []):
+            print(f"flagged: {flag}")
         return 0
     if verb == "export":
         target = archive.export(args.id, args.dir)

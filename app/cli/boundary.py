@@ -7,9 +7,10 @@ from typing import Sequence
 
 from analysis.bounds import SIZE_KINDS, size_limits_set
 from analysis.errors import is_user_error, user_message
+from analysis.text_boundary import SURROGATES, control_found, shown, terminal
 from app.cli import (added_mass, analyze, archive, diagnose, effects, gui, large_signal, levels, measure, qa,
                      recover, report, rig, stats)
-from app.cli.options import Parser, size_limit
+from app.cli.options import CliError, Parser, size_limit
 
 # 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
 EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 2, 70, 130
@@ -33,13 +34,22 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _check_encoding(argv: Sequence[str]) -> None:
+    """Arguments that were not UTF-8 bytes (a Latin-1 name) are refused before anything prints or stores them."""
+    for arg in argv:
+        what = control_found(str(arg), SURROGATES)
+        if what:
+            raise CliError(f"the argument '{shown(str(arg))[:60]}' holds {what}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; the CLI's only error boundary (analysis.errors): exit 2 for the user's errors,
     70 for a bug (one line, the details in a crash report), 130 for Ctrl-C."""
     try:
+        _check_encoding(sys.argv[1:] if argv is None else argv)
         args = build_parser().parse_args(argv)
         with size_limits_set(**dict(args.size_limit)):
-            if args.command in effects.COMMANDS:
+            if effects.builds_models(args):
                 effects.load(args)      # a bad effect file stops every command that builds models: one line
             return args.run(args)
     except KeyboardInterrupt:
@@ -47,7 +57,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
     except Exception as exc:  # noqa: BLE001 - the boundary: a user error is one line, anything else a bug
         if is_user_error(exc):
-            print(f"linpar: error: {user_message(exc)}", file=sys.stderr)
+            print(f"linpar: error: {terminal(user_message(exc))}", file=sys.stderr)
             return EXIT_ERROR
         from app.crash_report import internal_error_line
         print(f"linpar: {internal_error_line(exc, argv=argv)}", file=sys.stderr)

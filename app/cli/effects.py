@@ -18,6 +18,16 @@ if TYPE_CHECKING:       # the catalogue (and scipy) is loaded by the commands th
 
 # The commands that build models from effect ids (and so may name effects of the user's own).
 COMMANDS = ("analyze", "diagnose", "effects", "report", "export", "archive", "addedmass", "stats", "levels")
+# Of `linpar archive`, the verbs that analyse (store) or compare fits; list, show, export, sync... read records only.
+ARCHIVE_VERBS = ("store", "compare")
+
+
+def builds_models(args: argparse.Namespace) -> bool:
+    """Whether the command reads the effects (the user folder too): only those that build models do, so that a
+    bad effect file never blocks listing, showing, exporting or syncing the archive."""
+    if args.command == "archive":
+        return getattr(args, "archive_command", None) in ARCHIVE_VERBS
+    return args.command in COMMANDS
 
 
 def register(sub) -> None:
@@ -34,11 +44,26 @@ def add_effects_file_option(parser: argparse.ArgumentParser) -> None:
 
 
 def load(args: argparse.Namespace) -> tuple[Effect, ...]:
-    """Read and register the user's effects (registry.EffectFileError, one line, when one is bad)."""
+    """Read and register the user's effects. Every file that cannot be used is named (not only the first); the
+    good ones are registered. `linpar effects` lists the bad ones beside the good; any other command stops with
+    one line naming them all (registry.EffectFileError)."""
     from analysis.effects import registry
-    effects = registry.load_user_effects(getattr(args, "effects_files", None) or ())
+    problems: list[str] = []
+    effects = registry.load_user_effects(getattr(args, "effects_files", None) or (), problems=problems)
     registry.register(effects)
+    args.effect_problems = problems
+    if args.command != "effects":       # `linpar effects` lists what loaded first, then says the same line
+        _refuse_problems(args)
     return effects
+
+
+def _refuse_problems(args: argparse.Namespace) -> None:
+    """One line naming every effect file that cannot be used, when there are any (exit 2)."""
+    from analysis.effects.registry import EffectFileError
+    problems = getattr(args, "effect_problems", [])
+    if problems:
+        many = f"{len(problems)} effect files cannot be used: " if len(problems) > 1 else ""
+        raise EffectFileError(many + "; ".join(problems))
 
 
 def _parameters_text(effect: Effect) -> str:
@@ -51,6 +76,7 @@ def run(args: argparse.Namespace) -> int:
     users = registry.user_effects()
     if args.json:
         print_json([e.describe() for e in (*CATALOGUE.values(), *users)], indent=1)
+        _refuse_problems(args)
         return 0
     for category, effects in categories().items():
         print(f"[{category}]")
@@ -65,4 +91,5 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {e.id:<22} {e.title} ({_parameters_text(e)})")
         print(f"  {'':<22} site: {e.site.key}" + (f"; formula: {formula.text}" if formula is not None else ""))
         print(f"  {'':<22} from: {registry.source_of(e)}")
+    _refuse_problems(args)
     return 0

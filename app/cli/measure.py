@@ -55,7 +55,8 @@ from analysis.config_folder import data_folder
 from analysis.errors import is_user_error, user_message
 from app.cli import devices, large_signal
 from app.cli.devices import LASER_ANALOG, say
-from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects, number
+from app.cli.options import (CliError, add_json_option, add_model_option, add_sd_option, model_effects, name_text,
+                             number)
 from app.cli.output import print_json
 from app.cli.result_text import format_result
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
@@ -88,7 +89,7 @@ def register(sub) -> None:
                         "serial laser), or average again")
     add_model_option(m, why="; with the serial laser also delay-x")
     for field in ("serial", "operator", "station"):
-        m.add_argument(f"--{field}", default="", metavar="TEXT", help=f"the {field} kept with it in the archive")
+        m.add_argument(f"--{field}", default="", metavar="TEXT", type=name_text, help=f"the {field} kept with it in the archive")
     where = m.add_mutually_exclusive_group()
     where.add_argument("--archive", metavar="URL|DIR",
                        help="archive to store in: postgresql://USER@HOST[:PORT]/DB (the line's server) or a folder "

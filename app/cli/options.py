@@ -16,6 +16,7 @@ from typing import Callable, Sequence
 from analysis.bounds import SD, Bound, BoundsError, parse_size_limit
 from analysis.errors import LinparError
 from analysis.model.defaults import DEFAULT_EFFECTS
+from analysis.text_boundary import control_found, shown
 
 
 class CliError(LinparError):
@@ -35,6 +36,18 @@ def number(bound: Bound) -> Callable[[str], float | int]:
             raise argparse.ArgumentTypeError(str(exc)) from None
     parse.__name__ = bound.what          # argparse names the type in a few of its own messages
     return parse
+
+
+def name_text(text: str) -> str:
+    """An argparse type for a name kept with a measurement (serial, operator, station, driver, note): one line
+    of text, refused as it enters (analysis.text_boundary) rather than stored and refused when read back."""
+    what = control_found(text)
+    if what:
+        raise argparse.ArgumentTypeError(f"'{shown(text)[:60]}' holds {what}; expected one line of text")
+    return text
+
+
+name_text.__name__ = "name"
 
 
 def size_limit(text: str) -> tuple[str, int]:

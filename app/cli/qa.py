@@ -21,7 +21,7 @@ from pathlib import Path
 
 from analysis.bounds import BASELINE, COVERAGE_K, LIMITS_VERSION
 from app.cli.archive_server import add_archive_options, open_from_args, say_notes
-from app.cli.options import CliError, add_json_option, number
+from app.cli.options import CliError, add_json_option, name_text, number
 from app.cli.output import print_json
 
 
@@ -58,8 +58,8 @@ def register(sub) -> None:
                                                       "(an engineer's right)")
     limits.add_argument("--k", type=number(COVERAGE_K), default=3.0, help="limits at mean +- K sigma (default 3)")
     limits.add_argument("--out", metavar="FILE", help="write the proposal there (default: print it)")
-    limits.add_argument("--name", metavar="TEXT", help="the proposal's name")
-    limits.add_argument("--note", metavar="TEXT", default="", help="why this version (kept with it)")
+    limits.add_argument("--name", metavar="TEXT", type=name_text, help="the proposal's name")
+    limits.add_argument("--note", metavar="TEXT", type=name_text, default="", help="why this version (kept with it)")
     add_json_option(limits, "print JSON")
 
     golden = verbs.add_parser("golden", help="list, add or remove golden units (adding and removing: an engineer's "

@@ -11,8 +11,18 @@ def _v(value, scale: float = 1.0) -> str:
     return "-" if value is None else f"{value * scale:.4g}"
 
 
+INDEX_WIDTH = 7       # a capability index in at most 7 characters, each column one wider: never glued
+
+
 def _index(value) -> str:
-    return "-" if value is None else f"{value:.2f}"
+    """Cp, Cpk, ... to two decimals, or in scientific notation when that does not fit (a 6-digit Cp of a
+    nearly constant parameter): the columns keep their width and each number its sign."""
+    if value is None:
+        return "-"
+    for text in (f"{value:.2f}", f"{value:.1e}", f"{value:.0e}"):
+        if len(text) <= INDEX_WIDTH:
+            return text
+    return text
 
 
 def _unit(unit: str) -> str:
@@ -44,7 +54,7 @@ def stats_text(stats, location: str) -> str:
         lines.append("No measurement in this selection.")
         return "\n".join(lines)
     head = (f"{'parameter':<13}{'unit':<6}{'n':>7}{'mean':>11}{'sigma':>10}{'min':>11}{'max':>11}  {'limit':<22}"
-            f"{'Cp':>6}{'Cpk':>6}{'Pp':>6}{'Ppk':>6}{'yield':>8}{'alarms':>7}")
+            f"{'Cp':>8}{'Cpk':>8}{'Pp':>8}{'Ppk':>8}{'yield':>8}{'alarms':>7}")
     lines += ["", head]
     for p in stats.parameters.values():
         c, s = p.capability, p.display_scale
@@ -52,7 +62,7 @@ def stats_text(stats, location: str) -> str:
         alarms = "-" if p.chart is None else str(len(p.chart.alarms))
         lines.append(f"{p.name:<13}{_unit(p.display_unit):<6}{c.n:>7}{_v(c.mean, s):>11}{_v(c.sigma_overall, s):>10}"
                      f"{_v(c.minimum, s):>11}{_v(c.maximum, s):>11}  {(p.limit_text or '-')[:21]:<22}"
-                     f"{_index(c.cp):>6}{_index(c.cpk):>6}{_index(c.pp):>6}{_index(c.ppk):>6}{yield_text:>8}"
+                     f"{_index(c.cp):>8}{_index(c.cpk):>8}{_index(c.pp):>8}{_index(c.ppk):>8}{yield_text:>8}"
                      f"{alarms:>7}")
     lines += _alarm_lines(stats) + _station_lines(stats)
     return "\n".join(lines)

@@ -76,6 +76,7 @@ class ProductionPage(QWidget):
         self.parameter: str | None = None
 
         self.source_label = QLabel()
+        self.source_label.setTextFormat(Qt.PlainText)       # an archive's path or URL is never markup
         self.source_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
         self.since_edit = date_edit("Measured on or after this day")
         self.until_edit = date_edit("Measured on or before this day")
@@ -94,6 +95,7 @@ class ProductionPage(QWidget):
         self.message.setWordWrap(True)
         self.message.setTextFormat(Qt.RichText)
         self.summary = QLabel()
+        self.summary.setTextFormat(Qt.PlainText)            # it quotes the limits' name and the filters typed
         self.summary.setWordWrap(True)
         self.stats_table = _table(STATS_COLUMNS)
         self.alarms_table = _table(ALARM_COLUMNS)

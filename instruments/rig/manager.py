@@ -9,6 +9,7 @@ jackd), waits, and kills the whole process group only if it does not go.
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -16,13 +17,16 @@ import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
+from typing import Iterator, Sequence
 
 from analysis.errors import LinparError
+from analysis.file_lock import take
 from instruments.rig.control import ControlError, send_command
 from instruments.rig.state import DEFAULT_NAME, RigPaths, RigState, pid_alive, read_pid, read_state
 
 MODELS = ("linear", "nonlinear")     # the rig server's --model choices
+START_TIMEOUT_S = 20.0               # how long a start waits for the rig to answer
+LOCK_MARGIN_S = 15.0                 # beyond it, how long a second start or a stop waits for the first's lock
 
 
 class RigError(LinparError, RuntimeError):
@@ -67,15 +71,39 @@ def find_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None) -> RigHa
     return RigHandle(name, paths, state, already_running=True)
 
 
+@contextlib.contextmanager
+def _one_at_a_time(paths: RigPaths, wait_s: float) -> Iterator[None]:
+    """Hold the rig's lock while checking and starting (or stopping) it: two `linpar rig start` (or a
+    `measure` starting its rig) at once would each see no rig and start one, the second then lost to `rig
+    status` and `rig stop`. The other waits, then finds the rig the first started. The lock file sits beside
+    the rig's folder (a rig name never starts with '.')."""
+    paths.directory.parent.mkdir(parents=True, exist_ok=True)
+    lock = take(paths.directory.parent / f".{paths.directory.name}.lock", wait_s)
+    if lock is None:
+        raise RigError(f"rig {paths.directory.name!r}: another process has been starting or stopping it for "
+                       f"{wait_s:g} s; see 'linpar rig status', or try again")
+    try:
+        yield
+    finally:
+        lock.release()
+
+
 def start_rig(name: str = DEFAULT_NAME, driver: str = "paper", effects: str | None = None,
               faults: Sequence[str] = (), noise: str | None = None, runtime_dir: Path | None = None,
-              seed: int | None = None, timeout: float = 20.0, extra_args: Sequence[str] = (),
+              seed: int | None = None, timeout: float = START_TIMEOUT_S, extra_args: Sequence[str] = (),
               model: str = "linear") -> RigHandle:
     """The rig `name`, started in the background unless it runs; `model` is the server's --model."""
     require_linux()
     if model not in MODELS:
         raise RigError(f"unknown rig model {model!r} (expected {' or '.join(MODELS)})")
     paths = RigPaths.for_name(name, runtime_dir)
+    with _one_at_a_time(paths, timeout + LOCK_MARGIN_S):
+        return _start_unlocked(name, paths, driver, effects, faults, noise, runtime_dir, seed, timeout,
+                               extra_args, model)
+
+
+def _start_unlocked(name, paths, driver, effects, faults, noise, runtime_dir, seed, timeout, extra_args,
+                    model) -> RigHandle:
     running = find_rig(name, runtime_dir)
     if running is not None:
         running_model = running.state.extra.get("model", "linear")
@@ -124,6 +152,11 @@ def stop_rig(name: str = DEFAULT_NAME, runtime_dir: Path | None = None, timeout:
     """Stop the rig and its jackd; False if it was not running. RigError if it would not die."""
     require_linux()
     paths = RigPaths.for_name(name, runtime_dir)
+    with _one_at_a_time(paths, timeout + LOCK_MARGIN_S + START_TIMEOUT_S):
+        return _stop_unlocked(name, paths, timeout)
+
+
+def _stop_unlocked(name: str, paths: RigPaths, timeout: float) -> bool:
     pid = read_pid(paths)
     if not pid_alive(pid):
         _remove_stale(paths)

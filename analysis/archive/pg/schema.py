@@ -150,7 +150,12 @@ def _v2() -> str:
             f"GROUP BY measurement_id) p WHERE p.measurement_id = m.id;\n")
 
 
-MIGRATIONS: tuple[str, ...] = (_V1, _v2())
+def _v3() -> str:
+    from analysis.archive.pg.audit import V3_AUDIT
+    return V3_AUDIT
+
+
+MIGRATIONS: tuple[str, ...] = (_V1, _v2(), _v3())
 CURRENT_VERSION = len(MIGRATIONS)
 _LOCK_KEY = 0x6C696E706172      # "linpar": the advisory lock that serialises migrations
 

@@ -104,6 +104,8 @@ def parse_url(url: str) -> ServerURL:
         if not timeout.isdigit() or not 1 <= int(timeout) <= 600:
             raise ArchiveError(f"{shown}: connect_timeout {timeout!r}: expected seconds from 1 to 600")
     params.setdefault("application_name", "linpar")
+    from analysis.archive.pg.audit import STATION_OPTIONS
+    params["options"] = f"{params.get('options', '')} {STATION_OPTIONS}".strip()
     for key, value in (("keepalives", "1"), ("keepalives_idle", "5"), ("keepalives_interval", "3"),
                        ("keepalives_count", "3")):
         params.setdefault(key, value)
@@ -114,7 +116,9 @@ def _unreachable(exc) -> bool:
     """True when the server did not answer (the network, a server down or restarting), not a refusal."""
     state = getattr(exc, "sqlstate", None)
     if state is not None:
-        return state.startswith("08") or state in ("57P01", "57P02", "57P03")
+        # 55P03 lock_not_available, 57014 query_canceled (the station's lock and statement timeouts): the
+        # server is busy with a row a cut connection left, not refusing; the store waits in the queue.
+        return state.startswith("08") or state in ("57P01", "57P02", "57P03", "55P03", "57014")
     message = str(exc)
     if any(words in message for words in _NO_ANSWER):
         return True

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Mapping
 
+from analysis.archive.pg.audit import SERVER_SETTINGS
 from analysis.archive.pg.schema import add_user, ensure_roles, grant, migrate, roles_of
 from analysis.archive.pg.server import parse_url, server_errors
 
@@ -43,6 +44,7 @@ def setup(url: str, users: Mapping[str, str] | None = None) -> SetupReport:
             made = ensure_roles(conn)
             start, end = migrate(conn)
             grant(conn)
+            bound_sessions(conn, server.dbname)
             report = SetupReport(server.display, start, end, made)
             for name, role in (users or {}).items():
                 created = add_user(conn, name, role)
@@ -50,3 +52,11 @@ def setup(url: str, users: Mapping[str, str] | None = None) -> SetupReport:
         return report
     finally:
         conn.close()
+
+
+def bound_sessions(conn, dbname: str) -> None:
+    """The server-side bounds of every session on the archive's database (audit.SERVER_SETTINGS)."""
+    from psycopg import sql
+    for name, value in SERVER_SETTINGS.items():
+        conn.execute(sql.SQL("ALTER DATABASE {} SET {} = {}").format(sql.Identifier(dbname), sql.Identifier(name),
+                                                                      sql.Literal(value)))

@@ -1,0 +1,97 @@
+"""Text that crosses a boundary: the one check where a name enters, and the escapes where it leaves.
+
+A name a user typed or a file said (a limits name, a serial, an operator, a
+station, a driver, an effect's title) is copied into records, reports,
+exports, terminals and the GUI. One class of characters is refused where it
+enters, and the same class is what every reader of the archive checks, so
+that nothing stored can be refused when read back:
+
+- control characters (C0, DEL, C1: tabs, line breaks, NUL, ESC that starts
+  terminal sequences), the Unicode line and paragraph separators;
+- lone UTF-16 surrogates: Python's stand-ins for bytes that were not UTF-8
+  (a Latin-1 `--operator $'M\\xfcller'`), which no file or terminal can encode.
+
+Where text leaves, each way out has its own escape:
+
+- `shown`: what cannot be printed becomes visible (`\\t`, `\\x1b`, `\\xfc`):
+  a value read back that breaks the rule is shown flagged, never dropped;
+- `terminal`: ANSI/OSC escape sequences removed, other control characters shown;
+- `spreadsheet_cell`: OWASP's CSV-injection rule: a cell that begins with
+  = + - @, a tab or a carriage return is prefixed with ' so that no
+  spreadsheet runs it as a formula;
+- Qt labels are set to plain text (app/, not here: no Qt in analysis).
+"""
+from __future__ import annotations
+
+import re
+
+from analysis.errors import LinparError
+
+# The class refused where a name enters and checked wherever a stored one is read.
+CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+# The same, but a line break allowed: a multi-line description (an effect's physics).
+CONTROL_BUT_NEWLINE = re.compile(r"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+# Python's stand-ins for bytes that were not UTF-8 (surrogateescape).
+SURROGATES = re.compile(r"[\ud800-\udfff]")
+# ESC [ ... final byte (CSI), ESC ] ... BEL or ESC \ (OSC), ESC and one byte: what a terminal acts on.
+_ESCAPE_SEQUENCE = re.compile(r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x9b[0-?]*[ -/]*[@-~]"
+                              r"|\x9d[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?|\x1b[@-_]?")
+_FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
+_NAMED = {"\t": "\\t", "\n": "\\n", "\r": "\\r", "\x00": "\\0"}
+
+
+class TextError(LinparError, ValueError):
+    """A name that may not cross into the archive, a report or a terminal as given; one line."""
+
+
+def _what(char: str) -> str:
+    if "\ud800" <= char <= "\udfff":
+        return f"the byte {_visible(char)} that is not UTF-8 (set the terminal or file to UTF-8)"
+    return f"the control character {_visible(char)}"
+
+
+def _visible(char: str) -> str:
+    code = ord(char)
+    if char in _NAMED:
+        return _NAMED[char]
+    if 0xDC80 <= code <= 0xDCFF:          # surrogateescape's stand-in for the byte code - 0xDC00
+        return f"\\x{code - 0xDC00:02x}"
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+
+
+def control_found(text: str, pattern: re.Pattern = CONTROL) -> str | None:
+    """What the first refused character is, in words ("the control character \\t"), or None."""
+    bad = pattern.search(text)
+    return None if bad is None else _what(bad.group())
+
+
+def one_line(value, where: str, error: type[LinparError] = TextError, pattern: re.Pattern = CONTROL) -> str:
+    """`value` when it is a string without refused characters; `error` naming `where` otherwise."""
+    if not isinstance(value, str):
+        raise error(f"{where}: found {type(value).__name__}, expected a string")
+    what = control_found(value, pattern)
+    if what:
+        raise error(f"{where}: holds {what}; expected one line of text")
+    return value
+
+
+def cleaned(value: str, max_len: int = 200) -> str:
+    """A string as it may be stored when it cannot be refused (a form's field): refused characters -> spaces."""
+    return CONTROL.sub(" ", value).strip()[:max_len]
+
+
+def shown(text: str, pattern: re.Pattern = CONTROL) -> str:
+    """Every refused character written visibly (\\t, \\x1b, \\xfc): safe to print, and still telling."""
+    return pattern.sub(lambda m: _visible(m.group()), text)
+
+
+def terminal(text: str) -> str:
+    """Text for a terminal: escape sequences (colours, titles, hyperlinks) removed, other controls shown;
+    line breaks kept."""
+    return shown(_ESCAPE_SEQUENCE.sub("", str(text)), CONTROL_BUT_NEWLINE)
+
+
+def spreadsheet_cell(text: str) -> str:
+    """A text cell no spreadsheet runs as a formula (OWASP: prefix = + - @ tab CR with a quote)."""
+    text = str(text)
+    return "'" + text if text.startswith(_FORMULA_START) else text
