@@ -33,6 +33,7 @@ from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra
 from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra
 from analysis.validity import ABSENT, Finding, Severity
+from analysis.validity.findings import LASER_DELAY_NOT_FOUND
 
 DISPLACEMENT_MAX_KEY = "displacement_max_hz"
 
@@ -93,9 +94,6 @@ def analyse_measurement(recording: Recording, sd_m2: float | None = None, effect
     return with_delay_verdict(result, found[0]) if found else result
 
 
-DELAY_NOT_PLACED = "laser-delay-not-found"
-
-
 def with_delay_verdict(result: AnalysisResult, search: DelaySearch) -> AnalysisResult:
     """The result with the delay search in its validity, and a red displacement when the data cannot place it."""
     validity = copy.deepcopy(result.validity)
@@ -103,7 +101,7 @@ def with_delay_verdict(result: AnalysisResult, search: DelaySearch) -> AnalysisR
     channel = validity.get("channels", {}).get("displacement")
     if not search.placed and channel is not None and channel.get("status") != ABSENT:
         channel.setdefault("findings", []).append(Finding(
-            "displacement", DELAY_NOT_PLACED, Severity.RED,
+            "displacement", LASER_DELAY_NOT_FOUND, Severity.RED,
             f"the laser's delay cannot be placed from the data (searched {SEARCH_S[0] * 1e3:g} to "
             f"{SEARCH_S[1] * 1e3:g} ms: best {search.delay_s * 1e3:.3f} ms, the lines agree {search.score:.2f}, "
             f"the next peak only {search.chi2_margin:.3g} chi^2 worse)",
