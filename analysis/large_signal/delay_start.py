@@ -25,10 +25,10 @@ from typing import Sequence
 import numpy as np
 
 from analysis.effects import DEFAULT_EFFECTS, Site, get_effect
-from analysis.fit import FitData, fit_model
+from analysis.fit.least_squares import FitData, fit_model
 from analysis.laser_delay import DelaySearch, find_delay
 from analysis.large_signal.data import RecordingData
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.spectra import period_spectra, transfer_from_periods
 
 

@@ -32,8 +32,8 @@ from analysis.laser_delay import SEARCH_S, DelaySearch, find_delay
 from analysis.pipeline import AnalysisResult, analyze_recording, analyze_spectra, naming_the_file
 from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra
-from analysis.validity import ABSENT, Finding, Severity
-from analysis.validity.findings import LASER_DELAY_NOT_FOUND
+from analysis.validity.assessment import ABSENT
+from analysis.validity.findings import LASER_DELAY_NOT_FOUND, Finding, Severity
 
 DISPLACEMENT_MAX_KEY = "displacement_max_hz"
 

@@ -15,7 +15,7 @@ import pytest
 from analysis.drivers import load_driver
 from analysis.effects import parse_effects
 from analysis.laser_delay import SEARCH_S, find_delay
-from analysis.model import Model
+from analysis.model.composed import Model
 from analysis.multitone import design_multitone
 
 PAPER = load_driver("paper")
