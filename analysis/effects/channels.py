@@ -133,21 +133,24 @@ delay_x = DisplacementDelay(
     category=DISPLACEMENT_CATEGORY,
     title="Delay of the displacement channel",
     site=Site.DISPLACEMENT,
-    params=(ParamSpec("tau_x", "s", "us", 1e6, -5e-3, 5e-3, 0.0,
+    # Bounds: a serial laser's USB link leaves up to tens of ms (analysis/laser_delay.py searches as far).
+    params=(ParamSpec("tau_x", "s", "us", 1e6, -10e-3, 40e-3, 0.0,
                       "delay of the displacement channel after the voltage channel", typical=(0.0, 2e-3)),),
     physics=("A triangulation laser computes each distance from a camera exposure, so its output comes a "
              "little late; a laser on its own clock is also aligned to the audio only to within some residual. "
              "Either way the measured displacement is a delayed copy of the true one."),
     signature=("Displacement residual in the phase of Hx only, a phase lag growing linearly with frequency "
                "(w*tau_x), while |Hx| fits; the impedance is unaffected."),
-    typical="0 to 1 ms (sensor latency of a few measuring periods; ILD1420 at 4 kHz: 0.25 ms each)",
+    typical=("0 to 1 ms (sensor latency of a few measuring periods; ILD1420 at 4 kHz: 0.25 ms each); "
+             "1 to 25 ms through a USB serial adapter (its packets and latency timer)"),
     reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate and output latency); shared/spec/laser-ild1420.md",
     notes=("Below a low-pass's corner frequency a delay and a first-order low-pass look alike (a phase lag "
            "proportional to f): lowpass-x is the alternative when |Hx| also drops at the top. The fit "
            "starts from the slope of the phase that the current model leaves in Hx over the top octave "
            "(unwrapped from the lowest line up), so delays are found as long as the phase moves less than "
            "half a turn from one line to the next; far from the data the diagnosis also refits it from the "
-           "data's own start values."),
+           "data's own start values. A measurement with a serial laser starts it from a search over the "
+           "whole range (analysis/laser_delay.py)."),
     cold_start=True,
 )
 

@@ -40,7 +40,7 @@ NUISANCE_DEPENDENT = ("R2", "L2", "creep")     # columns.Columns.with_nuisance m
 class FitState:
     """The state the searches share: the data, their offsets and delays, the columns and the weights."""
 
-    def __init__(self, data: Sequence[RecordingData], max_orders: Orders):
+    def __init__(self, data: Sequence[RecordingData], max_orders: Orders, delay_centres: Sequence[float] = ()):
         self.data = list(data)
         self.max_orders = max_orders
         centred = [d.mean("x") - d.mean("x").mean() for d in self.data]
@@ -49,7 +49,9 @@ class FitState:
             raise LargeSignalError("the displacement does not move: no curve can be identified")
         self.offsets = [0.0] * len(self.data)
         self.offsets_std = [0.0] * len(self.data)
-        self.delays = [0.0] * len(self.data)
+        # Where each delay search is centred (delay_start.py: a serial link's latency, found from the data).
+        self.centres = [float(c) for c in delay_centres] if len(delay_centres) else [0.0] * len(self.data)
+        self.delays = list(self.centres)
         self._grams: dict = {}
         self.mean_cols: list[Columns] = [self.columns(k, False) for k in range(len(self.data))]
         self.weights: list[tuple[np.ndarray, np.ndarray]] = []
@@ -277,13 +279,14 @@ class FitState:
         return any(d.laser_delay_possible for d in self.data)
 
     def scan_delays(self, orders: Orders, nu: Nuisance) -> None:
-        """Each serial laser's delay to the least chi^2 on a grid over +-DELAY_LIMIT_S (DELAY_GRID_S apart):
-        chi^2 against the delay is not unimodal over that range (the lines of x turn through whole cycles), so
-        the grid finds the valley that refine_delays then searches."""
+        """Each serial laser's delay to the least chi^2 on a grid over +-DELAY_LIMIT_S around its centre
+        (DELAY_GRID_S apart): chi^2 against the delay is not unimodal over that range (the lines of x turn
+        through whole cycles), so the grid finds the valley that refine_delays then searches."""
         grid = np.arange(-DELAY_LIMIT_S, DELAY_LIMIT_S + DELAY_GRID_S / 2, DELAY_GRID_S)
         for k in self._delayed():
             chi2 = self._chi2_at_delay(k, orders, nu)
-            self.delays[k] = float(grid[int(np.argmin([chi2(t) for t in grid]))])
+            self.delays[k] = self.centres[k] + float(grid[int(np.argmin([chi2(self.centres[k] + t)
+                                                                          for t in grid]))])
             self.rebuild(k)
 
     def refine_delays(self, orders: Orders, nu: Nuisance) -> float:
@@ -292,7 +295,7 @@ class FitState:
         moved = 0.0
         for k in self._delayed():
             before = self.delays[k]
-            self.delays[k] = _valley_minimum(self._chi2_at_delay(k, orders, nu), before)
+            self.delays[k] = _valley_minimum(self._chi2_at_delay(k, orders, nu), before, self.centres[k])
             self.rebuild(k)
             moved = max(moved, abs(self.delays[k] - before))
         return moved
@@ -361,16 +364,19 @@ def static_force(x: np.ndarray, i: np.ndarray, names, theta: np.ndarray, x_scale
     return f
 
 
-def _valley_minimum(chi2, start: float) -> float:
+def _valley_minimum(chi2, start: float, centre: float = 0.0) -> float:
     """The least chi^2 of the valley ``start`` lies in: downhill a scan step at a time until a step either side
     is higher (a true bracket, so the bounded Brent search inside it cannot stop on an edge: held to one step
     around the scan's best, it did, and the coefficients took up the phase error left), then Brent to
-    DELAY_TOLERANCE_S. Within +-DELAY_LIMIT_S: a minimum on that limit is reported as such (delay_at_limit)."""
+    DELAY_TOLERANCE_S. Within +-DELAY_LIMIT_S of ``centre``: a minimum on that limit is reported as such
+    (delay_at_limit)."""
+    lo_limit, hi_limit = centre - DELAY_LIMIT_S, centre + DELAY_LIMIT_S
+
     def at(t: float) -> float:
-        return chi2(float(np.clip(t, -DELAY_LIMIT_S, DELAY_LIMIT_S)))
+        return chi2(float(np.clip(t, lo_limit, hi_limit)))
     centre, here = start, at(start)
     for _ in range(int(2 * DELAY_LIMIT_S / DELAY_SCAN_S) + 1):
-        low, high = max(centre - DELAY_SCAN_S, -DELAY_LIMIT_S), min(centre + DELAY_SCAN_S, DELAY_LIMIT_S)
+        low, high = max(centre - DELAY_SCAN_S, lo_limit), min(centre + DELAY_SCAN_S, hi_limit)
         below, above = at(low), at(high)
         if below < here and below <= above and low < centre:
             centre, here = low, below
@@ -383,9 +389,9 @@ def _valley_minimum(chi2, start: float) -> float:
     return float(best.x) if best.fun <= here else centre
 
 
-def delay_at_limit(delay_s: float) -> bool:
-    """Whether a searched delay sits on the search's limit (the true one may lie beyond it)."""
-    return abs(delay_s) > DELAY_LIMIT_S - 2 * DELAY_TOLERANCE_S
+def delay_at_limit(delay_s: float, centre: float = 0.0) -> bool:
+    """Whether a searched delay sits on the search's limit around its centre (the true one may lie beyond it)."""
+    return abs(delay_s - centre) > DELAY_LIMIT_S - 2 * DELAY_TOLERANCE_S
 
 
 def _lambda_limit(data: Sequence[RecordingData], ws: float) -> float:

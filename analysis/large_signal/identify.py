@@ -14,8 +14,11 @@ three small searches for what they are not linear in:
    log law diverges). The polynomials are thus centred on the rest position
    by construction: Kms(x) x vanishes at x = 0;
 2. the laser's delay, for a serial laser on a clock of its own (the
-   alignment leaves some tens of microseconds: 2 degrees at 100 Hz, which
-   the mechanical equation would misread as damping);
+   alignment leaves the link's latency, up to tens of ms through a USB
+   adapter; tens of microseconds left would be 2 degrees at 100 Hz, which
+   the mechanical equation would misread as damping): searched +-1 ms
+   around where the small-signal step's linear model places it
+   (delay_start.py);
 3. tau2 = L2 / R2 and creep's lambda: variable projection (the least squares
    solved for the rest at each try, scipy's bounded minimiser over these).
 
@@ -39,6 +42,7 @@ import numpy as np
 from analysis.large_signal.columns import ELECTRICAL, Nuisance, Orders
 from analysis.large_signal.covariance import covariance
 from analysis.large_signal.data import LargeSignalError, RecordingData
+from analysis.large_signal.delay_start import delay_centres
 from analysis.large_signal.fitting import DELAY_TOLERANCE_S, FitState, delay_at_limit
 from analysis.large_signal.solve import Solution, solve
 
@@ -66,6 +70,7 @@ class Identification:
     delays: tuple[float, ...]       # s, the laser's delay taken out of each recording
     delays_std: tuple[float, ...]   # s, their 1-sigma (0 where none was searched): the noise's and the search's
     data: tuple[RecordingData, ...]
+    delay_centres: tuple[float, ...]  # s, where each delay search was centred (delay_start.py)
     weights: tuple[tuple[np.ndarray, np.ndarray], ...]
     bic_table: tuple[tuple[str, float], ...]     # the orders tried and their BIC, for the report
     voltage_residual_percent: tuple[float, ...]  # the electrical equation's rms misfit re the voltage, per recording
@@ -73,7 +78,7 @@ class Identification:
 
     def delay_at_limit(self, k: int) -> bool:
         """Whether recording k's laser delay sits on the search's limit (the true one may lie beyond it)."""
-        return self.data[k].laser_delay_possible and delay_at_limit(self.delays[k])
+        return self.data[k].laser_delay_possible and delay_at_limit(self.delays[k], self.delay_centres[k])
 
     def value(self, name: str, power: int = 0) -> float:
         return float(self.theta[self.names.index((name, power))]) if (name, power) in self.names else 0.0
@@ -93,7 +98,7 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
         raise LargeSignalError(f"order {max_order!r}: expected a whole number from 0 to {HIGHEST_ORDER}")
     top = Orders(bl=max_order, kms=max_order, le=max_order, l2=min(max_order, MAX_L2_ORDER), le_i=2, rms_v=True,
                  creep=True)
-    fit = FitState(data, top)
+    fit = FitState(data, top, delay_centres(data))
     fit.initial_weights()
     nu = Nuisance()
     theta = fit.mechanical_start(top, nu, solve(fit.blocks(top, nu, only=ELECTRICAL)).theta)
@@ -116,7 +121,7 @@ def identify(data: Sequence[RecordingData], max_order: int = MAX_ORDER) -> Ident
     return Identification(orders, tuple(orders.names()), final.theta, cov * scale, final, nu, fit.x_scale,
                           tuple(fit.offsets), tuple(fit.offsets_std), tuple(fit.delays),
                           tuple(_delay_std(std * np.sqrt(scale), d) for std, d in zip(delays_std, fit.data)),
-                          tuple(fit.data),
+                          tuple(fit.data), tuple(fit.centres),
                           tuple(fit.weights), tuple(table),
                           tuple(fit.voltage_residual_percent(orders, nu, final.theta)),
                           tuple(fit.noise_misfit(orders, nu, final.theta)))

@@ -86,6 +86,7 @@ class LargeSignalResult:
                           "laser_delay_s": ident.delays[k],
                           "laser_delay_std_s": ident.delays_std[k] if ident.data[k].laser_delay_possible else None,
                           "laser_delay_at_limit": ident.delay_at_limit(k),
+                          "laser_delay_search_centre_s": ident.delay_centres[k],
                           "laser_delay_found": found[k],
                           "noise_chi2_red": dict(ident.noise_chi2_red[k]),
                           "peak_displacement_m": _peak(ident, k)})

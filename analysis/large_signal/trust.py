@@ -39,8 +39,10 @@ def delay_not_found(ident: Identification, k: int) -> str | None:
     remedy = ("Bl(x), Kms(x) and Le(x) are not to be trusted; check the laser's latency (its link) and measure "
               "again")
     if ident.delay_at_limit(k):
+        centre_us = ident.delay_centres[k] * 1e6
         return (f"{label}: the laser's delay was not found: it reached the search's limit ({delay_us:+.0f} us, at "
-                f"most {DELAY_LIMIT_S * 1e6:.0f} us either way): {remedy}")
+                f"most {DELAY_LIMIT_S * 1e6:.0f} us either way of {centre_us:+.0f} us, where the small-signal "
+                f"model placed it): {remedy}")
     misfit = ident.voltage_residual_percent[k]
     noise = ident.noise_chi2_red[k][ELECTRICAL]
     if misfit > VOLTAGE_MISFIT_UNTRUSTED_PERCENT and noise > NOISE_CHI2_UNTRUSTED:

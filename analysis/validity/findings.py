@@ -33,6 +33,7 @@ DROPOUTS = "dropouts"
 DRIFT = "drift"
 CHANNEL_COPY = "channel-copy"       # a scaled copy of another channel: a wiring fault (analysis.validity.wiring)
 MODEL_MISFIT = "model-misfit"       # the fit's misfit far above the noise (analysis.validity.fit)
+LASER_DELAY_NOT_FOUND = "laser-delay-not-found"   # a serial laser's delay the data cannot place (analysis.laser_delay)
 
 
 @dataclass(frozen=True, slots=True)

@@ -48,7 +48,9 @@ def register(sub) -> None:
     start.add_argument("--noise", metavar="SPEC",
                        help="sensor noise rms, e.g. voltage=1e-4,current=1e-5,displacement=1e-8 (V, A, m)")
     start.add_argument("--fault", action="append", default=[], metavar="SPEC",
-                       help="disconnect=voltage|current|displacement, clip=VOLTS, noise=FACTOR (repeatable)")
+                       help="disconnect=voltage|current|displacement, clip=VOLTS, noise=FACTOR, "
+                            "latency=SECONDS[,jitter=SECONDS] (the serial laser's samples late in packets, as "
+                            "through a USB serial adapter; 0 to 1 s) (repeatable)")
     start.add_argument("--json", action="store_true", help="print the rig's state as JSON")
 
     status = actions.add_parser("status", parents=[common], help="say whether the rig runs, and how")
@@ -115,6 +117,8 @@ def _status(args) -> int:
 
 
 def _fault(args) -> int:
+    from instruments.rig.engine import RigFaults
+    RigFaults.parse(args.specs)          # a spec that cannot be used is one line here, before the rig is asked
     handle = _manager().find_rig(args.name, args.runtime_dir)
     if handle is None:
         raise _manager().RigError(f"rig {args.name!r} is not running (start it with 'linpar rig start')")

@@ -55,6 +55,10 @@ from instruments.measurement.laser_gaps import LaserGaps, gap_accounting, refill
 from instruments.measurement.resample import HALF_TAPS, PASSBAND, covered, interpolate
 
 REFINE_PASSES = 3
+# A laser's crystal runs within tens of ppm of its rate; host times that say more than this are the host's
+# scheduling (a loaded machine, a USB adapter's bursts: -9,300 ppm seen on a JACK plan), and the refinement,
+# which follows a drift of less than a line's half turn per period, would not start from them.
+PLAUSIBLE_PPM = 1000.0
 REFILL_ROUNDS = 2       # EM rounds per pass of the refinement (laser_gaps.py): the second changes ~1e-3 of the first
 OUTLIER_SIGMAS = 12.0
 _CONVERGED = 1e-10      # a drift below this changes nothing measurable
@@ -171,13 +175,16 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
     outliers = outlier_mask(stream.distance_m)
     missing = ~np.isfinite(stream.distance_m) | outliers
     filled = _bridged(np.where(outliers, np.nan, stream.distance_m))
-    laser_rate = audio_rate / host_clock.ratio
+    pivot = float(np.mean(stream.block_last))      # where the host times place the stream best
+    start_clock = host_clock
+    if refine and abs(host_clock.ppm(audio_rate, nominal_rate)) > PLAUSIBLE_PPM:
+        start_clock = host_clock.pivoted(audio_rate / nominal_rate, pivot)     # the nominal rate: far closer
+    laser_rate = audio_rate / start_clock.ratio
     max_hz = PASSBAND * min(laser_rate, nominal_rate)
     max_bin = int(np.floor(max_hz * period_samples / audio_rate))
     bins = np.asarray(excited_bins, dtype=np.int64)
     bins = bins[bins <= max_bin]
-    clock, drift, lines, passes = host_clock, 0.0, 0, 0
-    pivot = float(np.mean(stream.block_last))      # where the host times place the stream best
+    clock, drift, lines, passes = start_clock, 0.0, 0, 0
     # The drift is measured on every D-th audio sample: still above twice max_hz, D times less work.
     step = _decimation(audio_rate, max_hz, period_samples)
     coarse = (starts[:, None] + np.arange(0, period_samples, step)[None, :]).ravel()

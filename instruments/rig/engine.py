@@ -24,6 +24,7 @@ import numpy as np
 
 from analysis.errors import LinparError
 from instruments.audio.config import Calibration, ChannelMap
+from instruments.laser.usb_link import MAX_LATENCY_S
 from instruments.simulation.block_driver import BlockDriver
 
 # The rig's fixed hardware: 1 FS out = 10 V at the terminals; the voltage
@@ -74,11 +75,15 @@ class RigFaults:
     ``disconnected``: signals whose input reads exact zeros (cable off).
     ``amp_clip_volts``: the amplifier's output limit (V peak), None for none.
     ``noise_factor``: the sensors' noise times this.
+    ``laser_latency_s``, ``laser_jitter_s``: the serial laser's link, late like a USB serial adapter
+    (instruments/laser/usb_link.py); applied by the rig's laser from its next switch-on.
     """
 
     disconnected: frozenset[str] = field(default_factory=frozenset)
     amp_clip_volts: float | None = None
     noise_factor: float = 1.0
+    laser_latency_s: float = 0.0
+    laser_jitter_s: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "disconnected", frozenset(self.disconnected))
@@ -89,6 +94,10 @@ class RigFaults:
             raise RigSpecError(f"fault: the clipping level must be > 0 V, got {self.amp_clip_volts}")
         if not self.noise_factor >= 0:
             raise RigSpecError(f"fault: the noise factor must be >= 0, got {self.noise_factor}")
+        for key, value in (("latency", self.laser_latency_s), ("jitter", self.laser_jitter_s)):
+            if not 0 <= value <= MAX_LATENCY_S:
+                raise RigSpecError(f"fault: {key} must be seconds from 0 to {MAX_LATENCY_S:g} (e.g. "
+                                   f"latency=0.008,jitter=0.002), got {value:g}")
 
     @classmethod
     def parse(cls, texts: Iterable[str]) -> RigFaults:
@@ -108,7 +117,12 @@ class RigFaults:
             return replace(self, amp_clip_volts=_number(value, "clip"))
         if key == "noise":
             return replace(self, noise_factor=_number(value, "noise"))
-        raise RigSpecError(f"unknown fault {key!r}; known: disconnect=SIGNAL, clip=VOLTS, noise=FACTOR")
+        if key == "latency":
+            return replace(self, laser_latency_s=_number(value, "fault: latency"))
+        if key == "jitter":
+            return replace(self, laser_jitter_s=_number(value, "fault: jitter"))
+        raise RigSpecError(f"unknown fault {key!r}; known: disconnect=SIGNAL, clip=VOLTS, noise=FACTOR, "
+                           f"latency=SECONDS[,jitter=SECONDS]")
 
     def describe(self) -> list[str]:
         out = [f"disconnect={name}" for name in sorted(self.disconnected)]
@@ -116,7 +130,16 @@ class RigFaults:
             out.append(f"clip={self.amp_clip_volts:g}")
         if self.noise_factor != 1.0:
             out.append(f"noise={self.noise_factor:g}")
+        if self.laser_latency_s:
+            out.append(f"latency={self.laser_latency_s:g}")
+        if self.laser_jitter_s:
+            out.append(f"jitter={self.laser_jitter_s:g}")
         return out
+
+    @property
+    def laser_link(self) -> dict[str, float]:
+        """The serial laser's link settings (RigLaser.configure's names)."""
+        return {"link_latency_s": self.laser_latency_s, "link_jitter_s": self.laser_jitter_s}
 
 
 @dataclass(frozen=True, slots=True, eq=False)

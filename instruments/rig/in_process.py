@@ -49,11 +49,15 @@ class InProcessRig:
 
     ``laser``: one of KINDS. The laser's ``ppm``, ``start_latency_s`` (switch-on
     to first measurement), ``link_latency_s`` (measurement to arrival, which no
-    host time shows) and ``error_plan`` apply to every laser ``new_laser`` makes.
+    host time shows), ``link_jitter_s`` (with it the samples arrive in a USB
+    adapter's packets, late by the latency plus up to the jitter:
+    instruments/laser/usb_link.py) and ``error_plan`` apply to every laser
+    ``new_laser`` makes.
     """
 
     def __init__(self, driver: BlockDriver, laser: str = "simulated", *, ppm: float = 25.0,
-                 start_latency_s: float = 0.0, link_latency_s: float = 0.0, error_plan=None, seed: int = 2,
+                 start_latency_s: float = 0.0, link_latency_s: float = 0.0, link_jitter_s: float = 0.0,
+                 error_plan=None, seed: int = 2,
                  blocksize: int = 2048, realtime: bool | None = None, calibration=RIG_CALIBRATION):
         if laser not in KINDS:
             raise ValueError(f"laser: {laser!r}, expected one of {', '.join(KINDS)}")
@@ -65,7 +69,7 @@ class InProcessRig:
             options=dict(driver=driver, blocksize=blocksize, seed=seed, feed=self.feed,
                          realtime=laser in ("simulated", "serial") if realtime is None else realtime)))
         self.laser_settings = {"clock_ppm": float(ppm), "start_latency_s": float(start_latency_s),
-                               "link_latency_s": float(link_latency_s)}
+                               "link_latency_s": float(link_latency_s), "link_jitter_s": float(link_jitter_s)}
         self.error_plan = error_plan
         self.emulator = None
         self.laser = None

@@ -225,17 +225,19 @@ def aim_at_cone(model: SensorModel, feed: DisplacementFeed) -> None:
 
 
 # What the rig's "laser" command may change (SensorModel attributes of the same names).
-CONFIGURABLE = ("clock_ppm", "start_latency_s", "noise_m", "link_latency_s")
+CONFIGURABLE = ("clock_ppm", "start_latency_s", "noise_m", "link_latency_s", "link_jitter_s")
 
 
 class RigLaser:
     """The ILD1420 emulator on the rig's pty, fed by a DisplacementFeed; unplug and plug it back."""
 
     def __init__(self, feed: DisplacementFeed, clock_ppm: float = 37.0, start_latency_s: float = 0.02,
-                 noise_m: float = 0.0, measuring_range_mm: int = 10, link_latency_s: float = 0.0):
+                 noise_m: float = 0.0, measuring_range_mm: int = 10, link_latency_s: float = 0.0,
+                 link_jitter_s: float = 0.0):
         self.feed = feed.start()
         self.settings = {"clock_ppm": float(clock_ppm), "start_latency_s": float(start_latency_s),
                          "noise_m": float(noise_m), "link_latency_s": float(link_latency_s),
+                         "link_jitter_s": float(link_jitter_s),
                          "measuring_range_mm": int(measuring_range_mm)}
         self.emulator: LaserEmulator | None = None
         self._lock = threading.Lock()
@@ -252,7 +254,8 @@ class RigLaser:
                 self.emulator.close()
             s = self.settings
             emulator = LaserEmulator(None, s["measuring_range_mm"], 4000.0, s["clock_ppm"], s["start_latency_s"],
-                                     s["noise_m"], link_latency_s=s["link_latency_s"])
+                                     s["noise_m"], link_latency_s=s["link_latency_s"],
+                                     link_jitter_s=s["link_jitter_s"])
             aim_at_cone(emulator.model, self.feed)
             self.emulator = emulator.start()
             return emulator.port_path
@@ -265,8 +268,8 @@ class RigLaser:
             emulator.disconnect()
 
     def configure(self, **settings: float) -> dict:
-        """Change clock_ppm, start_latency_s, noise_m, link_latency_s (from the next time its output is
-        switched on)."""
+        """Change clock_ppm, start_latency_s, noise_m, link_latency_s, link_jitter_s (from the next time its
+        output is switched on)."""
         unknown = sorted(set(settings) - set(CONFIGURABLE))
         if unknown:
             raise ValueError(f"laser: unknown setting(s) {', '.join(unknown)}; known: {', '.join(CONFIGURABLE)}")

@@ -112,7 +112,8 @@ class RigProcess:
             self.rig.activate()
             laser_pty = None
             if not args.no_laser:
-                self.laser = RigLaser(feed, args.laser_ppm, args.laser_latency, args.laser_noise)
+                self.laser = RigLaser(feed, args.laser_ppm, args.laser_latency, args.laser_noise,
+                                      **faults.laser_link)
                 laser_pty = self.laser.plug()
             self.control = ControlServer(paths.control_socket, self.handle)
             self.control.start()
@@ -173,6 +174,8 @@ class RigProcess:
             faults = RigFaults() if request.get("clear") else rig.engine.faults
             faults = RigFaults.parse([faults_text(faults), *request.get("set", [])])
             rig.engine.faults = faults
+            if self.laser is not None:          # the link's lateness: from the laser's next switch-on
+                self.laser.configure(**faults.laser_link)
             self._update_state(faults=tuple(faults.describe()))
             return {"faults": faults.describe()}
         if cmd == "xrun":

@@ -43,10 +43,11 @@ class LaserEmulator:
                  counter_start: int = 0, rest_distance_m: float | None = None,
                  serial_number: str = "11240001", firmware: str = "004.093.087.02",
                  warnings: Mapping[str, str] | None = None, reply_bytes_per_measurement: int = 0,
-                 chunk_s: float = 0.002, link_latency_s: float = 0.0) -> None:
+                 chunk_s: float = 0.002, link_latency_s: float = 0.0, link_jitter_s: float = 0.0) -> None:
         self.model = SensorModel(displacement, measuring_range_mm, rate_hz, clock_ppm, start_latency_s,
                                  noise_m, error_plan, counter_start=counter_start,
-                                 rest_distance_m=rest_distance_m, link_latency_s=link_latency_s)
+                                 rest_distance_m=rest_distance_m, link_latency_s=link_latency_s,
+                                 link_jitter_s=link_jitter_s)
         self.plan = self.model.error_plan
         self.measuring_range_mm = measuring_range_mm
         self.serial_number = serial_number

@@ -9,7 +9,10 @@ moment measurement output was switched on; its own time stamp advances by
 exactly 1/rate_hz per sample because it counts its own crystal. It reaches
 the host ``link_latency_s`` after it was taken (the sensor's processing, a
 USB adapter's latency timer): a latency no host time can see, only a
-calibration (the plan's ``laser_latency_s``) or the fit's delay-x.
+calibration (the plan's ``laser_latency_s``) or the delay found from the
+data. With ``link_jitter_s`` or ``packet_samples`` > 1 the samples arrive
+in packets, late by the latency plus a random share of the jitter, as
+through a USB serial adapter (instruments/laser/usb_link.py).
 
 Host times here are the emulation's schedule, the audio frame counter's line
 when the displacement comes from a rig (instruments/rig/frame_clock.py):
@@ -30,6 +33,7 @@ from instruments.laser.ild1420.values import (
     COUNTER_MODULUS, X_FULL_SCALE, CounterUnwrapper, LaserErrorCode, block_from_raw, distance_to_x,
     timestamp_words)
 from instruments.laser.sensor import LaserBlock
+from instruments.laser.usb_link import PACKET_SAMPLES, UsbLink
 
 Displacement = Callable[[np.ndarray], np.ndarray]
 
@@ -60,13 +64,16 @@ class SensorModel:
                  rate_hz: float = 4000.0, clock_ppm: float = 0.0, start_latency_s: float = 0.0,
                  noise_m: float = 0.0, error_plan: ErrorPlan | None = None, *,
                  counter_start: int = 0, timestamp_start_s: float = 0.0,
-                 rest_distance_m: float | None = None, link_latency_s: float = 0.0) -> None:
+                 rest_distance_m: float | None = None, link_latency_s: float = 0.0,
+                 link_jitter_s: float = 0.0, packet_samples: int | None = None) -> None:
         self.displacement = displacement or _at_rest
         self.measuring_range_m = measuring_range_mm / 1000.0
         self.rate_hz = float(rate_hz)
         self.clock_ppm = clock_ppm
         self.start_latency_s = start_latency_s
         self.link_latency_s = link_latency_s
+        self.link_jitter_s = link_jitter_s
+        self.packet_samples = packet_samples      # None: packets of PACKET_SAMPLES when there is jitter
         self.noise_m = noise_m
         self.error_plan = error_plan or ErrorPlan()
         self.counter_start = counter_start
@@ -77,6 +84,7 @@ class SensorModel:
         self._counter_next = counter_start
         self._unwrapper = CounterUnwrapper()  # decoded_block's, as the driver's reader keeps one
         self.t0: float | None = None
+        self._link: UsbLink | None = None     # packets and jitter of the link, from begin() on
 
     @property
     def host_rate_hz(self) -> float:
@@ -84,8 +92,12 @@ class SensorModel:
         return self.rate_hz * (1.0 + self.clock_ppm * 1e-6)
 
     def begin(self, t0: float) -> None:
-        """Measurement output switched on at host time t0."""
+        """Measurement output switched on at host time t0 (the link's packets start again)."""
         self.t0 = t0
+        packets = self.packet_samples or (PACKET_SAMPLES if self.link_jitter_s else 1)
+        plain = packets == 1 and not self.link_jitter_s
+        self._link = None if plain else UsbLink(self.link_latency_s, self.link_jitter_s, packets,
+                                                  seed=self.error_plan.seed)
 
     @property
     def disconnect_after(self) -> int | None:
@@ -102,13 +114,17 @@ class SensorModel:
         return self.start_latency_s + np.asarray(k, dtype=np.float64) / self.host_rate_hz
 
     def arrival_time(self, k) -> np.ndarray | float:
-        """Host time at which sample k reaches the host: taken, plus the link's latency."""
+        """Host time at which sample k reaches the host: taken, plus the link's latency (with its packet)."""
+        if self._link is not None:
+            return self.t0 + self._link.arrival(k, self.sample_times)
         return self.t0 + self.sample_times(k) + self.link_latency_s
 
     def due(self, now: float) -> int:
         """How many samples of this stream have reached the host by host time now."""
         if self.t0 is None:
             return 0
+        if self._link is not None:
+            return self._link.arrived(now - self.t0, self.sample_times, self.host_rate_hz, self.start_latency_s)
         elapsed = now - self.t0 - self.start_latency_s - self.link_latency_s
         return 0 if elapsed < 0 else int(np.floor(elapsed * self.host_rate_hz)) + 1
 

@@ -128,3 +128,25 @@ def test_a_nonlinear_rig_starts_and_says_so(virtual_rig, tmp_path):   # virtual_
         assert status.returncode == 0 and "nonlinear model" in status.stdout
     finally:
         assert linpar("stop").returncode == 0
+
+
+@pytest.mark.parametrize("spec, says", [("latency=abc", "expected a number"), ("latency=-0.001", "from 0 to 1"),
+                                        ("latency=1.5", "from 0 to 1"), ("latency=0.008,jitter=-0.002", "from 0 to 1"),
+                                        ("latency=0.008,jitter=inf", "finite")])
+@pytest.mark.parametrize("action", ["start", "fault"])
+def test_a_latency_fault_that_no_link_has_is_one_line_before_anything_starts(capsys, fake_manager, spec, says,
+                                                                             action):
+    argv = ("rig", "start", "--fault", spec) if action == "start" else ("rig", "fault", spec)
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and err.count("\n") == 1 and says in err and out == ""
+    assert fake_manager.calls == []
+
+
+def test_a_latency_fault_with_jitter_is_handed_to_the_rig(capsys, fake_manager):
+    code, _, err = run(capsys, "rig", "start", "--fault", "latency=0.008,jitter=0.002", "--json")
+    assert code == 0, err
+    (_args, kwargs), = fake_manager.calls
+    from instruments.rig.engine import RigFaults
+    faults = RigFaults.parse(_args[3] if len(_args) > 3 else kwargs.get("faults", ()))
+    assert faults.laser_link == {"link_latency_s": 0.008, "link_jitter_s": 0.002}
+    assert faults.describe() == ["latency=0.008", "jitter=0.002"]

@@ -201,3 +201,16 @@ def test_the_raw_capture_file_round_trips_without_pickle(tmp_path):
     with pytest.raises(ValueError, match="format"):
         np.savez(tmp_path / "other.npz", format=np.array("something/1"), info=np.array("{}"))
         read_raw_capture(tmp_path / "other.npz")
+
+
+def test_host_times_off_by_thousands_of_ppm_do_not_keep_the_refinement_from_the_laser_clock():
+    """A loaded machine (or a USB adapter's bursts) can make the audio's arrival times say the laser runs
+    9,300 ppm off (seen on a JACK plan); the refinement then starts from the nominal rate and still finds the
+    laser's 37 ppm."""
+    scene = Scene(ppm=37.0)
+    scene.audio_times = scene.T0 + (scene.audio_times - scene.T0) * (1.0 + 9.3e-3)
+    aligned = scene.align()
+    assert abs(aligned.host_clock.ppm(FS, RATE) - 37.0) > 5000
+    assert aligned.clock.ppm(FS, RATE) == pytest.approx(37.0, abs=0.05) and aligned.passes >= 1
+    freqs, ratio = scene.line_ratio(aligned)
+    assert np.max(np.abs(np.abs(ratio) - 1)[freqs < 300]) < 2e-3

@@ -106,20 +106,37 @@ def test_a_laser_clock_200_ppm_off_starting_100_ms_late_is_corrected(rig, tmp_pa
     assert outcome.alignment["clock_ppm"] == pytest.approx(clock_ppm, abs=1.0)
     result = outcome.result
     assert result.parameters["Bl"].value == pytest.approx(TRUTH["Bl"], rel=0.005)
-    # The leftover delay, fitted by delay-x, against the 100 ms of the start latency and the 0.5 ms a
-    # 200 ppm drift makes over the periods: the host times place both streams to ~0.1 ms (clocks.py; here
-    # typically -0.1 .. +0.1 ms, once -1.1 ms with a second rig and a GUI session on the same two cores).
-    # Its statistical uncertainty is far smaller: what is left is the difference of the two streams'
-    # smallest arrival latencies, not noise; so the bound is the host timing's, not the fit's.
-    assert abs(result.fit.values["tau_x"]) < 0.5e-3
-    # Hx straight from the spectra, without the fit: at the lowest lines (15 - 32 Hz) its phase is the
-    # driver's to 6 degrees (0.5 ms at 35 Hz), its magnitude to 1e-3.
+    # Wherever the host placed the laser's stream (the two streams' smallest arrival latencies: typically
+    # -0.1 .. +0.1 ms, once -1.1 ms on a loaded machine), the data place the delay it left (analysis/
+    # laser_delay.py), and Hx advanced by it is the driver's: nothing here bounds the host's scheduling.
+    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] != "red", result.validity
+    tau = result.fit.values["tau_x"]
+    assert result.parameters["tau_x"].std < 20e-6
     hx = result.spectra.displacement
-    low = hx.freqs < 35.0
-    ratio = hx.value[low] / true_hx(hx.freqs[low])
-    assert low.sum() >= 3
-    assert np.max(np.abs(np.degrees(np.angle(ratio)))) < 6.0
-    assert np.max(np.abs(np.abs(ratio) - 1)) < 1e-3
+    low = hx.freqs < 200.0
+    ratio = hx.value[low] * np.exp(2j * np.pi * hx.freqs[low] * tau) / true_hx(hx.freqs[low])
+    assert low.sum() >= 10
+    assert np.max(np.abs(np.degrees(np.angle(ratio)))) < 1.0
+    assert np.max(np.abs(np.abs(ratio[hx.freqs[low] < 35.0]) - 1)) < 1e-3
+
+
+@pytest.mark.parametrize("latency_ms", [8.0, 20.0])
+def test_a_usb_link_late_by_ms_with_jitter_is_found_from_the_data(rig, tmp_path, latency_ms):
+    """The rig's laser behind a USB serial adapter (--fault latency=...,jitter=0.002): its delay is found from
+    Hx, and the driver recovered; Hx advanced by the delay found is the driver's."""
+    rig.command("fault", set=[f"latency={latency_ms * 1e-3:g},jitter=0.002"])
+    try:
+        result = measure(rig, tmp_path).result
+    finally:
+        rig.command("fault", clear=True)
+    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] != "red", result.validity
+    for name in ("Bl", "Mms", "Kms"):
+        assert result.parameters[name].value == pytest.approx(TRUTH[name], rel=0.005), name
+    tau = result.fit.values["tau_x"]
+    hx = result.spectra.displacement
+    low = hx.freqs < 200.0
+    ratio = hx.value[low] * np.exp(2j * np.pi * hx.freqs[low] * tau) / true_hx(hx.freqs[low])
+    assert np.max(np.abs(np.degrees(np.angle(ratio)))) < 1.0
 
 
 def test_closing_the_laser_pty_mid_measurement_ends_it_within_2_s_keeping_the_periods(rig, tmp_path):

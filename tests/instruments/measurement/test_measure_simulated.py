@@ -33,12 +33,10 @@ from tests.pace import paced
 PAPER = load_driver("paper")
 TRUTH = {**PAPER.parameters, **derived_from_values(PAPER.parameters)}
 PERIOD = 8192
-# How far the alignment's offset may lie from the emulation's truth: the workstation's audio pump hands a
-# block on some tens of microseconds after the card's schedule at best (its lower envelope), more on a busy
-# machine. Measured over 20 runs idle and 20 with both cores busy: see docs/timing.md.
-SLACK_S = 0.25e-3
-# How closely delay-x finds the offset's error: the fit's own uncertainty on tau_x here is ~5 us.
-FIT_TAU_S = 30e-6
+# How closely the delay found from the data (delay-x) matches where the emulation really put the laser's
+# samples against the alignment (InProcessRig.truth), whatever the host's threads did: measured within
+# 0.2 us at link latencies 0 - 20 ms with 2 ms of jitter; the bound the issue asks for.
+FIT_TAU_S = 20e-6
 
 
 def plan(**changes) -> MeasurementPlan:
@@ -47,11 +45,12 @@ def plan(**changes) -> MeasurementPlan:
     return MeasurementPlan.from_template("woofer", **{**base, **changes})
 
 
-def simulated(ppm=0.0, latency_s=0.0, error_plan=None, serial=True, link_latency_s=0.0):
+def simulated(ppm=0.0, latency_s=0.0, error_plan=None, serial=True, link_latency_s=0.0, link_jitter_s=0.0):
     """The paper driver on a one-period FIR and, with ``serial``, a SimulatedLaser measuring its cone."""
     driver = LinearBlockDriver(PAPER.model(), dict(PAPER.parameters), 48000, fir_length=PERIOD)
     return InProcessRig(driver, "simulated" if serial else "analog", ppm=ppm, start_latency_s=latency_s,
-                        link_latency_s=link_latency_s, error_plan=error_plan, realtime=True)
+                        link_latency_s=link_latency_s, link_jitter_s=link_jitter_s, error_plan=error_plan,
+                        realtime=True)
 
 
 def assert_recovers(result, names=("RE", "fs", "Bl", "Mms", "Qts"), rel=0.005):
@@ -80,11 +79,9 @@ def test_the_serial_laser_is_aligned_and_the_driver_recovered_with_everything_on
     assert "displacement" in frames[-1].channels and frames[-1].peak_displacement_m > 1e-4
     assert_recovers(outcome.result)
     assert "delay-x" in outcome.result.model.effect_ids
-    # The 50 ms start latency is gone. What is left is the difference of the smallest arrival latencies of
-    # the workstation's own threads (its audio pump; the simulated laser stamps its blocks by the schedule),
-    # which delay-x fits: SLACK_S (see the link-latency test).
+    # What the 50 ms start latency and the host's threads leave, wherever the host put it, is found from the
+    # data (see the link-latency test).
     offset_error = rig.truth().delay_s(outcome.alignment["offset_audio_samples"], 48000)
-    assert abs(offset_error) < SLACK_S
     assert outcome.result.fit.values["tau_x"] == pytest.approx(offset_error, abs=FIT_TAU_S)
     assert outcome.alignment["clock_ppm"] == pytest.approx(150.0, abs=0.5)
     sidecar = json.loads(outcome.sidecar_path.read_text())
@@ -96,18 +93,22 @@ def test_the_serial_laser_is_aligned_and_the_driver_recovered_with_everything_on
     assert info["laser"]["alignment"]["clock_ppm"] == outcome.alignment["clock_ppm"]
 
 
-def test_a_link_latency_the_host_times_cannot_see_is_fitted_as_a_delay_from_a_start_in_the_data(tmp_path,
-                                                                                                  record_property):
-    """2 ms from a measurement to its arrival (the sensor's processing, a USB adapter's latency timer), which
-    no host time shows: the displacement lags by 2 ms, which delay-x fits from a start read off Hx's phase
-    (from 0 it would not converge beyond ~0.3 ms)."""
-    rig = simulated(ppm=-30.0, link_latency_s=0.002)
+@pytest.mark.parametrize("latency_ms", [0.0, 3.0, 8.0, 15.0, 20.0])
+def test_a_usb_links_latency_with_jitter_is_found_from_the_data(tmp_path, record_property, latency_ms):
+    """A laser behind a USB serial adapter: its samples come in packets, late by a latency the host times
+    cannot see plus up to 2 ms of jitter. The delay the alignment leaves (the truth: where the emulation put
+    the samples) is found from Hx against the model, with no start from the host, and the driver recovered."""
+    rig = simulated(ppm=-30.0, link_latency_s=latency_ms * 1e-3, link_jitter_s=2e-3)
     outcome = run_measurement(plan(), rig.audio, rig.laser, tmp_path, name="m")
-    offset_error = rig.truth().delay_s(outcome.alignment["offset_audio_samples"], 48000)
-    record_property("tau_x_s", outcome.result.fit.values["tau_x"])      # for the spread over runs (--junitxml)
-    assert offset_error == pytest.approx(0.002, abs=SLACK_S)
-    assert outcome.result.fit.values["tau_x"] == pytest.approx(offset_error, abs=FIT_TAU_S)
-    assert outcome.result.parameters["Bl"].value == pytest.approx(TRUTH["Bl"], rel=0.005)
+    injected = rig.truth().delay_s(outcome.alignment["offset_audio_samples"], 48000)
+    result = outcome.result
+    found = result.fit.values["tau_x"]
+    record_property("delay_error_s", found - injected)      # for the spread over runs (--junitxml)
+    assert found == pytest.approx(injected, abs=FIT_TAU_S)
+    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] == "green"
+    for name in ("Bl", "Mms", "Kms"):
+        assert result.parameters[name].value == pytest.approx(TRUTH[name], rel=0.005), name
+    assert result.parameters["tau_x"].std < FIT_TAU_S       # reported with its uncertainty
 
 
 def test_laser_error_codes_are_counted_not_averaged_and_judged(tmp_path):
