@@ -112,7 +112,11 @@ def derived(model: LargeSignalModel, thresholds: LimitThresholds = LimitThreshol
         spread = [v for v in spread if v is not None]
         limits[name] = Limit(name, value, float(np.std(spread)) if len(spread) > 2 else float("nan"),
                              criteria[name], beyond, side)
-    return Derived(offset, float(np.std(offsets)), at_edge, asym, float(np.std(asyms)), x_sym, limits)
+    return Derived(offset, _spread(offsets), at_edge, asym, _spread(asyms), x_sym, limits)
+
+
+def _spread(values: list[float]) -> float:
+    return float(np.std(values)) if values else float("nan")
 
 
 def _margin_fn(name: str, th: LimitThresholds):
@@ -177,6 +181,8 @@ def _draws(model: LargeSignalModel, n: int, seed: int):
     """(Bl, Kms, Le coefficients, rest shift) drawn from the covariance; the shift moves every curve alike."""
     rng = np.random.default_rng(seed)
     curves = [model.Bl, model.Kms, model.Le]
+    if not all(np.all(np.isfinite(c.cov)) for c in curves):
+        return []      # a fit that could not say its covariance: the limits' 1-sigma are unknown, not zero
     draws = [rng.multivariate_normal(c.coefficients, _psd(c.cov), size=n, method="eigh") for c in curves]
     shifts = rng.normal(0.0, model.Bl.x0_std, size=n) if model.Bl.x0_std > 0 else np.zeros(n)
     out = []

@@ -222,6 +222,17 @@ def test_thresholds_are_settable_and_move_the_limits(known):
         LimitThresholds(bl_ratio=1.5)
 
 
+def test_a_covariance_the_fit_could_not_give_leaves_the_limits_uncertainty_unknown(known):
+    """A fit that ends with NaN in a curve's covariance (seen once on a loaded rig) must not crash the limits:
+    their values stand, their 1-sigma are unknown (NaN, written as null), never zero."""
+    _, _, _, result = known
+    from analysis.large_signal.limits import derived
+    broken_bl = dataclasses.replace(result.model.Bl, cov=np.full_like(result.model.Bl.cov, np.nan))
+    out = derived(dataclasses.replace(result.model, curves={**result.model.curves, "Bl": broken_bl}))
+    assert out.limits["X_Bl"].value == pytest.approx(derived(result.model).limits["X_Bl"].value)
+    assert np.isnan(out.limits["X_Bl"].std) and np.isnan(out.offset_std)
+
+
 def test_predictions_at_a_chosen_level(known):
     _, _, _, result = known
     prediction = result.predictions[0]
