@@ -1,4 +1,4 @@
-"""The layers of STYLE.md, enforced: the import-linter contracts in pyproject.toml, run as `make test` runs.
+"""The layers of CONTRIBUTING.md, enforced: the import-linter contracts in pyproject.toml, run as `make test` runs.
 
 analysis imports neither instruments nor app and no Qt; instruments imports no app and no Qt.
 """
