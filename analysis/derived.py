@@ -1,4 +1,4 @@
-"""Derived parameters with propagated uncertainties (physics.md sections 1 and 3).
+"""Derived parameters with propagated uncertainties (docs/physics.md sections 1 and 3).
 
     fs  = 1 / (2 pi sqrt(CMES LCES))      Mms = CMES Bl^2     Rms = Bl^2 / RES
     Cms = LCES / Bl^2    Kms = 1 / Cms    Qes = 2 pi fs CMES RE    Qms = 2 pi fs CMES RES
@@ -131,7 +131,7 @@ def _split(x) -> tuple[float, float | None]:
 
 def parameter_table(fit: FitResult, sd_m2: float | None,
                     no_displacement: str = NO_DISPLACEMENT) -> dict[str, ParameterValue]:
-    """Fitted and derived parameters, in the order of physics.md, with reasons for the missing.
+    """Fitted and derived parameters, in the order of docs/physics.md, with reasons for the missing.
 
     `no_displacement`: why the parameters that need Bl are missing when the fit had no displacement.
     """

@@ -1,4 +1,4 @@
-"""Peak excursion of a measurement (physics.md section 6): reported for every one.
+"""Peak excursion of a measurement (docs/physics.md section 6): reported for every one.
 
 The peak is taken from the coherent mean period, the average of the analysed
 periods sample by sample,

@@ -7,7 +7,7 @@ early, and keeps the last level that was still right, when
 - a channel's noise + distortion stands `distortion_limit_db` above its noise
   floor (the driver leaves its linear range, or the amplifier limits),
 - the peak excursion passes `x_limit_m` (0.5 mm by default: the small-signal
-  range, physics.md section 6),
+  range, docs/physics.md section 6),
 - the next step would pass `v_max`, the user's maximum voltage (it then
   measures at v_max once).
 

@@ -1,4 +1,4 @@
-"""A level series: the "linear" parameters against peak excursion (physics.md section 6, the paper's Table II).
+"""A level series: the "linear" parameters against peak excursion (docs/physics.md section 6, the paper's Table II).
 
 Measured at rising drive levels, the parameters a linear model fits drift: they
 are weighted means of the nonlinear curves Bl(x), Kms(x), Le(x) over the

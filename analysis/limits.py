@@ -298,7 +298,7 @@ def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], valid
     `validity`: the result's validity, or its overall light alone.
 
     Neither an invalid nor a not-judged result has its parameters judged against
-    their limits (physics.md section 5): the why says what to do.
+    their limits (docs/physics.md section 5): the why says what to do.
     """
     from analysis.qa_verdict import judge
     judgement = judge(limits, parameters, validity)

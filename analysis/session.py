@@ -1,6 +1,6 @@
 """Who measured what, where, when and with which software: the traceability of a measurement.
 
-The recording's sidecar holds it under "session" (../shared/spec/recording-format.md):
+The recording's sidecar holds it under "session" (docs/recording-format.md):
 
     "session": {"operator": "A. Tester", "station": "bench-2", "template": "woofer",
                 "measured_at": "2025-05-01T10:20:30Z", "software": "linpar 0.1.0"}

@@ -1,4 +1,4 @@
-"""Predicted sound pressure from the displacement transfer function (physics.md section 4).
+"""Predicted sound pressure from the displacement transfer function (docs/physics.md section 4).
 
 Far field of a piston in half space (2 pi sr) at distance r:
 

@@ -1,4 +1,4 @@
-"""Every limit the validity checks use, in one place (physics.md section 5).
+"""Every limit the validity checks use, in one place (docs/physics.md section 5).
 
 The defaults below are what the workstation ships with; a JSON file of
 overrides ({"snr_red_db": 25, ...}, any subset of the field names) changes
@@ -15,7 +15,7 @@ snr_red_db = 20
     A transfer function is a ratio of averaged lines, Z = U/I. With noise on
     the denominator the ratio is biased by about 1/SNR (power ratio): 1 % at
     20 dB, more than the paper's repeatability of RE (0.3 %) or Bl (0.35 %)
-    (physics.md section 7). Below it the parameters are not just noisy but wrong.
+    (docs/physics.md section 7). Below it the parameters are not just noisy but wrong.
 snr_yellow_db = 30
     A line's own scatter is then below 3 %; the fit still reports honest
     uncertainties below 30 dB, but they grow quickly.
@@ -36,7 +36,7 @@ distortion_yellow_db = 6, distortion_red_db = 10
     distortion_min_bins = 32 lines keep the noise-only ratio within ~1 dB,
     so noise alone never reaches 6 dB even in the worst of thirty bands.
 x_band_red_hz = 300
-    physics.md: a displacement that sinks into the noise below ~300 Hz does
+    docs/physics.md: a displacement that sinks into the noise below ~300 Hz does
     not carry the resonance region well enough to give Bl. Yellow below 500 Hz.
 x_line_snr_db = 20, x_lines_red = 10, x_lines_yellow = 20
     A displacement line "stands above the noise" at 20 dB (the same bias
@@ -47,7 +47,7 @@ full_scale_red = 0.999, full_scale_yellow = 0.9
     A sample at full scale is a clipped sample. Above 90 % of full scale
     (< 1 dB headroom) the next level step will clip.
 laser_error_red_share = 0.01, out_of_range_red_share = 0.001
-    Error codes are not distances (spec/laser-ild1420.md). When the recording
+    Error codes are not distances (docs/laser-protocol.md). When the recording
     says what leaving them out cost (capture.laser_gaps), that decides (the
     laser_gap_* below); otherwise any is yellow, 1 % is red. Out of range
     means the cone left the measuring range at its peaks, which clips the

@@ -257,7 +257,7 @@ class QAView(QWidget):
         self.judgement = judge(self.limits, self.result.parameters, self.result.validity)
         self.verdicts = self.judgement.verdicts
         # Parameters of an invalid measurement, or of a model that does not describe it, are worthless
-        # (physics.md section 5): no parameter is judged against its limit (the verdict says why).
+        # (docs/physics.md section 5): no parameter is judged against its limit (the verdict says why).
         judged = self.judgement.judged
         colours = {"pass": Qt.darkGreen, "FAIL": Qt.darkRed, "uncertain": QColor("#8a4300")}
         self.table.setRowCount(len(self.verdicts))

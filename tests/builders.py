@@ -19,7 +19,7 @@ PAPER = load_driver("paper")
 
 
 def electrical(RE, LE, Mms, Cms, Rms, Bl, **extra) -> dict[str, float]:
-    """Electrical-analogue values from mechanical ones (physics.md section 1)."""
+    """Electrical-analogue values from mechanical ones (docs/physics.md section 1)."""
     return {"RE": RE, "LE": LE, "CMES": Mms / Bl**2, "LCES": Cms * Bl**2, "RES": Bl**2 / Rms, "Bl": Bl, **extra}
 
 
@@ -51,7 +51,8 @@ def recording(values=None, effects="lr2,creep-log", *, n_periods=8, settle=1, no
 TYPICAL_NOISE = ChannelNoise(voltage=1e-4, current=1e-4, displacement=1e-8)
 
 
-# The real measurements of ../shared/data/real (beside the repository, in CI too).
+# Real drivers measured by others: a data set kept beside the repository (its sibling folder
+# "shared", data/real; or $LINPAR_SHARED/data/real), in CI too. Tests skip, saying why, without it.
 REPO_ROOT = Path(__file__).resolve().parent.parent
 REAL_DATA = Path(os.environ.get("LINPAR_SHARED", REPO_ROOT.parent / "shared")) / "data" / "real"
 

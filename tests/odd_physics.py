@@ -2,7 +2,7 @@
 
 Each shape is odd on purpose (a bump in log f with a twisted phase, a dip
 that comes back): no textbook effect has it, and no reasonable catalogue
-or effect file would add it. Each acts at one site of physics.md section 8,
+or effect file would add it. Each acts at one site of docs/physics.md section 8,
 the way an effect there acts, so the site localisation has a right answer.
 The sizes make the default model miss by 10^2 to 10^5 in reduced chi^2 with
 the tests' typical noise.

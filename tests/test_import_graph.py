@@ -1,4 +1,4 @@
-"""No module import circles anywhere in the project (STYLE.md: "a circle is a missing module").
+"""No module import circles anywhere in the project (CONTRIBUTING.md: "a circle is a missing module").
 
 The graph is read from the source with ast, nothing is imported. Every import
 counts, wherever it is written: at the top, inside a function (a late import

@@ -1,4 +1,4 @@
-"""The noise of an imported curve, from its own local scatter (physics.md section 9).
+"""The noise of an imported curve, from its own local scatter (docs/physics.md section 9).
 
 A curve exported by another tool has no periods to take the noise from.
 Each line's noise is estimated instead from the scatter of the curve about

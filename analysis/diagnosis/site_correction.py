@@ -6,7 +6,7 @@ The correction is a complex function of frequency,
 
 with cubic B-splines B_k on knots evenly spaced in ln f over the measured
 band (KNOTS_PER_DECADE). It enters the model the way an effect at that site
-does (physics.md section 8), in a form that is smooth for the physics
+does (docs/physics.md section 8), in a form that is smooth for the physics
 expected there:
 
     electrical     Ze + RE0 * h          ohms added to the blocked impedance (RE0: RE of the fit it starts from)

@@ -1,6 +1,6 @@
 """Where the physics is missing: the site localisation.
 
-For each of the six sites of physics.md section 8, the current model gets a
+For each of the six sites of docs/physics.md section 8, the current model gets a
 smooth, flexible complex correction there (analysis.diagnosis.site_correction) and is
 refitted with it, its own parameters free. The sites are ranked by how much
 misfit their correction removes, paid for by its effective number of

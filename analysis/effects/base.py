@@ -17,7 +17,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 
 class Site(Enum):
-    """Where an effect's response enters the model (physics.md section 8; analysis.model.composed composes them).
+    """Where an effect's response enters the model (docs/physics.md section 8; analysis.model.composed composes them).
 
     The member's `key` is the site's name in files, JSON and on screen: the
     same six names are the sites of the catalogue, of the site localisation

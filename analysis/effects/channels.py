@@ -143,7 +143,7 @@ delay_x = DisplacementDelay(
                "(w*tau_x), while |Hx| fits; the impedance is unaffected."),
     typical=("0 to 1 ms (sensor latency of a few measuring periods; ILD1420 at 4 kHz: 0.25 ms each); "
              "1 to 25 ms through a USB serial adapter (its packets and latency timer)"),
-    reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate and output latency); shared/spec/laser-ild1420.md",
+    reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate and output latency); docs/laser-protocol.md",
     notes=("Below a low-pass's corner frequency a delay and a first-order low-pass look alike (a phase lag "
            "proportional to f): lowpass-x is the alternative when |Hx| also drops at the top. The fit "
            "starts from the slope of the phase that the current model leaves in Hx over the top octave "
@@ -181,7 +181,7 @@ lowpass_x = DisplacementLowPass(
     signature=("Displacement residual at the top of the band: the measured |Hx| falls below the model and "
                "its phase lags, by 45 degrees at fc_x; the impedance is unaffected."),
     typical="fc_x 1 to 20 kHz (a 4 kHz measuring rate gives about 1 to 2 kHz)",
-    reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate, averaging); shared/spec/laser-ild1420.md",
+    reference="Micro-Epsilon optoNCDT 1420 manual (measuring rate, averaging); docs/laser-protocol.md",
     notes=("When fc_x lies far above the band the fit only sees the phase lag w/wc and fc_x trades against a "
            "delay (see delay-x); its standard error is then large, rightly."),
 )

@@ -1,6 +1,6 @@
 """The driver measured in a box: the enclosure's air as a mechanical load on the cone.
 
-The box's air is a spring on the cone, Kb = rho*c^2*Sd^2/Vb; with Vas = rho*c^2*Sd^2*Cms (physics.md
+The box's air is a spring on the cone, Kb = rho*c^2*Sd^2/Vb; with Vas = rho*c^2*Sd^2*Cms (docs/physics.md
 section 3) that is Kb = alpha_b*Kms, alpha_b = Vas/Vb, so neither Sd nor Bl is needed: in the model's
 admittance Y = Zm/Bl^2 the spring Kb/s is alpha_b/(s*LCES). Kms and the creep law remain the
 suspension's own (the box's air does not creep), Mms the driver's moving mass.

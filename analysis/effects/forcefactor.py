@@ -16,7 +16,7 @@ Eliminating i_f = -(s*M*i + Bl_f*v) / (R_f + s*L_f):
 The first bracket is the LR-2 model of the blocked impedance (L2 = M^2/L_f, R2 = M^2*R_f/L_f^2,
 corner R_f/L_f), the last term a small damping (at most Bl_f^2/R_f, a part of Rms below the corner).
 The middle bracket multiplies Bl in the back-EMF and, by reciprocity, in the force alike: the
-force-factor site of physics.md section 8, with
+force-factor site of docs/physics.md section 8, with
 
     g(s) = 1 - dBl * s*tau / (1 + s*tau),   tau = 1 / (2*pi*f_Bl),   dBl = M*Bl_f / (Bl*L_f)
 

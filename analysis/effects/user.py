@@ -18,7 +18,7 @@ Optional: `category` (one effect per category in a model; by default the effect 
 own), `signature`, `typical`, `reference`, and per parameter `description` and `typical = [lo, hi]`
 (a fit outside is flagged, as for the catalogue). Anything else is refused.
 
-The formula (analysis.effects.formula) gives, at its site (physics.md section 8):
+The formula (analysis.effects.formula) gives, at its site (docs/physics.md section 8):
 
     electrical     ohms added to the blocked impedance Ze
     force-factor   a factor on Bl, in the force and the back-EMF alike

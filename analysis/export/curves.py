@@ -11,7 +11,7 @@ Numbers are written with Python's shortest round-trip repr, so a curve read
 back is the curve written, bit for bit. Measured curves are at the measured
 lines; model curves on a logarithmic grid (MODEL_PER_DECADE lines a decade)
 over the measured band only, where the model was fitted. The .frd is the
-predicted far-field SPL of physics.md section 4 (half space, SPL_DISTANCE_M,
+predicted far-field SPL of docs/physics.md section 4 (half space, SPL_DISTANCE_M,
 SPL_VOLTAGE), which needs Hx (the laser) and Sd.
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Large-signal parameters: Bl(x), Kms(x), Le(x) (and L2(x), Le(i), Rms(v), creep) from multitone recordings
-with the laser, the coil's rest offset and the excursion limits (physics.md section 6).
+with the laser, the coil's rest offset and the excursion limits (docs/physics.md section 6).
 
     data.py         what a recording gives: periods, bands          columns.py   the equations as regressions
     weights.py      each line's noise and misfit                    solve.py     weighted least squares

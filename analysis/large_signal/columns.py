@@ -1,4 +1,4 @@
-"""The large-signal equations as linear regressions on the measured u, i and x (physics.md section 6).
+"""The large-signal equations as linear regressions on the measured u, i and x (docs/physics.md section 6).
 
 With x measured, both equations of the large-signal model are linear in the
 coefficients of the polynomials (xn = x / x_scale, so that every power stays

@@ -8,7 +8,7 @@
     X_C              ... at which Cms(x) = 1 / Kms(x) falls to compliance_ratio of Cms(0) (75 %)
     X_L              ... at which Le(x) leaves Le(0) by more than le_change              (10 %)
 
-The defaults are Klippel's published ones, after IEC 62458 (physics.md
+The defaults are Klippel's published ones, after IEC 62458 (docs/physics.md
 section 6). A limit is looked for on both sides of the rest position,
 inside the range the measurements covered: where a side's curve never
 crosses its threshold there, that side only says "beyond the covered range"

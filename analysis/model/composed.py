@@ -1,4 +1,4 @@
-"""The lumped loudspeaker model of physics.md, composed with effects.
+"""The lumped loudspeaker model (docs/physics.md section 1), composed with effects.
 
     Ze(s) = RE + s*LE + sum(blocked effects)
     Y(s)  = s*CMES + 1/RES + 1/(s*LCES*c(s)) + sum(mechanical effects)   c(s): product of compliance factors
@@ -11,7 +11,7 @@
 The motional branch is written as an admittance so that mechanical effects
 (which add to Zm, and Y = Zm / Bl^2) simply add. Bl only scales Hx. A
 force-factor effect multiplies Bl in the force and in the back-EMF alike
-(physics.md section 8: U = Ze*I + g*Bl*v, g*Bl*I = Zm*v), hence g^2 in Z and
+(docs/physics.md section 8: U = Ze*I + g*Bl*v, g*Bl*I = Zm*v), hence g^2 in Z and
 g in Hx; with g = 1 Hx is the textbook ZR / (ZR + Ze) / (Bl*s).
 """
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.errors import LinparError
 
-# The textbook model without extra effects: the lumped elements of physics.md.
+# The textbook model without extra effects: the lumped elements of docs/physics.md section 1.
 BASE_PARAMS: tuple[ParamSpec, ...] = (
     ParamSpec("RE", "ohm", "ohm", 1.0, 1e-3, 1e3, 6.0, "voice-coil DC resistance"),
     ParamSpec("LE", "H", "mH", 1e3, 0.0, 1.0, 1e-4, "voice-coil inductance"),

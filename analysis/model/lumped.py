@@ -5,7 +5,7 @@ from typing import Mapping
 
 import numpy as np
 
-RHO = 1.18        # kg/m^3, air at 20 C (physics.md section 3)
+RHO = 1.18        # kg/m^3, air at 20 C (docs/physics.md section 3)
 C_SOUND = 343.0   # m/s
 
 

@@ -3,7 +3,7 @@ its alarms, a histogram, and the stations compared; plus the verdicts as the sta
 
 Which units count: a measurement whose validity is red, or that its limits
 version could not judge ("invalid", "not judged": the model does not
-describe it), has parameters that judge nothing (physics.md section 5): it
+describe it), has parameters that judge nothing (docs/physics.md section 5): it
 is left out, and counted, with the reason, where the user reads the result.
 The limits the capability is computed against are one stored version (the
 newest unless another is asked for); the recorded verdicts each keep the

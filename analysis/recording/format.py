@@ -1,7 +1,7 @@
 """Recordings: the raw signals of one multitone measurement, and their files.
 
 A recording is NAME.wav (the samples) and NAME.json (the sidecar: what each
-channel is and how to scale it); the format is ../shared/spec/recording-format.md.
+channel is and how to scale it); the format is docs/recording-format.md.
 A Recording in memory always satisfies every rule of the format: the checks run
 when it is built, whether from files (read_recording), from signals
 (make_recording) or directly, so code that holds one need not check again.

@@ -5,7 +5,7 @@ below it that knows the JSON: the format's name, the signals and their units,
 the keys of each object, a Channel (one entry of "channels"), RecordingError,
 and the one-line messages about a sidecar. Import the public names from
 analysis.recording.format, which re-exports them; the format is
-../shared/spec/recording-format.md.
+docs/recording-format.md.
 """
 from __future__ import annotations
 

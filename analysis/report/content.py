@@ -119,8 +119,8 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     info = result.model_info
     effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
     chi = info.get("chi2_red") or {}
-    rows = [("Model", "lumped model of physics.md" + (" with Hx (laser)" if result.with_displacement else
-                                                       ", impedance only")),
+    rows = [("Model", "Lumped model (electrical + mechanical)" + (" with Hx (laser)" if result.with_displacement
+                                                                 else ", impedance only")),
             ("Effects", effects)] + _user_effect_rows(result)
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))

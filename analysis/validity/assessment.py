@@ -1,4 +1,4 @@
-"""Whether a measurement can be trusted, channel by channel (physics.md section 5).
+"""Whether a measurement can be trusted, channel by channel (docs/physics.md section 5).
 
 `assess(recording)` runs every check and returns a Validity:
 

@@ -20,7 +20,7 @@ Sidecar shape (every key optional):
                      "unseen_s": 0.0, "lost": 0, "outliers": 0}
     }
 
-Laser measurements that are not distances (spec/laser-ild1420.md) are never
+Laser measurements that are not distances (docs/laser-protocol.md) are never
 averaged into the signal. The measurement runner treats them as missing data
 (instruments/measurement/laser_gaps.py) and says in "laser_gaps" what that
 cost: the displacement's noise grows by noise_factor (in variance), and

@@ -167,7 +167,7 @@ def sign_findings(spectra, re_ohm: float | None) -> list[Finding]:
 
         Bl = (Z - Ze) / (s * Hx * Z)
 
-    (physics.md: Hx = Bl / (s*Zm*Z), Z - Ze = Bl^2 / Zm), real and positive for a cone that moves outward
+    (docs/physics.md section 1: Hx = Bl / (s*Zm*Z), Z - Ze = Bl^2 / Zm), real and positive for a cone that moves outward
     with a positive current. Taken where the motion dominates Z (|Z| > 2 RE, around fs, Ze ~ RE there);
     pointing the other way on most of those lines: the displacement's sign is inverted. An inverted sign
     drags a fit's fs and Bl anywhere, so the fit's values are not used, only its RE."""

@@ -1,4 +1,4 @@
-"""The validity checks that need only the averaged spectra (physics.md section 5).
+"""The validity checks that need only the averaged spectra (docs/physics.md section 5).
 
 For each channel, from the coherent mean X[k] and the variance of the mean
 var[k] of every bin (analysis.spectra):

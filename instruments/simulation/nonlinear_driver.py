@@ -1,6 +1,6 @@
 """A loudspeaker whose Bl, stiffness, inductances and damping depend on the cone and the coil, in the time domain.
 
-Equations (physics.md sections 1 and 6 with the parameters made functions of x,
+Equations (docs/physics.md sections 1 and 6 with the parameters made functions of x,
 i and v; state: coil current i, eddy-branch current i2, velocity v, displacement x):
 
     d/dt(L(x, i) i)  = u - RE i - R2 (i - i2) - Bl(x) v     (L(x, i) i: the coil's flux)
@@ -78,10 +78,10 @@ from instruments.simulation.block_driver import DriverBlock
 from instruments.simulation.linear_driver import (
     DEFAULT_FIR_LENGTH, DEFAULT_PARTITION, PartitionedConvolver, frequency_sampled_fir)
 
-# Defaults: the paper's driver softens with excursion (physics.md section 6: fs falls, Cms rises).
+# Defaults: the paper's driver softens with excursion (docs/physics.md section 6: fs falls, Cms rises).
 # Kms(x)/Kms0 = 1 - 12000 x^2 + 4.5e7 x^4: -27 % at 5 mm, -64 % at 8.6 mm, lowest (0.2) at 11.5 mm.
 # With the project's multitone (16,384 samples, 5 Hz - 10 kHz) the fitted fs falls from 70.5 to 58 Hz
-# and Cms rises by 53 % at 8.5 mm peak: the paper's 57.1 Hz and +50 % at 8.6 mm (physics.md section 6).
+# and Cms rises by 53 % at 8.5 mm peak: the paper's 57.1 Hz and +50 % at 8.6 mm (docs/physics.md section 6).
 DEFAULT_KMS_POLY = (0.0, -12000.0, 0.0, 4.5e7)
 # Bl(x)/Bl0 = 1 - 5000 x^2: -12.5 % at 5 mm (Klippel's Xmax criterion, 82 % of Bl0, near 6 mm).
 DEFAULT_BL_POLY = (0.0, -5000.0)
@@ -111,7 +111,7 @@ class NonlinearBlockDriver:
                  i_range_a: float = DEFAULT_I_RANGE_A, substeps: int = 1):
         missing = [k for k in ("RE", "LE", "CMES", "LCES", "RES", "Bl") if k not in values]
         if missing:
-            raise ValueError(f"values lack {', '.join(missing)} (the electrical analogues of physics.md)")
+            raise ValueError(f"values lack {', '.join(missing)} (the electrical analogues of docs/physics.md section 1)")
         if sample_rate <= 0:
             raise ValueError(f"sample_rate must be positive, got {sample_rate}")
         if values["LE"] <= 0:

@@ -9,7 +9,7 @@ from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
-# physics.md section 7: mean and std of 10 repetitions
+# docs/physics.md section 7: mean and std of 10 repetitions
 TABLE_I = {"fs": (70.5, 0.057, 1.0), "Mms": (11.87, 0.075, 1e3), "Rms": (2.27, 0.013, 1.0),
            "Cms": (0.43, 0.0057, 1e3), "Kms": (2.33, 0.011, 1e-3)}
 

@@ -1,4 +1,4 @@
-"""Level series (physics.md section 6, Table II): the parameters drift with the excursion as the paper's did.
+"""Level series (docs/physics.md section 6, Table II): the parameters drift with the excursion as the paper's did.
 
 The series is measured on the simulated nonlinear driver (the paper's driver,
 softening with excursion). Asserted on the trend, not on exact numbers: fs

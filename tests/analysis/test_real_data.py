@@ -1,4 +1,4 @@
-"""Real measured drivers (../shared/data/real): import, added mass, the whole laser method.
+"""Real measured drivers (the data set beside the repository, tests.builders.REAL_DATA): import, added mass, the whole laser method.
 
 None of the reference values is ground truth (see the data README): the
 tests check agreement with what other tools report on the same files, at

@@ -24,7 +24,7 @@ from tests.app.wizard.test_wizard_helpers import choose_simulator, run_job, to_h
 # A Python repr: Name(...) nested, Name(key=...), or <... object at 0x...>.
 FORBIDDEN = {
     "a Python repr": re.compile(r"\b[A-Z]\w*\((?:[A-Z]\w*\(|\w+=)|<\w[\w.]* object at 0x"),
-    "physics.md": re.compile(r"physics\.md"),
+    "docs/physics.md": re.compile(r"physics\.md"),
     "Table I": re.compile(r"\bTable I\b"),
     "ΔBIC": re.compile(r"ΔBIC"),
 }
@@ -116,7 +116,7 @@ def offending_texts(root: QWidget, patterns: dict[str, re.Pattern] = FORBIDDEN) 
     ("SimulatedAudio(LinearBlockDriver(lr2,creep-log, 48000 Hz, 65536 taps), 48000 Hz)", True),
     ("Fit(method='leastsq')", True),
     ("<analysis.fit.least_squares.FitResult object at 0x7f00>", True),
-    ("see physics.md section 5", True),
+    ("see docs/physics.md section 5", True),
     ("as the paper's Table I.", True),
     ("ΔBIC -9.2e9", True),
     ("LR-2 (L2 shunted by R2)", False),

@@ -2,7 +2,7 @@
 (frames.py), ASCII commands (commands.py), 18-bit values (values.py), the
 physics of a virtual one (sensor_model.py) and its emulator on a
 pseudo-terminal (emulator.py, POSIX only: imported by the virtual rig and the
-tests, never from here). See shared/spec/laser-ild1420.md.
+tests, never from here). See docs/laser-protocol.md.
 
 ``MODEL`` is what the factory (instruments/laser/factory.py) finds: importing
 this package loads neither pyserial nor the emulator.

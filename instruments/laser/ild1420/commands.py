@@ -1,6 +1,6 @@
 """The ILD1420's ASCII commands: their names, their parameters, their replies.
 
-The names follow the manual as quoted in shared/spec/laser-ild1420.md
+The names follow the manual as quoted in docs/laser-protocol.md
 (GETINFO, MEASRATE, OUTPUT, GETOUTINFO_RS422, RESETCNT). The spec does not
 name the command that adds the counter and time stamp to the RS422 output;
 we use OUTADD_RS422, the manual family's spelling. Every name lives here

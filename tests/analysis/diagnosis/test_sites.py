@@ -32,7 +32,7 @@ def test_every_site_has_its_name_both_ways():
 
 
 def test_a_force_factor_multiplies_bl_in_the_force_and_the_back_emf_alike():
-    """physics.md section 8: Z = Ze + (g Bl)^2 / Zm and Hx = g Bl / (s Zm Z), for a complex g(s)."""
+    """docs/physics.md section 8: Z = Ze + (g Bl)^2 / Zm and Hx = g Bl / (s Zm Z), for a complex g(s)."""
     from analysis.effects.base import ParamSpec
     g_effect = ConstantG("g", "test-g", "g", Site.FORCE_FACTOR, (ParamSpec("g", "1", "-", 1, 0, 2, 1, "g"),),
                          "", "", "", "")

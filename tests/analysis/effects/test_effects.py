@@ -8,7 +8,7 @@ from analysis.effects import CATALOGUE, get_effect
 from analysis.effects.breakup import breakup
 from analysis.fit.startvalues import StartContext
 
-# The paper's driver (physics.md section 7): fs = 70.5 Hz.
+# The paper's driver (docs/physics.md section 7): fs = 70.5 Hz.
 BASE = {"RE": 3.02, "LE": 0.132e-3, "CMES": 433e-6, "LCES": 11.75e-3, "RES": 12.08, "Bl": 5.23}
 FS = 1.0 / (2 * math.pi * math.sqrt(BASE["CMES"] * BASE["LCES"]))
 FREQS = np.array([3.0, 20.0, 70.0, 400.0, 2500.0, 15000.0])

@@ -222,7 +222,7 @@ SITE_VALUES = {"RE": 3.02, "LE": 0.132e-3, "CMES": 433e-6, "LCES": 11.75e-3, "RE
     ("current", lambda F, p: 1 / F),
     ("displacement", lambda F, p: F),
 ])
-def test_the_formula_acts_at_its_site_as_physics_md_section_8_says(site, expected):
+def test_the_formula_acts_at_its_site_as_docs_physics_section_8_says(site, expected):
     effect = effect_from_text(effect_text(site=site, formula="1 + r * s / ws"), "x.toml")
     p = {**SITE_VALUES, "r": 0.3}
     ws = 1 / math.sqrt(p["CMES"] * p["LCES"])          # 2*pi*fs

@@ -80,7 +80,7 @@ def test_the_curves_start_at_the_paper_values_and_soften():
 
 
 def test_at_large_excursion_fs_falls_and_cms_rises_like_the_papers_driver():
-    """physics.md section 6: fs 70.5 -> 57.1 Hz, Cms +50 % from 0.17 mm to 8.6 mm peak.
+    """docs/physics.md section 6: fs 70.5 -> 57.1 Hz, Cms +50 % from 0.17 mm to 8.6 mm peak.
 
     With the project's standard multitone (16,384 samples, 5 Hz - 10 kHz), as the defaults' comment says.
     """
