@@ -12,7 +12,9 @@ driver has all of these at once, and none in a textbook's exact form:
 - the piston's air load on both sides of the cone (two baffled pistons);
 - a cone mode: the outer part of the cone (mass m2) rides on the inner part through a spring and a damper,
   resonating near 1-2 kHz, and the laser's spot sees part of its motion;
-- eddy currents that take part of Bl above a corner, with a sqrt(s) shelf (not bl-eddy's first order).
+- eddy currents that take part of Bl above a corner: a loss growing as s well below it (the eddy
+  currents' field is proportional to its rate of change there), through a sqrt(s) stretch (the skin
+  depth) to its full size well above (not bl-eddy's first order).
 
 The truth is what a user means by the lumped values: RE the coil's DC resistance, Bl at low frequency,
 Mms the whole moving mass at fs (the cone's, the outer ring's that moves with it below the mode, and the
@@ -100,8 +102,8 @@ class RealisticDriver:
         ring, ring_motion = self._ring(s)
         zm = (s * self.Mmd + damping + 1.0 / (s * self._compliance(s)) + ring
               + 2.0 * piston_radiation_impedance(np.abs(s), self.radius))
-        root = np.sqrt(s / (2j * np.pi * self.bl_corner_hz))
-        bl = self.Bl * (1.0 - self.bl_loss * root / (1.0 + root))
+        u = s / (2j * np.pi * self.bl_corner_hz)
+        bl = self.Bl * (1.0 - self.bl_loss * u / (1.0 + np.sqrt(u) + u))
         return ze, zm, bl, ring_motion
 
     def impedance(self, s: np.ndarray, values=None) -> np.ndarray:
