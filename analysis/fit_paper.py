@@ -73,7 +73,7 @@ def fit_paper(data: FitData, model: Model, start: Mapping[str, float] | None = N
     covar = _two_step_covariance(model, values, z_values, data, sigmas, free1, free2, creep)
     return result_of(model, values, tuple(free1 + free2), covar, data, True, sigmas,
                      bool(r1.success and r2.success), f"Z step: {r1.message}; Hx step: {r2.message}", int(nfev),
-                     birge_scaled=True)
+                     birge_scaled=True, method="paper")
 
 
 def _jacobian(residual, values: dict[str, float], names: list[str], specs) -> np.ndarray:

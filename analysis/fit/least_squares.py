@@ -117,6 +117,7 @@ class FitResult:
     nfev: int
     noise_known: bool = True      # False: weights are relative, uncertainties come from the scatter
     extras: dict = field(default_factory=dict)
+    method: str = "joint"         # how it was identified (analysis.methods)
 
     @property
     def n_varying(self) -> int:
@@ -352,7 +353,7 @@ def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
 
 def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], covar: np.ndarray | None,
               data: FitData, use_x: bool, sigmas: dict[str, np.ndarray], success: bool, message: str, nfev: int,
-              birge_scaled: bool = False) -> FitResult:
+              birge_scaled: bool = False, method: str = "joint") -> FitResult:
     """The FitResult of `values`: each channel's chi^2, and the covariance Birge-scaled (unless it already is)."""
     channels: dict[str, ChannelFit] = {}
     n_total = 0
@@ -384,4 +385,4 @@ def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], 
         for i, name in enumerate(varying):
             stderr[name] = float(np.sqrt(covar[i, i])) if covar[i, i] >= 0 else None
     return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total, success, message, nfev,
-                     noise_known)
+                     noise_known, method=method)
