@@ -10,15 +10,18 @@ import threading
 
 import pytest
 
+from analysis.curve_fit import LINES_PER_DECADE, FitRange, fit_curves
 from analysis.effects import parse_effects
 from analysis.fit import FitCancelled
+from analysis.importers import read_curve, read_uiv
 from analysis.model import Model
 from analysis.model_uncertainty import alternative_models, describes_the_data, model_uncertainty
 from analysis.pipeline import analyze_recording
-from tests.builders import TYPICAL_NOISE, recording
+from tests.builders import REAL_DATA, TYPICAL_NOISE, recording
 from tests.realistic_drivers import REALISTIC, realistic_recording
 
 LUMPED = ("RE", "Bl", "Mms", "Kms")
+AS_THE_CLI_DOES = FitRange(None, None, None, LINES_PER_DECADE)      # linpar analyze --uiv / --impedance
 
 
 def z_score(p, truth):
@@ -66,3 +69,30 @@ def test_a_cancelled_model_part_stops():
     with pytest.raises(FitCancelled):
         model_uncertainty(statistical, cancel)
 
+
+
+needs_real = pytest.mark.skipif(not (REAL_DATA / "woofer_uiv_laser").is_dir(),
+                                reason="the shared real measurements (../shared/data/real) are not beside the "
+                                       "repository")
+
+
+@needs_real
+def test_a_real_woofer_by_the_whole_laser_method_covers_the_lecturers_values():
+    uiv = read_uiv(REAL_DATA / "woofer_uiv_laser" / "meas_data_UIV_spectra_1Hz-10kHz.csv")
+    result = model_uncertainty(fit_curves(uiv.impedance, uiv.displacement, None, None, AS_THE_CLI_DOES))
+    p = result.parameters
+    assert p["Bl"].value == pytest.approx(10.8, rel=0.02)       # the lecturer's Bl
+    for name, reference in (("Bl", 10.8), ("Rms", 2.44)):
+        assert abs(p[name].value - reference) <= 2 * p[name].std, name
+        assert p[name].std_model > p[name].std_noise, name       # the model misses far more than the noise
+
+
+@needs_real
+def test_a_real_impedance_covers_the_advanced_fit_of_another_tool():
+    z = read_curve(REAL_DATA / "seas_l16rnx" / "L16RNX_0g_242_27mV.zma").transfer
+    p = model_uncertainty(fit_curves(z, None, None, None, AS_THE_CLI_DOES)).parameters
+    # Speakerbench's fit with a semi-inductance and a 3-parameter creep: RE 5.7212 ohm, fs 44.985 Hz. The
+    # default model's RE is 10 % above it; its noise part alone says 0.2 %.
+    assert abs(p["RE"].value - 5.7212) > 10 * p["RE"].std_noise
+    for name, reference in (("RE", 5.7212), ("fs", 44.985)):
+        assert abs(p[name].value - reference) <= 2 * p[name].std, name
