@@ -29,6 +29,7 @@ import numpy as np
 from analysis.effects.base import Site
 from analysis.fit import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _lm_name, _minimize,
                           _params, _residual_vector, _values, channel_sigmas, fit_model, result_of, start_values)
+from analysis.fit_covariance import jacobian, normal_inverse
 from analysis.model import Model
 from analysis.startvalues import linear_gain
 
@@ -76,27 +77,6 @@ def fit_paper(data: FitData, model: Model, start: Mapping[str, float] | None = N
                      birge_scaled=True, method="paper")
 
 
-def _jacobian(residual, values: dict[str, float], names: list[str], specs) -> np.ndarray:
-    columns = []
-    for name in names:
-        v, spec = values[name], specs[name]
-        h = 1e-6 * max(abs(v), abs(spec.default) * 1e-3, 1e-30)
-        hi, lo = min(v + h, spec.max), max(v - h, spec.min)
-        columns.append((residual({**values, name: hi}) - residual({**values, name: lo})) / (hi - lo))
-    return np.column_stack(columns) if columns else np.zeros((len(residual(values)), 0))
-
-
-def _normal_inverse(J: np.ndarray) -> np.ndarray | None:
-    """(J'J)^-1 with the columns scaled to unit norm first (parameters span twenty decades)."""
-    norms = np.linalg.norm(J, axis=0)
-    if not np.all(np.isfinite(J)) or np.any(norms == 0):
-        return None
-    jtj = (J / norms).T @ (J / norms)
-    if np.linalg.cond(jtj) > 1e12:
-        return None
-    return np.linalg.inv(jtj) / np.outer(norms, norms)
-
-
 def _two_step_covariance(model, values, z_values, data, sigmas, free1, free2, creep) -> np.ndarray | None:
     """The covariance of (free1, free2) (module doc); the Z step's creep (at z_values) is a nuisance there."""
     specs = {s.name: s for s in model.param_specs}
@@ -111,13 +91,13 @@ def _two_step_covariance(model, values, z_values, data, sigmas, free1, free2, cr
     rz, rx = z_residual(z_values), x_residual(values)
     b_z = max(1.0, float(rz @ rz) / max(len(rz) - len(z_step), 1))
     b_x = max(1.0, float(rx @ rx) / max(len(rx) - len(free2), 1))
-    A1 = _normal_inverse(_jacobian(z_residual, z_values, z_step, specs))
-    A2 = _normal_inverse(_jacobian(x_residual, values, free2, specs))
+    A1 = normal_inverse(jacobian(z_residual, z_values, z_step, specs))
+    A2 = normal_inverse(jacobian(x_residual, values, free2, specs))
     if A1 is None or A2 is None:
         return None
     n1 = len(free1)
     cov1 = A1[:n1, :n1] * b_z
-    G = -A2 @ _jacobian(x_residual, values, free2, specs).T @ _jacobian(x_residual, values, free1, specs)
+    G = -A2 @ jacobian(x_residual, values, free2, specs).T @ jacobian(x_residual, values, free1, specs)
     cov2 = A2 * b_x + G @ cov1 @ G.T
     cross = G @ cov1
     return np.block([[cov1, cross.T], [cross, cov2]])

@@ -30,6 +30,7 @@ import numpy as np
 
 from analysis.effects.base import Site
 from analysis.errors import LinparError
+from analysis.fit.covariance import jacobian, normal_inverse
 from analysis.fit.stall import StallWatch
 from analysis.fit.startvalues import linear_gain, start_context
 from analysis.model.composed import Model
@@ -324,7 +325,18 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
             nfev += result.nfev
             result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel,
                                per_parameter)
+    if result.covar is None:        # MINPACK stopped without one ("tolerance too small"): from the Jacobian
+        return _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev + result.nfev)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
+
+
+def _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev) -> FitResult:
+    values = _values(result.params)
+    specs = {s.name: s for s in model.param_specs}
+    free = tuple(n for n in (_our_name(v) for v in result.var_names) if not specs[n].on_bound(values[n]))
+    J = jacobian(lambda p: _residual_vector(model, p, data, use_x, sigmas), values, free, specs)
+    return result_of(model, values, free, normal_inverse(J), data, use_x, sigmas, bool(result.success),
+                     str(result.message), int(nfev))
 
 
 def _check_effects(model: Model, data: FitData, values: Mapping[str, float]) -> None:
