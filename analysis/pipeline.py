@@ -27,7 +27,7 @@ from analysis.fit.error import fit_error_percent
 from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult
 from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
-from analysis.methods import DEFAULT_METHOD, fit_with
+from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model, ModelError
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
@@ -115,7 +115,7 @@ def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None 
                     effects: Sequence[Effect] | None = None, cancel: threading.Event | None = None,
                     start_of: StartOf | None = None, method: str = DEFAULT_METHOD) -> AnalysisResult:
     """The judged analysis of a recording's spectra (module doc); `start_of(data, model, cancel)` may give
-    start values for the fit; `method` names the identification (analysis.methods)."""
+    start values for the fit; `method` names the identification (analysis.fit.methods)."""
     with naming_the_file(recording):
         return _analyzed(recording, spectra, sd_m2, effects, cancel, start_of, method)
 

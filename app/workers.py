@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.fit.least_squares import FitCancelled
-from analysis.model_uncertainty import model_uncertainty
+from analysis.fit.model_uncertainty import model_uncertainty
 from analysis.pipeline import AnalysisResult, analyze_recording
 from analysis.recording.format import read_recording
 from app.job_book import Job, JobRunner
@@ -37,7 +37,7 @@ class AnalysisWorker(JobRunner):
         return self.run("analysis", work, f"analysing {path.name}")
 
     def start_model_part(self, outcome: AnalysisOutcome) -> Job:
-        """The model part of each parameter's uncertainty (analysis.model_uncertainty), after the statistical
+        """The model part of each parameter's uncertainty (analysis.fit.model_uncertainty), after the statistical
         result is shown: a few seconds of refits when the model misses the data, none when it does not. It
         finishes with the outcome again, its parameters' std now the total (std_noise and std_model beside)."""
         def work(job: Job) -> AnalysisOutcome:

@@ -38,7 +38,7 @@ from analysis.errors import LinparError
 from analysis.fit.error import fit_error_percent, rms_relative_residual
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma
 from analysis.fit.startvalues import start_context
-from analysis.methods import DEFAULT_METHOD, fit_with
+from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
@@ -122,7 +122,7 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
                f_range: FitRange | None = None, notes: Sequence[str] = (), method: str = DEFAULT_METHOD
                ) -> CurveAnalysis:
     """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves, by `method`
-    (analysis.methods: the paper's two steps suit magnitude-only exports)."""
+    (analysis.fit.methods: the paper's two steps suit magnitude-only exports)."""
     if effects is None or isinstance(effects, str):
         effects = parse_effects(effects)
     data, notes = curve_data(impedance, hx, f_range, notes)

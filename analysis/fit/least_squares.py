@@ -118,7 +118,7 @@ class FitResult:
     nfev: int
     noise_known: bool = True      # False: weights are relative, uncertainties come from the scatter
     extras: dict = field(default_factory=dict)
-    method: str = "joint"         # how it was identified (analysis.methods)
+    method: str = "joint"         # how it was identified (analysis.fit.methods)
 
     @property
     def n_varying(self) -> int:

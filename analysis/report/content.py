@@ -14,7 +14,7 @@ from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
 from analysis.fit.report import fit_report_rows
-from analysis.methods import DEFAULT_METHOD, METHODS
+from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.numbers import format_number, format_std, parameter_cells, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 

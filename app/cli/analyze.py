@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
 
 def analyze_recording(args: argparse.Namespace) -> int:
     from analysis import limits as qa
-    from analysis.model_uncertainty import model_uncertainty
+    from analysis.fit.model_uncertainty import model_uncertainty
     from analysis.pipeline import analyze_path, result_json
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
     # The model part of each uncertainty (refits when the model misses the data by more than its noise).

@@ -65,7 +65,7 @@ def add_model_option(parser, default: Sequence[str] = DEFAULT_EFFECTS, why: str 
 
 
 def add_method_option(parser) -> None:
-    """--method NAME: the identification (analysis.methods; the names written out: no import of the fit)."""
+    """--method NAME: the identification (analysis.fit.methods; the names written out: no import of the fit)."""
     parser.add_argument("--method", choices=("joint", "paper"), default="joint",
                         help="joint: Z and Hx fitted together (default); paper: the seed paper's two steps, Z for "
                              "the electrical parameters, then Hx for Bl and the creep with those held")

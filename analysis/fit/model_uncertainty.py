@@ -17,7 +17,7 @@ reported one over the members (the reported value stays the user's model's):
     std_model = max over members |value_member - value|          std = sqrt(std_noise^2 + std_model^2)
 
 Measured on the realistic woofer, midrange and subwoofer (two seeds each), the truth lies within 2 total
-std for RE, Bl, Mms and Kms; see tests/analysis/test_model_uncertainty.py.
+std for RE, Bl, Mms and Kms; see tests/analysis/fit/test_model_uncertainty.py.
 
 When the model describes the recording (every channel's reduced chi^2 below MISFIT_FROM: the misfit
 within twice the noise) nothing is refitted and the model part is 0. The refits take a few seconds: a
@@ -33,9 +33,9 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue, derived_from_values
 from analysis.effects import get_effect
-from analysis.fit import FitData, FitError, FitResult
-from analysis.methods import fit_with
-from analysis.model import Model, ModelError
+from analysis.fit.least_squares import FitData, FitError, FitResult
+from analysis.fit.methods import fit_with
+from analysis.model.composed import Model, ModelError
 
 # Each family: forms of one physics at one site, any of which a real driver may follow about as well.
 ALTERNATIVES = (("lr2", "lr3", "leach", "wright"), ("creep-log", "creep-log-causal"))
@@ -134,7 +134,7 @@ def with_model_part(parameters: Mapping[str, ParameterValue], spread: Mapping[st
 
 
 def model_uncertainty(result, cancel: threading.Event | None = None):
-    """`result` (an analysis.pipeline.AnalysisResult, or a curve_fit.CurveAnalysis) with each parameter's
+    """`result` (an analysis.pipeline.AnalysisResult, or an analysis.curves.fitting.CurveAnalysis) with each parameter's
     model part (module doc), the alternatives fitted by the result's own method.
 
     The same result when nothing was fitted; the refits honour `cancel` (FitCancelled)."""

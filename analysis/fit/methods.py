@@ -1,10 +1,10 @@
 """The identification methods a user can choose by name (`--method`, the GUI's analysis options).
 
-- joint: Z and Hx fitted together, every line weighted by its own noise (analysis.fit). The default: on
+- joint: Z and Hx fitted together, every line weighted by its own noise (analysis.fit.least_squares). The default: on
   recordings the model describes it is the most efficient, and on the realistic recordings of the tests
   (several physics at once, none in the model's form) it comes closer than the two steps.
 - paper: the seed paper's two steps, Z for the electrical parameters, then Hx for Bl and the creep with
-  those held (analysis.fit_paper): neither channel's misfit bends what the other determines. The one to
+  those held (analysis.fit.paper): neither channel's misfit bends what the other determines. The one to
   use on curves exported by other tools, magnitude only, whose Z misfit at low frequency would pull the
   creep in a joint fit.
 """
@@ -37,9 +37,9 @@ def fitter(name: str) -> Callable:
     """The fit function of method `name`: (data, model, start=None, cancel=None) -> FitResult."""
     check_method(name)
     if name == "paper":
-        from analysis.fit_paper import fit_paper
+        from analysis.fit.paper import fit_paper
         return fit_paper
-    from analysis.fit import fit_model
+    from analysis.fit.least_squares import fit_model
     return fit_model
 
 

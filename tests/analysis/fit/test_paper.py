@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from analysis.curve_fit import FitRange, fit_curves
+from analysis.curves.fitting import FitRange, fit_curves
 from analysis.errors import LinparError
-from analysis.methods import METHODS, UnknownMethodError, check_method
+from analysis.fit.methods import METHODS, UnknownMethodError, check_method
 from analysis.pipeline import analyze_recording, result_json
-from tests.analysis.test_import_curve_fit import curve
+from tests.analysis.curves.test_fitting import curve
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
 FITTED = ("RE", "LE", "L2", "R2", "CMES", "LCES", "RES", "Bl", "lambda")

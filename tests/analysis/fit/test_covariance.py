@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 from analysis.effects import parse_effects
-from analysis.fit import FitData, _residual_vector, channel_sigmas, fit_model
-from analysis.fit_covariance import jacobian, normal_inverse
-from analysis.model import Model
+from analysis.fit.covariance import jacobian, normal_inverse
+from analysis.fit.least_squares import FitData, _residual_vector, channel_sigmas, fit_model
+from analysis.model.composed import Model
 from analysis.pipeline import analyze_recording
 from analysis.spectra import estimate_spectra
 from tests.builders import TYPICAL_NOISE, recording

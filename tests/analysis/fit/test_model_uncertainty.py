@@ -10,12 +10,12 @@ import threading
 
 import pytest
 
-from analysis.curve_fit import LINES_PER_DECADE, FitRange, fit_curves
+from analysis.curves.fitting import LINES_PER_DECADE, FitRange, fit_curves
 from analysis.effects import parse_effects
-from analysis.fit import FitCancelled
+from analysis.fit.least_squares import FitCancelled
+from analysis.fit.model_uncertainty import alternative_models, describes_the_data, model_uncertainty
 from analysis.importers import read_curve, read_uiv
-from analysis.model import Model
-from analysis.model_uncertainty import alternative_models, describes_the_data, model_uncertainty
+from analysis.model.composed import Model
 from analysis.pipeline import analyze_recording
 from tests.builders import REAL_DATA, TYPICAL_NOISE, recording
 from tests.realistic_drivers import REALISTIC, realistic_recording
@@ -46,7 +46,7 @@ def test_the_truth_lies_within_two_reported_std_on_realistic_recordings(name, se
 def test_a_recording_the_model_describes_gets_no_model_part_and_no_refit(monkeypatch):
     result = analyze_recording(recording(noise=TYPICAL_NOISE, seed=3))
     assert describes_the_data(result.fit)
-    monkeypatch.setattr("analysis.model_uncertainty.fit_with", lambda *a, **k: pytest.fail("refitted"))
+    monkeypatch.setattr("analysis.fit.model_uncertainty.fit_with", lambda *a, **k: pytest.fail("refitted"))
     after = model_uncertainty(result)
     for name, p in after.parameters.items():
         if p.value is None:

@@ -27,11 +27,12 @@ from typing import Mapping
 import numpy as np
 
 from analysis.effects.base import Site
-from analysis.fit import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _lm_name, _minimize,
-                          _params, _residual_vector, _values, channel_sigmas, fit_model, result_of, start_values)
-from analysis.fit_covariance import jacobian, normal_inverse
-from analysis.model import Model
-from analysis.startvalues import linear_gain
+from analysis.fit.covariance import jacobian, normal_inverse
+from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _lm_name,
+                                        _minimize, _params, _residual_vector, _values, channel_sigmas, fit_model,
+                                        result_of, start_values)
+from analysis.fit.startvalues import linear_gain
+from analysis.model.composed import Model
 
 
 
