@@ -20,7 +20,7 @@ Measured on the realistic woofer, midrange and subwoofer (two seeds each), the t
 std for RE, Bl, Mms and Kms; see tests/analysis/fit/test_model_uncertainty.py.
 
 When the model describes the recording (every channel's reduced chi^2 below MISFIT_FROM: the misfit
-within twice the noise) nothing is refitted and the model part is 0. The refits take a few seconds: a
+within twice the noise) nothing is refitted and nothing changes: no model part is reported. The refits take a few seconds: a
 separate step after the statistical result (the GUI can show that at once and run this in the
 background; `linpar analyze` runs it before printing).
 """
@@ -98,10 +98,11 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
 
 def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
                  cancel: threading.Event | None = None) -> dict[str, float]:
-    """Each parameter's model part (module doc): 0 for all when the model describes the data."""
+    """Each parameter's model part (module doc); none when the model describes the data (the table is then
+    left as it is: its std is the noise's alone, as before)."""
     reported = _with_derived(fit.values, sd_m2)
     if describes_the_data(fit):
-        return {name: 0.0 for name in reported}
+        return {}
     spread = {name: 0.0 for name in reported}
     for member in members(fit, data, cancel):
         theirs = _with_derived(member.values, sd_m2)
