@@ -24,9 +24,10 @@ from analysis.derived import NO_DISPLACEMENT, ParameterValue, parameter_table, u
 from analysis.effects import Effect, DEFAULT_EFFECTS, get_effect
 from analysis.errors import LinparError
 from analysis.fit.error import fit_error_percent
-from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult, fit_model
+from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult
 from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
+from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model, ModelError
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
@@ -89,10 +90,10 @@ def resolve_sd(recording: Recording, sd_m2: float | None) -> float | None:
 
 def analyze_recording(recording: Recording, sd_m2: float | None = None,
                       effects: Sequence[Effect] | None = None,
-                      cancel: threading.Event | None = None) -> AnalysisResult:
+                      cancel: threading.Event | None = None, method: str = DEFAULT_METHOD) -> AnalysisResult:
     with naming_the_file(recording):
         spectra = estimate_spectra(recording)
-    return analyze_spectra(recording, spectra, sd_m2, effects, cancel)
+    return analyze_spectra(recording, spectra, sd_m2, effects, cancel, method=method)
 
 
 @contextmanager
@@ -112,15 +113,15 @@ StartOf = Callable[[FitData, Model, "threading.Event | None"], dict]
 
 def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None = None,
                     effects: Sequence[Effect] | None = None, cancel: threading.Event | None = None,
-                    start_of: StartOf | None = None) -> AnalysisResult:
+                    start_of: StartOf | None = None, method: str = DEFAULT_METHOD) -> AnalysisResult:
     """The judged analysis of a recording's spectra (module doc); `start_of(data, model, cancel)` may give
-    start values for the fit."""
+    start values for the fit; `method` names the identification (analysis.fit.methods)."""
     with naming_the_file(recording):
-        return _analyzed(recording, spectra, sd_m2, effects, cancel, start_of)
+        return _analyzed(recording, spectra, sd_m2, effects, cancel, start_of, method)
 
 
 def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effects: Sequence[Effect] | None,
-              cancel: threading.Event | None, start_of: StartOf | None) -> AnalysisResult:
+              cancel: threading.Event | None, start_of: StartOf | None, method: str) -> AnalysisResult:
     validity, usable, spectra = _judged(recording, spectra)
     effects = tuple(default_effects() if effects is None else effects)
     sd = resolve_sd(recording, sd_m2)
@@ -131,11 +132,11 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     data = FitData.from_spectra(spectra)
     model = Model(effects, with_displacement=data.displacement is not None)
     start = start_of(data, model, cancel) if start_of is not None else None
-    fit = fit_model(data, model, start=start, cancel=cancel)
+    fit = fit_with(method, data, model, start=start, cancel=cancel)
     corrected, heating = without_coil_heating(recording, spectra, validity, fit.values["RE"])
     if corrected is not spectra:        # the noise estimate was the drift's: fit again on the honest one
         spectra = corrected
-        fit = fit_model(FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
+        fit = fit_with(method, FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
     parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
     # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
     implausible = plausibility_findings(recording, spectra, parameters, sd, validity.peak_displacement_m)
@@ -203,8 +204,8 @@ def checked_capture(recording: Recording) -> CaptureInfo | None:
 
 
 def analyze_path(path: str | Path, sd_m2: float | None = None,
-                 effects: Sequence[Effect] | None = None) -> AnalysisResult:
-    return analyze_recording(read_recording(path), sd_m2, effects)
+                 effects: Sequence[Effect] | None = None, method: str = DEFAULT_METHOD) -> AnalysisResult:
+    return analyze_recording(read_recording(path), sd_m2, effects, method=method)
 
 
 def result_json(result: AnalysisResult) -> dict:
@@ -220,6 +221,7 @@ def result_json(result: AnalysisResult) -> dict:
 def model_json(fit: FitResult) -> dict:
     return {
         "effects": list(fit.model.effect_ids),
+        "method": fit.method,
         "chi2_red": fit.chi2_red_by_channel(),
         "aic": fit.aic,
         "bic": fit.bic,

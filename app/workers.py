@@ -6,6 +6,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from analysis.fit.least_squares import FitCancelled
+from analysis.fit.model_uncertainty import model_uncertainty
 from analysis.pipeline import AnalysisResult, analyze_recording
 from analysis.recording.format import read_recording
 from app.job_book import Job, JobRunner
@@ -34,3 +35,13 @@ class AnalysisWorker(JobRunner):
             result = analyze_recording(recording, sd_m2, cancel=job.cancel_event)
             return AnalysisOutcome(job.id, path, result, result_curves(result))
         return self.run("analysis", work, f"analysing {path.name}")
+
+    def start_model_part(self, outcome: AnalysisOutcome) -> Job:
+        """The model part of each parameter's uncertainty (analysis.fit.model_uncertainty), after the statistical
+        result is shown: a few seconds of refits when the model misses the data, none when it does not. It
+        finishes with the outcome again, its parameters' std now the total (std_noise and std_model beside)."""
+        def work(job: Job) -> AnalysisOutcome:
+            job.say(f"the model part of the uncertainties of {outcome.path.name}")
+            result = model_uncertainty(outcome.result, cancel=job.cancel_event)
+            return AnalysisOutcome(job.id, outcome.path, result, outcome.curves)
+        return self.run("model part", work, f"estimating the model part of {outcome.path.name}'s uncertainties")

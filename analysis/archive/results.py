@@ -105,7 +105,8 @@ def not_fitted_model(why: str | None) -> dict:
 
 
 def _model_json(fit) -> dict:
-    return {"effects": list(fit.model.effect_ids), "with_displacement": fit.model.with_displacement,
+    return {"effects": list(fit.model.effect_ids), "method": fit.method,
+            "with_displacement": fit.model.with_displacement,
             "user_effects": user_effects_json(fit.model.effects),
             "values": {k: _num(v) for k, v in fit.values.items()},
             "stderr": {k: _num(v) for k, v in fit.stderr.items()},

@@ -36,8 +36,9 @@ from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
 from analysis.fit.error import fit_error_percent, rms_relative_residual
-from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma, fit_model
+from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma
 from analysis.fit.startvalues import start_context
+from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
@@ -109,6 +110,7 @@ class CurveAnalysis:
     ranges: dict[str, tuple[float, float]]       # the band each channel was fitted over
     validity: dict
     notes: tuple[str, ...] = ()
+    data: FitData | None = None                  # what was fitted (the model part's refits fit it again)
 
     @property
     def model(self) -> Model:
@@ -117,20 +119,22 @@ class CurveAnalysis:
 
 def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
                effects: Sequence[Effect] | str | None = None, sd_m2: float | None = None,
-               f_range: FitRange | None = None, notes: Sequence[str] = ()) -> CurveAnalysis:
-    """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves."""
+               f_range: FitRange | None = None, notes: Sequence[str] = (), method: str = DEFAULT_METHOD
+               ) -> CurveAnalysis:
+    """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves, by `method`
+    (analysis.fit.methods: the paper's two steps suit magnitude-only exports)."""
     if effects is None or isinstance(effects, str):
         effects = parse_effects(effects)
     data, notes = curve_data(impedance, hx, f_range, notes)
     z, x = data.impedance, data.displacement
     model = Model(tuple(effects), with_displacement=x is not None)
-    fit = fit_model(data, model)
+    fit = fit_with(method, data, model)
     fit, held = covariance_with_bounds(fit, lambda v: weighted_residual(model, v, data))
     if held:
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
     validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
-    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes))
+    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data)
 
 
 def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,

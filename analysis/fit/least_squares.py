@@ -30,6 +30,7 @@ import numpy as np
 
 from analysis.effects.base import Site
 from analysis.errors import LinparError
+from analysis.fit.covariance import jacobian, normal_inverse
 from analysis.fit.stall import StallWatch
 from analysis.fit.startvalues import linear_gain, start_context
 from analysis.model.composed import Model
@@ -117,6 +118,7 @@ class FitResult:
     nfev: int
     noise_known: bool = True      # False: weights are relative, uncertainties come from the scatter
     extras: dict = field(default_factory=dict)
+    method: str = "joint"         # how it was identified (analysis.fit.methods)
 
     @property
     def n_varying(self) -> int:
@@ -180,13 +182,13 @@ def _channel_residual(model_values: np.ndarray, tf: TransferFunction, sigma: np.
 
 
 def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x: bool,
-                     sigmas: dict[str, np.ndarray]) -> np.ndarray:
+                     sigmas: dict[str, np.ndarray], use_z: bool = True) -> np.ndarray:
     z = data.impedance
-    if use_x and data.same_lines:    # both channels from one pass through the model
+    if use_x and use_z and data.same_lines:    # both channels from one pass through the model
         Z, Hx = model.responses(2j * np.pi * z.freqs, p)
         return np.concatenate(_channel_residual(Z, z, sigmas["impedance"])
                               + _channel_residual(Hx, data.displacement, sigmas["displacement"]))
-    parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"])
+    parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"]) if use_z else []
     if use_x:
         x = data.displacement
         parts += _channel_residual(model.displacement(2j * np.pi * x.freqs, p), x, sigmas["displacement"])
@@ -218,11 +220,12 @@ def _values(params: lmfit.Parameters) -> dict[str, float]:
 
 
 def _minimize(model, params, data, use_x, sigmas, cancel,
-              per_parameter: int = EVALUATIONS_PER_PARAMETER) -> lmfit.minimizer.MinimizerResult:
+              per_parameter: int = EVALUATIONS_PER_PARAMETER, use_z: bool = True) -> lmfit.minimizer.MinimizerResult:
     names = [(lm_name, _our_name(lm_name)) for lm_name in params]    # worked out once, not per evaluation
 
     def residual(prm):
-        r = _residual_vector(model, {ours: prm[lm_name].value for lm_name, ours in names}, data, use_x, sigmas)
+        r = _residual_vector(model, {ours: prm[lm_name].value for lm_name, ours in names}, data, use_x, sigmas,
+                             use_z)
         # A parameter set where the model is undefined is simply very bad:
         # a fixed size keeps MINPACK's bookkeeping intact.
         return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
@@ -322,7 +325,18 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
             nfev += result.nfev
             result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel,
                                per_parameter)
+    if result.covar is None:        # MINPACK stopped without one ("tolerance too small"): from the Jacobian
+        return _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev + result.nfev)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
+
+
+def _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev) -> FitResult:
+    values = _values(result.params)
+    specs = {s.name: s for s in model.param_specs}
+    free = tuple(n for n in (_our_name(v) for v in result.var_names) if not specs[n].on_bound(values[n]))
+    J = jacobian(lambda p: _residual_vector(model, p, data, use_x, sigmas), values, free, specs)
+    return result_of(model, values, free, normal_inverse(J), data, use_x, sigmas, bool(result.success),
+                     str(result.message), int(nfev))
 
 
 def _check_effects(model: Model, data: FitData, values: Mapping[str, float]) -> None:
@@ -344,7 +358,15 @@ def _at_bounds(model: Model, params: lmfit.Parameters) -> set[str]:
 
 
 def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
-    values = _values(result.params)
+    covar = None if result.covar is None else np.asarray(result.covar)
+    return result_of(model, _values(result.params), tuple(_our_name(n) for n in result.var_names), covar, data,
+                     use_x, sigmas, bool(result.success), str(result.message), int(nfev))
+
+
+def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], covar: np.ndarray | None,
+              data: FitData, use_x: bool, sigmas: dict[str, np.ndarray], success: bool, message: str, nfev: int,
+              birge_scaled: bool = False, method: str = "joint") -> FitResult:
+    """The FitResult of `values`: each channel's chi^2, and the covariance Birge-scaled (unless it already is)."""
     channels: dict[str, ChannelFit] = {}
     n_total = 0
     for name in CHANNELS[: 2 if use_x else 1]:
@@ -357,7 +379,6 @@ def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
         channels[name] = ChannelFit(name, tf.freqs, tf.value, model_values, sigmas[name] * np.sqrt(2.0),
                                     chi2, n_points, 0.0, tf.has_phase)
         n_total += n_points
-    varying = tuple(_our_name(n) for n in result.var_names)
     k = len(varying)
     chi2 = sum(ch.chi2 for ch in channels.values())
     # Parameters are shared out to channels by their share of the data.
@@ -369,11 +390,11 @@ def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
     noise_known = all(data.channel(name).noise_known for name in channels)
     # Known noise: the Birge ratio, never below 1. Unknown noise: the residual's
     # own scatter sets the scale (as lmfit's scale_covar does).
-    birge = max(1.0, chi2_red) if noise_known else chi2_red
-    covar = None if result.covar is None else np.asarray(result.covar) * birge
+    birge = 1.0 if birge_scaled else max(1.0, chi2_red) if noise_known else chi2_red
+    covar = None if covar is None else covar * birge
     stderr: dict[str, float | None] = {n: None for n in values}
     if covar is not None:
         for i, name in enumerate(varying):
             stderr[name] = float(np.sqrt(covar[i, i])) if covar[i, i] >= 0 else None
-    return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total,
-                     bool(result.success), str(result.message), int(nfev), noise_known)
+    return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total, success, message, nfev,
+                     noise_known, method=method)

@@ -14,6 +14,7 @@ from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
 from analysis.fit.report import fit_report_rows
+from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.numbers import format_number, format_std, parameter_cells, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 
@@ -113,6 +114,12 @@ def uncertainty_parts(p) -> str:
                      for std, what in ((p.std_noise, "noise"), (p.std_model, "model")) if std is not None)
 
 
+def _method_text(name) -> str:
+    """The identification method's name and what it does (results stored before methods had a name: joint)."""
+    name = name or DEFAULT_METHOD
+    return f"{name}: {METHODS[name]}" if name in METHODS else str(name)
+
+
 def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     if result.not_fitted:
         return (("Model", "nothing fitted"), ("Why", result.not_fitted))
@@ -121,7 +128,7 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     chi = info.get("chi2_red") or {}
     rows = [("Model", "Lumped model (electrical + mechanical)" + (" with Hx (laser)" if result.with_displacement
                                                                  else ", impedance only")),
-            ("Effects", effects)] + _user_effect_rows(result)
+            ("Effects", effects), ("Method", _method_text(info.get("method")))] + _user_effect_rows(result)
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))
     for channel, value in chi.items():

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 
 from app.cli import curves, effects
-from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects
+from app.cli.options import add_json_option, add_method_option, add_model_option, add_sd_option, model_effects
 from app.cli.output import print_json
 from app.cli.result_text import format_result
 
@@ -16,6 +16,7 @@ def register(sub) -> None:
     analyze.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
     add_sd_option(analyze)
     add_model_option(analyze)
+    add_method_option(analyze)
     add_json_option(analyze)
     analyze.add_argument("--limits", metavar="FILE",
                          help="QA limits (JSON): print pass/fail; exit 0 pass, 1 fail, 2 error")
@@ -35,9 +36,11 @@ def run(args: argparse.Namespace) -> int:
 
 def analyze_recording(args: argparse.Namespace) -> int:
     from analysis import limits as qa
+    from analysis.fit.model_uncertainty import model_uncertainty
     from analysis.pipeline import analyze_path, result_json
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
-    result = analyze_path(args.path, args.sd, model_effects(args.model))
+    # The model part of each uncertainty (refits when the model misses the data by more than its noise).
+    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model), method=args.method))
     doc = result_json(result)
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)

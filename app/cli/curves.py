@@ -80,8 +80,11 @@ def load_curves(args: argparse.Namespace):
 
 def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
+    from analysis.fit.model_uncertainty import model_uncertainty
     z, hx, notes = load_curves(args)
-    result = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes)
+    fitted = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes,
+                        method=getattr(args, "method", "joint"))
+    result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)
     if args.json:
         print_json(curve_json(result))
         return 0

@@ -64,6 +64,13 @@ def add_model_option(parser, default: Sequence[str] = DEFAULT_EFFECTS, why: str 
                              "'none' for the textbook model)")
 
 
+def add_method_option(parser) -> None:
+    """--method NAME: the identification (analysis.fit.methods; the names written out: no import of the fit)."""
+    parser.add_argument("--method", choices=("joint", "paper"), default="joint",
+                        help="joint: Z and Hx fitted together (default); paper: the seed paper's two steps, Z for "
+                             "the electrical parameters, then Hx for Bl and the creep with those held")
+
+
 def add_sd_option(parser, note: str = "") -> None:
     parser.add_argument("--sd", type=number(SD), metavar="M2", help=f"effective radiating area in m^2{note}")
 

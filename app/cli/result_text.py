@@ -47,7 +47,7 @@ def format_result(result) -> str:
         notes = []          # every parameter has that one reason
     else:
         chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
-        lines += ["", f"model: {fit.model.describe()}   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
+        lines += ["", f"model: {fit.model.describe()} ({fit.method} fit)   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
                       f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
         errors = (result.validity or {}).get("fit_error_percent") or {}
         if errors:

@@ -186,3 +186,17 @@ def test_a_bug_in_a_slot_is_a_message_with_its_crash_report(window, dialogs):
     (kind, title, text), = dialogs
     assert title == "Internal error" and "internal error while working in the window: ZeroDivisionError" in text
     assert "ZeroDivisionError" in Path(text.rsplit("(details in ", 1)[1].rstrip(")")).read_text(encoding="utf-8")
+
+
+def test_the_model_part_of_the_uncertainties_runs_in_the_worker_after_the_result(qtbot, window):
+    from analysis.pipeline import analyze_recording
+    from app.workers import AnalysisOutcome
+    from tests.realistic_drivers import realistic_recording
+    result = analyze_recording(realistic_recording("midrange", 0))
+    shown = AnalysisOutcome(0, Path("midrange"), result, None)
+    with qtbot.waitSignal(window.worker.finished, timeout=4 * ANALYSIS_TIMEOUT_MS) as done:
+        window.worker.start_model_part(shown)
+    outcome = done.args[1]
+    mms = outcome.result.parameters["Mms"]
+    assert mms.value == result.parameters["Mms"].value and mms.std_noise == result.parameters["Mms"].std
+    assert mms.std_model > 0 and mms.std > mms.std_noise

@@ -41,6 +41,7 @@ def test_content_has_header_lights_parameters_in_customary_units_and_fit_quality
     assert rows["Bl"].std not in ("", "–")
     model = dict(c.model)
     assert "lr2" in model["Effects"] and "creep-log" in model["Effects"]
+    assert model["Method"].startswith("joint: Z and Hx fitted together")
     assert {"Reduced χ² (impedance)", "Reduced χ² (displacement)", "AIC", "BIC"} <= set(model)
     assert ("volts_per_fs", "1.5") in c.calibration
     assert dict(c.settings)["Sample rate"] == "48000 Hz"

@@ -163,3 +163,18 @@ def test_the_effects_catalogue_is_listed(capsys):
     code, out, _ = run(capsys, "effects", "--json")
     ids = {e["id"] for e in json.loads(out)}
     assert {"lr2", "creep-log"} <= ids
+
+
+def test_analyze_by_the_papers_method(capsys, rec_path):
+    assert main(["analyze", str(rec_path), "--method", "paper", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["model"]["method"] == "paper"
+    assert doc["parameters"]["Bl"]["value"] == pytest.approx(PAPER.parameters["Bl"], rel=0.01)
+    assert "std_model" not in doc["parameters"]["Bl"]          # the model describes the recording: no model part
+    assert main(["analyze", str(rec_path)]) == 0
+    assert "(joint fit)" in capsys.readouterr().out
+
+
+def test_analyze_refuses_an_unknown_method(capsys, rec_path):
+    assert main(["analyze", str(rec_path), "--method", "magic"]) == 2
+    assert "invalid choice: 'magic' (choose from 'joint', 'paper')" in capsys.readouterr().err
