@@ -1,6 +1,6 @@
 """The seed paper's two-step identification: Z for the electrical parameters, then Hx for Bl and the creep.
 
-physics.md section 1: everything in Hx but Bl is known once Z is fitted. The paper fits Z alone for
+docs/physics.md section 1: everything in Hx but Bl is known once Z is fitted. The paper fits Z alone for
 RE, LE, the eddy-current branch and the motional branch's CMES, LCES, RES; then, those held, it fits Hx
 for Bl and the creep law (creep barely shows in Z, clearly in Hx below fs). Neither channel's misfit can
 then bend what the other determines: a blocked impedance the model cannot follow moves the Z-step's

@@ -69,8 +69,7 @@ def test_a_cancelled_model_part_stops():
 
 
 needs_real = pytest.mark.skipif(not (REAL_DATA / "woofer_uiv_laser").is_dir(),
-                                reason="the shared real measurements (../shared/data/real) are not beside the "
-                                       "repository")
+                                reason="the real data set is not on this machine")
 
 
 @needs_real
