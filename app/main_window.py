@@ -21,6 +21,7 @@ from app.results_view import ResultsView
 from app.series_page import SeriesPage
 from app.settings import Settings
 from app.staged_fanout import StagedFanOut
+from app.window_fit import fit_window
 from app.wizard import MeasureWizard
 from app.workers import AnalysisOutcome, AnalysisWorker
 
@@ -119,10 +120,11 @@ class MainWindow(QMainWindow):
 
     def _restore_window(self) -> None:
         geometry, state = self.settings.window_geometry()
-        if geometry is None or not self.restoreGeometry(geometry):
-            self.resize(1400, 900)
+        restored = geometry is not None and self.restoreGeometry(geometry)
         if state is not None:
             self.restoreState(state)
+        # At most the screen's room, maximized on a small screen; a size remembered elsewhere is clamped.
+        fit_window(self, restored)
 
     def _rebuild_recent_menu(self) -> None:
         self.recent_menu.clear()
