@@ -65,6 +65,9 @@ class MainWindow(QMainWindow):
         self.model_lab.model_adopted.connect(self.results.show_outcome)
         self.wizard = MeasureWizard(self.settings.qsettings)
         self.qa = QAView(self.settings.qsettings)
+        # Reports are written by the QA page from any page (File > Export report…): the window says how it went.
+        self.qa.report_written.connect(lambda written: self.status_label.setText(f"Report written: {written}"))
+        self.qa.report_failed.connect(lambda why: self.show_error("Could not write the report", why))
         # A finished measurement goes to the Results page, and from there to the lab and QA.
         self.wizard.measurement_finished.connect(self.on_measured)
         self.wizard.open_results_requested.connect(self.on_open_measured)
