@@ -50,17 +50,8 @@ def file_name(source: Any) -> str:
     return PurePath(text.replace("\\", "/")).name
 
 
-# The calibration's keys, as one line each: (words, unit, factor from SI to that unit).
-_CALIBRATION_WORDS = {
-    "volts_per_fs_out": ("Output: full scale at the driver's terminals", "V", 1.0),
-    "volts_per_fs_voltage_sense": ("Voltage input: full scale", "V", 1.0),
-    "volts_per_fs_current_sense": ("Current input: full scale of the sense amplifier", "V", 1.0),
-    "shunt_ohm": ("Current shunt", "Ω", 1.0),
-    "current_amp_gain": ("Current amplifier gain", "×", 1.0),
-    "volts_per_fs_laser": ("Laser input: full scale", "V", 1.0),
-    "laser_m_per_volt": ("Laser sensitivity", "mm/V", 1e3),
-    "volts_per_fs": ("Input full scale", "V", 1.0),
-}
+_CALIBRATION_KEYS = ("volts_per_fs_out", "volts_per_fs_voltage_sense", "volts_per_fs_current_sense", "shunt_ohm",
+                     "current_amp_gain", "volts_per_fs_laser", "laser_m_per_volt", "volts_per_fs")
 
 
 def _calibration_numbers(calibration: Mapping, out: dict[str, float]) -> None:
@@ -68,25 +59,35 @@ def _calibration_numbers(calibration: Mapping, out: dict[str, float]) -> None:
     for key, value in calibration.items():
         if isinstance(value, Mapping):
             _calibration_numbers(value, out)
-        elif key in _CALIBRATION_WORDS and isinstance(value, (int, float)) and not isinstance(value, bool):
+        elif key in _CALIBRATION_KEYS and isinstance(value, (int, float)) and not isinstance(value, bool):
             if math.isfinite(value):
                 out.setdefault(key, float(value))
 
 
+def _g(x: float) -> str:
+    return f"{x:.4g}"
+
+
 def calibration_rows(calibration: Mapping | None) -> tuple[tuple[str, str], ...]:
-    """A short table in words: what each input's full scale is, in its unit (the raw keys are in the appendix)."""
-    numbers: dict[str, float] = {}
-    _calibration_numbers(dict(calibration or {}), numbers)
+    """A short table in words: what full scale means on each channel, with how it was got (the raw keys are
+    in the appendix)."""
+    n: dict[str, float] = {}
+    _calibration_numbers(dict(calibration or {}), n)
     rows = []
-    for key, (words, unit, factor) in _CALIBRATION_WORDS.items():
-        if key in numbers:
-            rows.append((words, f"{numbers[key] * factor:.4g} {unit}"))
-    current = [numbers.get(k) for k in ("volts_per_fs_current_sense", "shunt_ohm", "current_amp_gain")]
-    if all(v for v in current):
-        rows.append(("Current input: full scale", f"{current[0] / (current[1] * current[2]):.4g} A"))
-    laser = [numbers.get(k) for k in ("volts_per_fs_laser", "laser_m_per_volt")]
-    if all(v for v in laser):
-        rows.append(("Laser input: full scale", f"{laser[0] * laser[1] * 1e3:.4g} mm"))
+    if "volts_per_fs_out" in n:
+        rows.append(("Output to the driver", f"{_g(n['volts_per_fs_out'])} V at full scale"))
+    if "volts_per_fs_voltage_sense" in n:
+        rows.append(("Voltage input", f"{_g(n['volts_per_fs_voltage_sense'])} V at full scale"))
+    sense, shunt, gain = (n.get(k) for k in ("volts_per_fs_current_sense", "shunt_ohm", "current_amp_gain"))
+    if sense and shunt and gain:
+        rows.append(("Current input", f"{_g(sense / (shunt * gain))} A at full scale (shunt {_g(shunt)} Ω, "
+                                      f"amplifier ×{_g(gain)}, {_g(sense)} V at the converter)"))
+    laser_v, laser_m = n.get("volts_per_fs_laser"), n.get("laser_m_per_volt")
+    if laser_v and laser_m:
+        rows.append(("Laser input", f"{_g(laser_v * laser_m * 1e3)} mm at full scale ({_g(laser_v)} V, "
+                                    f"{_g(laser_m * 1e3)} mm/V)"))
+    if "volts_per_fs" in n:
+        rows.append(("Inputs", f"{_g(n['volts_per_fs'])} V at full scale"))
     return tuple(rows) or (("Calibration", "not recorded with this measurement"),)
 
 

@@ -43,7 +43,7 @@ def test_content_has_header_lights_parameters_in_customary_units_and_fit_quality
     assert "lr2" in fit["Effects"] and "creep-log" in fit["Effects"]
     assert fit["Method"].startswith("joint: Z and Hx fitted together")
     assert {"Reduced χ² (impedance)", "Reduced χ² (displacement)", "AIC", "BIC"} <= set(fit)
-    assert ("Input full scale", "1.5 V") in c.calibration and ("volts_per_fs", "1.5") in c.calibration_detail
+    assert ("Inputs", "1.5 V at full scale") in c.calibration and ("volts_per_fs", "1.5") in c.calibration_detail
     assert dict(c.settings)["Sample rate"] == "48000 Hz"
     assert c.has_spl
 
@@ -230,9 +230,9 @@ def test_customer_rows_use_the_workstations_names_order_and_sd():
     model = dict(c.model)["Model"]
     assert "physics.md" not in model and "LR-2" in model and "lr2" not in model
     calibration = dict(c.calibration)
-    assert calibration["Current input: full scale"] == "2 A"            # 1 V / (0.1 ohm * 5)
-    assert calibration["Laser input: full scale"] == "20 mm"            # 10 V * 2 mm/V
-    assert calibration["Output: full scale at the driver's terminals"] == "10 V"
+    assert calibration["Current input"].startswith("2 A at full scale")     # 1 V / (0.1 ohm * 5)
+    assert calibration["Laser input"].startswith("20 mm at full scale")     # 10 V * 2 mm/V
+    assert calibration["Output to the driver"] == "10 V at full scale"
 
 
 @needs_pdftotext
@@ -247,7 +247,7 @@ def test_pdf_reads_as_a_customer_document_with_an_appendix(tmp_path):
     assert re.search(r"^\s*Sd\s+\d+", customer, re.M) and re.search(r"^\s*Re\s+3\.0", customer, re.M)
     assert customer.index(" fs ") < customer.index(" Qts ") < customer.index(" Vas ") < customer.index(" Bl ")
     assert "physics.md" not in text and str(tmp_path) not in text and "woofer-12.wav" in customer
-    assert "volts_per_fs" not in customer and "Current input: full scale" in customer
+    assert "volts_per_fs" not in customer and re.search(r"Current input\s+2 A at full scale", customer)
     assert "CMES" in appendix and "Correlations" in appendix and "volts_per_fs_current_sense" in appendix
     assert "CMES" not in customer
 
