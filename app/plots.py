@@ -116,7 +116,7 @@ def beyond_range(freqs: np.ndarray, residual: np.ndarray, limit: float) -> tuple
     sign = np.sign(parts[larger, np.arange(size.shape[1])])[out]
     worst = int(np.argmax(np.where(out, peak, -1.0)))
     count = int(out.sum())
-    words = (f"{count} point{'s' if count != 1 else ''} beyond ±{limit:.3g}σ (▲▼ at the edge), "
+    words = (f"{count} point{'s' if count != 1 else ''} beyond ±{limit:.3g}σ (▲▼), "
              f"up to {peak[worst]:.3g}σ at {freqs[worst]:.3g} Hz")
     return np.asarray(freqs)[out], sign, words
 
@@ -195,9 +195,9 @@ class TransferPlot(pg.GraphicsLayoutWidget):
                   if self.beyond_text else "")
         # In the title rather than a legend: a legend would cover the points of the thin strip.
         self.residual.setTitle(
-            f"normalised residual (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span>"
-            f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span> part; reduced χ² = "
-            f"{curves.chi2_red:.2f}{beyond}", size="9pt")
+            f"residual (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span>"
+            f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span>; reduced χ² = "
+            f"{curves.chi2_red:.3g}{beyond}", size="9pt")
         self.magnitude.enableAutoRange()
         self.phase.enableAutoRange(axis="y")
 
