@@ -32,6 +32,8 @@ station QA3 reading high, its control chart with the alarms flagged
 --only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
 (tools/screenshots_verdicts.py).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
+--only first-window: a fresh user's first window on a 1280x720 and a 1920x1080 screen, and the Results page
+with residuals beyond the strip's range (tools/screenshots_window.py).
 --only hardware: the Hardware page's sound-card and serial-port lists at both sizes, this machine's and a
 Windows PC's as an example (tools/screenshots_hardware.py).
 qa-current-zeroed-1280x720.png and -1920x1080.png: the QA page judging a recording
@@ -442,6 +444,11 @@ def real_like_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     return shots(app, window, folder, out, open_in_lab)
 
 
+def first_window_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_window import first_window_screenshots as shots
+    return shots(app, window, folder, out)
+
+
 def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_pages import every_page_screenshots
     return every_page_screenshots(app, window, folder, out)
@@ -493,7 +500,8 @@ def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> 
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
         "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
-        "verdicts": verdicts_screenshots, "real-like": real_like_screenshots}
+        "verdicts": verdicts_screenshots, "real-like": real_like_screenshots,
+        "first-window": first_window_screenshots}
 
 
 def main(argv: list[str]) -> int:
