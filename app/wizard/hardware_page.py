@@ -38,7 +38,8 @@ def remembered_device(saved) -> tuple[AudioDeviceChoice | None, str]:
 class HardwarePage(WizardPage):
     title = "Hardware"
     subtitle = ("The sound card that drives the amplifier and reads voltage and current, and the laser. The "
-                "virtual rig stands in for all of it when nothing else is there.")
+                "in-process simulator stands in for all of it when nothing else is there: choose it to try "
+                "linpar without hardware.")
 
     def __init__(self, state, session, parent=None, rig_name: str = DEFAULT_NAME, rig_runtime_dir: str | None = None):
         super().__init__(state, session, parent)
