@@ -471,7 +471,7 @@ def real_like_screenshots(app: QApplication, window, folder: Path, out: Path) ->
 
 def first_window_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_window import first_window_screenshots as shots
-    return shots(app, window, folder, out)
+    return shots(app, window, folder, out, hidden_delay_recording(folder))
 
 
 def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:

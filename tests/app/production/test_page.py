@@ -128,3 +128,11 @@ def test_without_stored_limits_the_page_says_the_command(qtbot, window, measured
     fill(str(archive_root), measured, n=4, drift_at=99)
     page, _ = show(qtbot, window)
     assert "linpar qa limits --store FILE" in page.summary.text()
+
+
+def test_the_unit_axis_has_whole_units_only(qtbot):
+    from app.production_charts import UnitAxis
+    axis = UnitAxis("bottom")
+    for low, high in ((0.3, 4.6), (0.5, 40.5), (-2.0, 2000.0)):
+        values = [v for _, level in axis.tickValues(low, high, 600) for v in level]
+        assert values and all(float(v).is_integer() for v in values), (low, high, values)
