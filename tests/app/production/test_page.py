@@ -131,7 +131,7 @@ def test_without_stored_limits_the_page_says_the_command(qtbot, window, measured
 
 
 def test_the_unit_axis_has_whole_units_only(qtbot):
-    from app.production_charts import UnitAxis
+    from app.production.charts import UnitAxis
     axis = UnitAxis("bottom")
     for low, high in ((0.3, 4.6), (0.5, 40.5), (-2.0, 2000.0)):
         values = [v for _, level in axis.tickValues(low, high, 600) for v in level]
