@@ -85,7 +85,8 @@ def run_gui(path: str | None = None) -> int:
     window = MainWindow()
     sys.excepthook = _report_uncaught(window)
     window.model_lab.catalogue.set_problems(problems)
-    window.show()
+    from app.window_fit import show_fitted
+    show_fitted(window)                   # maximized when the screen is smaller than the window's preferred size
     QTimer.singleShot(0, window.offer_unfinished)     # measurements a crash cut short: keep, analyse, discard
     if path:
         window.open_path(path)

@@ -21,6 +21,7 @@ from app.results_view import ResultsView
 from app.series_page import SeriesPage
 from app.settings import Settings
 from app.staged_fanout import StagedFanOut
+from app.window_fit import fit_window
 from app.wizard import MeasureWizard
 from app.workers import AnalysisOutcome, AnalysisWorker
 
@@ -64,6 +65,9 @@ class MainWindow(QMainWindow):
         self.model_lab.model_adopted.connect(self.results.show_outcome)
         self.wizard = MeasureWizard(self.settings.qsettings)
         self.qa = QAView(self.settings.qsettings)
+        # Reports are written by the QA page from any page (File > Export report…): the window says how it went.
+        self.qa.report_written.connect(lambda written: self.status_label.setText(f"Report written: {written}"))
+        self.qa.report_failed.connect(lambda why: self.show_error("Could not write the report", why))
         # A finished measurement goes to the Results page, and from there to the lab and QA.
         self.wizard.measurement_finished.connect(self.on_measured)
         self.wizard.open_results_requested.connect(self.on_open_measured)
@@ -119,10 +123,11 @@ class MainWindow(QMainWindow):
 
     def _restore_window(self) -> None:
         geometry, state = self.settings.window_geometry()
-        if geometry is None or not self.restoreGeometry(geometry):
-            self.resize(1400, 900)
+        restored = geometry is not None and self.restoreGeometry(geometry)
         if state is not None:
             self.restoreState(state)
+        # At most the screen's room, maximized on a small screen; a size remembered elsewhere is clamped.
+        fit_window(self, restored)
 
     def _rebuild_recent_menu(self) -> None:
         self.recent_menu.clear()

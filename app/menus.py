@@ -137,8 +137,8 @@ class Menus:
 
     # -- File ------------------------------------------------------------------
     def on_export_report(self) -> None:
-        """The QA page writes reports (with its verdict against the loaded limits): show it and ask where."""
-        self.window.pages.setCurrentWidget(self.window.qa)
+        """The QA page writes reports (with its verdict against the loaded limits); the page shown stays: the
+        status bar says when it is written, a message why it could not be."""
         self.window.qa.on_export()
 
     def on_load_limits(self) -> None:

@@ -22,18 +22,13 @@ from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeade
                                QVBoxLayout, QWidget)
 
 from analysis.derived import NO_SD, ParameterValue
+from analysis.parameter_names import DISPLAY_NAMES, THIELE_SMALL, display_name  # noqa: F401 (shared)
 from analysis.report.numbers import pretty_unit
 from app import style
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
 NAME, VALUE, STD, UNIT = range(4)
 
-# The Thiele-Small set, in reading order; everything else is one of the model's internal quantities.
-THIELE_SMALL = ("fs", "Qts", "Qes", "Qms", "Vas", "RE", "LE", "Bl", "Mms", "Cms", "Rms", "Kms", "Sd",
-                "SPL_2.83V_1m", "SPL_1W_1m", "eta0")
-# How the table names them where the code's name is not the customary one.
-DISPLAY_NAMES = {"RE": "Re", "LE": "Le", "SPL_2.83V_1m": "Sensitivity (2.83 V, 1 m)",
-                 "SPL_1W_1m": "Sensitivity (1 W, 1 m)", "eta0": "η₀ (efficiency)"}
 INTERNAL_TITLE = "Model's internal quantities"
 DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
 
@@ -53,10 +48,6 @@ DERIVED_DESCRIPTIONS = {
     "SPL_2.83V_1m": "sensitivity at 2.83 V, 1 m, half space",
     "Sd": "effective radiating area of the diaphragm (given, not measured)",
 }
-
-
-def display_name(name: str) -> str:
-    return DISPLAY_NAMES.get(name, name)
 
 
 def ordered_rows(parameters: Mapping[str, ParameterValue], sd_m2: float | None = None) -> list:

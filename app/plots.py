@@ -17,7 +17,8 @@ from app.plot_placeholder import PlotPlaceholder
 
 LEFT_AXIS_WIDTH = 72          # the same on every row, so that the x axes line up
 RESIDUAL_MIN_RANGE = 4.0      # sigma: the +-3 guides always stay in view
-RESIDUAL_MAX_RANGE = 30.0     # beyond that, outliers are clipped so the rest stays readable
+RESIDUAL_MAX_RANGE = 30.0     # beyond that, outliers are pinned at the edge so the rest stays readable
+EDGE = 0.93                   # where a pinned point sits, as a share of the range: inside the strip, visible
 NO_CURVES = "Nothing to draw: no fitted measurement (the validity above says why)."
 
 
@@ -100,6 +101,26 @@ def _guides(plot: pg.PlotItem) -> None:
                                      pen=pg.mkPen(style.GUIDE, width=1, style=dash)))
 
 
+def beyond_range(freqs: np.ndarray, residual: np.ndarray, limit: float) -> tuple[np.ndarray, np.ndarray, str]:
+    """The lines whose real or imaginary residual lies beyond +-limit: (their frequencies, the sign of the
+    larger part), and the words that count them ("14 points beyond ±30σ, up to 2.8e+04σ at 8.2 Hz"; empty
+    when none). A misfit of thousands of sigma must not vanish off the strip's edge: on a recording with
+    hidden physics it was the only sign of where the model failed."""
+    parts = np.stack([np.asarray(residual.real, float), np.asarray(residual.imag, float)])
+    size = np.where(np.isfinite(parts), np.abs(parts), 0.0)
+    larger = np.argmax(size, axis=0)
+    peak = size[larger, np.arange(size.shape[1])]
+    out = peak > limit
+    if not out.any():
+        return np.zeros(0), np.zeros(0), ""
+    sign = np.sign(parts[larger, np.arange(size.shape[1])])[out]
+    worst = int(np.argmax(np.where(out, peak, -1.0)))
+    count = int(out.sum())
+    words = (f"{count} point{'s' if count != 1 else ''} beyond ±{limit:.3g}σ (▲▼), "
+             f"up to {peak[worst]:.3g}σ at {freqs[worst]:.3g} Hz")
+    return np.asarray(freqs)[out], sign, words
+
+
 class TransferPlot(pg.GraphicsLayoutWidget):
     """Magnitude, phase and normalised residual of one transfer function, x axes linked."""
 
@@ -138,6 +159,14 @@ class TransferPlot(pg.GraphicsLayoutWidget):
                                              symbolBrush=pg.mkBrush(style.RESIDUAL_IMAG), name="imag")
         self.residual.addItem(self.residual_real)
         self.residual.addItem(self.residual_imag)
+        # Points beyond the strip's range, pinned at its edge: an up triangle above, a down one below.
+        self.residual_beyond_up = pg.PlotDataItem(pen=None, symbol="t1", symbolSize=8, symbolPen=None,
+                                                  symbolBrush=pg.mkBrush(style.RESIDUAL_BEYOND))
+        self.residual_beyond_down = pg.PlotDataItem(pen=None, symbol="t", symbolSize=8, symbolPen=None,
+                                                    symbolBrush=pg.mkBrush(style.RESIDUAL_BEYOND))
+        self.residual.addItem(self.residual_beyond_up)
+        self.residual.addItem(self.residual_beyond_down)
+        self.beyond_text = ""
         self.placeholder = PlotPlaceholder(self, NO_CURVES)
 
     def set_curves(self, curves, title: str) -> None:
@@ -158,26 +187,33 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         res = curves.residual
         self.residual_real.setData(curves.freqs, res.real)
         self.residual_imag.setData(curves.freqs, res.imag)
+        limit = self._residual_range(res)
+        freqs, sign, self.beyond_text = beyond_range(curves.freqs, res, limit)
+        self.residual_beyond_up.setData(freqs[sign > 0], np.full(int((sign > 0).sum()), EDGE * limit))
+        self.residual_beyond_down.setData(freqs[sign < 0], np.full(int((sign < 0).sum()), -EDGE * limit))
+        beyond = (f"; <span style='color:{style.RESIDUAL_BEYOND}'>{self.beyond_text}</span>"
+                  if self.beyond_text else "")
         # In the title rather than a legend: a legend would cover the points of the thin strip.
         self.residual.setTitle(
-            f"normalised residual (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span>"
-            f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span> part; reduced χ² = "
-            f"{curves.chi2_red:.2f}", size="9pt")
-        self._residual_range(res)
+            f"residual (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span>"
+            f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span>; reduced χ² = "
+            f"{curves.chi2_red:.3g}{beyond}", size="9pt")
         self.magnitude.enableAutoRange()
         self.phase.enableAutoRange(axis="y")
 
-    def _residual_range(self, res: np.ndarray) -> None:
+    def _residual_range(self, res: np.ndarray) -> float:
         parts = np.abs(np.concatenate([res.real, res.imag]))
         parts = parts[np.isfinite(parts)]
         peak = float(np.percentile(parts, 99)) * 1.15 if parts.size else 0.0
         limit = min(max(RESIDUAL_MIN_RANGE, peak), RESIDUAL_MAX_RANGE)
         self.residual.setYRange(-limit, limit, padding=0)
+        return limit
 
     def clear_curves(self) -> None:
         for item in (self.magnitude_measured, self.magnitude_model, self.phase_measured, self.phase_model,
-                     self.residual_real, self.residual_imag):
+                     self.residual_real, self.residual_imag, self.residual_beyond_up, self.residual_beyond_down):
             item.setData([], [])
+        self.beyond_text = ""
         for item in (self.magnitude_error, self.phase_error):
             item.setData(x=np.zeros(0), y=np.zeros(0), top=np.zeros(0), bottom=np.zeros(0))
         self.placeholder.show_text(NO_CURVES)

@@ -100,6 +100,7 @@ def _interval_tip(verdict) -> str:
 class QAView(QWidget):
     verdict_changed = Signal(str)       # "pass" | "fail" | "uncertain" | "invalid" | "not judged" | "none"
     report_written = Signal(str)
+    report_failed = Signal(str)         # why; the window says it on whichever page is shown
 
     def __init__(self, settings: QSettings | None = None, parent=None):
         super().__init__(parent)
@@ -336,7 +337,8 @@ class QAView(QWidget):
             return
         stem = self.result.source.with_suffix("").name if self.result.source else "report"
         start = str(self.result.source.with_name(stem + "-report.pdf")) if self.result.source else "report.pdf"
-        path, _ = QFileDialog.getSaveFileName(self, "Export report", start, "PDF (*.pdf);;HTML (*.html)")
+        # The window is the dialog's parent: File > Export report… asks from whichever page is shown.
+        path, _ = QFileDialog.getSaveFileName(self.window(), "Export report", start, "PDF (*.pdf);;HTML (*.html)")
         if path:
             self.export_to(Path(path))
 
@@ -345,13 +347,16 @@ class QAView(QWidget):
         job = self.worker.run("report", lambda job: write_report_file(job, result, path, limits),
                               f"writing the report {path.name}")
         self.export_label.setText("")
-        self.export_jobs.run(job, f"Writing {path.name}…", self.on_report_written,
-                             lambda message: self.export_label.setText(f"Could not write the report: {message}"),
+        self.export_jobs.run(job, f"Writing {path.name}…", self.on_report_written, self.on_report_failed,
                              lambda: self.export_label.setText("Export cancelled: nothing written."))
 
     def on_report_written(self, written: str) -> None:
         self.export_label.setText(f"Written: {written}")
         self.report_written.emit(written)
+
+    def on_report_failed(self, message: str) -> None:
+        self.export_label.setText(f"Could not write the report: {message}")
+        self.report_failed.emit(message)
 
     def shutdown(self, wait_ms: int) -> bool:
         self.export_jobs.drop()

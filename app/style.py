@@ -14,6 +14,7 @@ MEASURED = "#1f5fbf"        # measured lines: blue points
 MODEL = "#d1495b"           # the fitted model: red line
 RESIDUAL_REAL = "#1f5fbf"
 RESIDUAL_IMAG = "#e08a00"
+RESIDUAL_BEYOND = "#8e1b1b"  # residuals beyond the strip's range, pinned at its edge
 GUIDE = "#8c8c8c"
 MISSING_TEXT = "#8c8c8c"
 

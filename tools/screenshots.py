@@ -32,6 +32,10 @@ station QA3 reading high, its control chart with the alarms flagged
 --only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
 (tools/screenshots_verdicts.py).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
+--only production-counts: production-4-units-*.png and production-40-units-*.png, the capability
+indices greyed below 25 units, with their 95 % intervals.
+--only first-window: a fresh user's first window on a 1280x720 and a 1920x1080 screen, and the Results page
+with residuals beyond the strip's range (tools/screenshots_window.py).
 --only hardware: the Hardware page's sound-card and serial-port lists at both sizes, this machine's and a
 Windows PC's as an example (tools/screenshots_hardware.py).
 qa-current-zeroed-1280x720.png and -1920x1080.png: the QA page judging a recording
@@ -354,9 +358,9 @@ def new_effect_screenshots(app: QApplication, window, folder: Path, out: Path) -
                                           prepare=lambda: lab.catalogue.tree.scrollToItem(item))
 
 
-def production_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
-    """The Production page: 240 units of one driver from three stations, fs 2 sigma up from unit 150, QA3 reading
-    0.6 Hz high; limits version 1 stored first. At 1280x720 and 1920x1080."""
+def _store_units(window, folder: Path, counts: tuple[int, ...]):
+    """Yield after storing each count of units (cumulative) of one driver from three stations, fs 2 sigma up
+    from unit 150, QA3 reading 0.6 Hz high; limits version 1 stored first."""
     import copy
 
     import numpy as np
@@ -378,35 +382,58 @@ def production_screenshots(app: QApplication, window, folder: Path, out: Path) -
                                          "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
                                          "Qts": {"min": 0.40, "max": 0.52, "unit": "-"}}}, note="first article")
     rng = np.random.default_rng(4)
-    for i in range(240):
-        station = ("QA1", "QA2", "QA3")[i % 3]
-        unit_doc = copy.deepcopy(doc)
-        params = unit_doc["parameters"]
-        fs = 70.5 + 0.8 * rng.standard_normal() + (1.6 if i >= 150 else 0.0) + (0.6 if station == "QA3" else 0.0)
-        for name, p in params.items():          # unit-to-unit spread of a few percent, as a batch has
-            if p.get("value") is not None:
-                p["value"] = p["value"] * (1 + 0.015 * rng.standard_normal())
-        params["fs"]["value"] = fs
-        archive.store(wav, unit_doc, {"driver": "W18-PAPER", "serial": f"{7000 + i}", "station": station,
-                                      "operator": ("ana", "ben")[i % 2],
-                                      "measured_at": f"2024-05-{1 + i // 80:02d}T{6 + i % 80 // 8:02d}:"
-                                                     f"{i % 8 * 7:02d}:00Z"})
+    i = 0
+    for count in counts:
+        while i < count:
+            station = ("QA1", "QA2", "QA3")[i % 3]
+            unit_doc = copy.deepcopy(doc)
+            params = unit_doc["parameters"]
+            fs = 70.5 + 0.8 * rng.standard_normal() + (1.6 if i >= 150 else 0.0) + (0.6 if station == "QA3" else 0.0)
+            for name, p in params.items():          # unit-to-unit spread of a few percent, as a batch has
+                if p.get("value") is not None:
+                    p["value"] = p["value"] * (1 + 0.015 * rng.standard_normal())
+            params["fs"]["value"] = fs
+            archive.store(wav, unit_doc, {"driver": "W18-PAPER", "serial": f"{7000 + i}", "station": station,
+                                          "operator": ("ana", "ben")[i % 2],
+                                          "measured_at": f"2024-05-{1 + i // 80:02d}T{6 + i % 80 // 8:02d}:"
+                                                         f"{i % 8 * 7:02d}:00Z"})
+            i += 1
+        yield count
+
+
+def _grab_production(app: QApplication, window, out: Path, stem: str) -> list[Path]:
     page = window.production
     window.pages.setCurrentWidget(page)
     written = []
     for width, height in SMALL_AND_LARGE:
         window.resize(width, height)
         page.parameter = "fs"
+        page.refresh()
         if not wait_for(page.computed, ANALYSIS_TIMEOUT_S) and page.data is None:
             print("screenshots: the production statistics did not come", file=sys.stderr)
             return written
         page.details.setCurrentIndex(0)
         settle(app)
-        path = out / f"production-{width}x{height}.png"
+        path = out / f"{stem}-{width}x{height}.png"
         window.grab().save(str(path))
         written.append(path)
-        page.refresh()
     window.resize(*SIZE)
+    return written
+
+
+def production_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Production page over 240 units (see _store_units), at 1280x720 and 1920x1080."""
+    written = []
+    for _ in _store_units(window, folder, (240,)):
+        written += _grab_production(app, window, out, "production")
+    return written
+
+
+def production_counts_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    """The Production page with 4 units (capability greyed, its intervals wide) and with 40."""
+    written = []
+    for count in _store_units(window, folder, (4, 40)):
+        written += _grab_production(app, window, out, f"production-{count}-units")
     return written
 
 
@@ -440,6 +467,11 @@ def hardware_screenshots(app: QApplication, window, folder: Path, out: Path) -> 
 def real_like_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_real_like import real_like_screenshots as shots
     return shots(app, window, folder, out, open_in_lab)
+
+
+def first_window_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_window import first_window_screenshots as shots
+    return shots(app, window, folder, out, hidden_delay_recording(folder))
 
 
 def pages_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
@@ -493,7 +525,8 @@ def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> 
 ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect": new_effect_screenshots,
         "large-signal": large_signal_screenshots, "production": production_screenshots,
         "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
-        "verdicts": verdicts_screenshots, "real-like": real_like_screenshots}
+        "verdicts": verdicts_screenshots, "real-like": real_like_screenshots,
+        "first-window": first_window_screenshots, "production-counts": production_counts_screenshots}
 
 
 def main(argv: list[str]) -> int:

@@ -13,7 +13,7 @@ needed=(libportaudio2 jackd2 libegl1 libgl1 libxkbcommon0 libxkbcommon-x11-0 lib
         libx11-6 libx11-xcb1 libxcb1 libxcb-cursor0 libxcb-glx0 libxcb-icccm4 libxcb-image0 libxcb-keysyms1
         libxcb-randr0 libxcb-render0 libxcb-render-util0 libxcb-shape0 libxcb-shm0 libxcb-sync1 libxcb-util1
         libxcb-xfixes0 libxcb-xkb1
-        poppler-utils postgresql xvfb)
+        poppler-utils postgresql xvfb x11-utils)
 missing=()
 for pkg in "${needed[@]}"; do
   dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")

@@ -15,7 +15,9 @@ from typing import Any, Mapping
 from analysis.archive.results import StoredResult
 from analysis.fit.report import fit_report_rows
 from analysis.fit.methods import DEFAULT_METHOD, METHODS
-from analysis.report.numbers import format_number, format_std, parameter_cells, pretty_unit
+from analysis.report.customer import (calibration_rows, file_name, model_title, parameter_row_cells,
+                                      split_parameters)
+from analysis.report.numbers import format_number, format_std, pretty_unit
 from analysis.report.qa import LimitRow, QASection, qa_section
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
@@ -67,13 +69,17 @@ class ReportContent:
     overall: str
     lights: tuple[Light, ...]
     peak_displacement: str
-    parameters: tuple[ParameterRow, ...]
-    model: tuple[tuple[str, str], ...]
+    parameters: tuple[ParameterRow, ...]            # the Thiele-Small set with Sd, as the workstation names them
+    model: tuple[tuple[str, str], ...]              # the model in words and how well it fits
     settings: tuple[tuple[str, str], ...]
-    calibration: tuple[tuple[str, str], ...]
+    calibration: tuple[tuple[str, str], ...]        # in words: each input's full scale
     result: StoredResult = field(repr=False)
     notes: tuple[str, ...] = ()          # e.g. why there is no SPL plot
     qa: QASection | None = None          # the verdict against a limits file, when one was given
+    # The appendix: the engineering detail a customer's page leaves out.
+    internal: tuple[ParameterRow, ...] = ()         # the model's own quantities (CMES, LCES, ...)
+    fit: tuple[tuple[str, str], ...] = ()           # effects by id, chi^2, AIC/BIC, correlations
+    calibration_detail: tuple[tuple[str, str], ...] = ()     # the recording's calibration keys as stored
 
     @property
     def has_spl(self) -> bool:
@@ -94,15 +100,20 @@ def _lights(validity: Mapping) -> tuple[Light, ...]:
     return tuple(lights)
 
 
-def _effect_title(effect_id: str, result: StoredResult) -> str:
+def _effect(effect_id: str, result: StoredResult):
     from analysis.effects import CATALOGUE
-    e = result.user_effects.get(effect_id) or CATALOGUE.get(effect_id)
+    return result.user_effects.get(effect_id) or CATALOGUE.get(effect_id)
+
+
+def _effect_title(effect_id: str, result: StoredResult) -> str:
+    e = _effect(effect_id, result)
     return f"{effect_id} ({e.title})" if e else effect_id
 
 
 def _user_effect_rows(result: StoredResult) -> list[tuple[str, str]]:
     """Each effect of the user's own with its formula, site and file: the report says what was fitted."""
-    return [(f"Own effect {e.id}", f"{e.formula.text} at the {e.site.key} site ({e.acts_as}); file {e.source}")
+    return [(f"Own effect {e.id}", f"{e.formula.text} at the {e.site.key} site ({e.acts_as}); file "
+                                   f"{file_name(e.source)}")
             for e in result.user_effects.values() if e.id in result.effects]
 
 
@@ -120,18 +131,37 @@ def _method_text(name) -> str:
     return f"{name}: {METHODS[name]}" if name in METHODS else str(name)
 
 
+def _chi2_text(info: Mapping) -> str:
+    chi = info.get("chi2_red") or {}
+    return ", ".join(f"{v:.3g} ({channel})" if isinstance(v, (int, float)) else f"n/a ({channel})"
+                     for channel, v in chi.items())
+
+
 def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
+    """The customer's lines: the model by the titles of its effects, the fit in one line."""
     if result.not_fitted:
         return (("Model", "nothing fitted"), ("Why", result.not_fitted))
+    titles = [e.title if e else effect_id for effect_id, e in ((i, _effect(i, result)) for i in result.effects)]
     info = result.model_info
-    effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
-    chi = info.get("chi2_red") or {}
-    rows = [("Model", "Lumped model (electrical + mechanical)" + (" with Hx (laser)" if result.with_displacement
-                                                                 else ", impedance only")),
-            ("Effects", effects), ("Method", _method_text(info.get("method")))] + _user_effect_rows(result)
+    rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))
-    for channel, value in chi.items():
+    chi = _chi2_text(info)
+    if chi:
+        rows.append(("Fit quality", f"reduced χ² {chi}; 1 means the model fits within the noise"))
+    if not info.get("converged"):
+        rows.append(("Converged", f"NO: {info.get('message', '')}"))
+    return tuple(rows)
+
+
+def _fit_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
+    """The appendix's lines: effects by id, every statistic of the fit, its correlations and notes."""
+    if result.not_fitted:
+        return ()
+    info = result.model_info
+    effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
+    rows = [("Effects", effects), ("Method", _method_text(info.get("method")))] + _user_effect_rows(result)
+    for channel, value in (info.get("chi2_red") or {}).items():
         rows.append((f"Reduced χ² ({channel})", format_number(value) if value is not None else "n/a"))
     for key, label in (("aic", "AIC"), ("bic", "BIC")):
         value = info.get(key)
@@ -174,6 +204,14 @@ def _settings_rows(settings: Mapping) -> tuple[tuple[str, str], ...]:
     return tuple(rows)
 
 
+def _rows(parameters) -> tuple[ParameterRow, ...]:
+    rows = []
+    for p in parameters:
+        name, value, std, unit, rel = parameter_row_cells(p)
+        rows.append(ParameterRow(name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted))
+    return tuple(rows)
+
+
 def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapping | None = None,
                  calibration: Mapping | None = None, limits=None) -> ReportContent:
     """header: driver, serial, measured_at, operator, station, id, source (any may be missing).
@@ -185,12 +223,11 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     # The recording's session is the base (analysis.session): the same header from the recording, the
     # archive or an export; what the caller knows (the archive's id, the file) is added.
     header = {**result.session, **{k: v for k, v in header.items() if v}, "reported_with": software()}
+    if header.get("source"):
+        header["source"] = file_name(header["source"])      # the file, not the folder it was in
     head = tuple((label, str(header.get(key) or "–")) for key, label in HEADER_FIELDS
                  if header.get(key) or key in ALWAYS_SHOWN)
-    params = []
-    for p in result.parameters.values():
-        value, std, unit, rel = parameter_cells(p)
-        params.append(ParameterRow(p.name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted))
+    customer, internal = split_parameters(result.parameters, result.sd_m2)
     peak = result.validity.get("peak_displacement_m")
     peak_text = f"{peak * 1e3:.3g} mm" if isinstance(peak, (int, float)) else "not measured"
     cal: list[tuple[str, str]] = []
@@ -206,10 +243,11 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     return ReportContent(
         title=f"Linear parameters: {title}" if title else "Linear parameters",
         header=head, overall=result.overall, lights=_lights(result.validity), peak_displacement=peak_text,
-        parameters=tuple(params), model=_model_rows(result),
+        parameters=_rows(customer), model=_model_rows(result),
         settings=_settings_rows({**dict(result.settings), **dict(settings or {})}),
-        calibration=tuple(cal) or (("Calibration", "not recorded"),), result=result, notes=tuple(notes),
-        qa=None if limits is None else qa_section(limits, result.parameters, result.validity))
+        calibration=calibration_rows(calibration), result=result, notes=tuple(notes),
+        qa=None if limits is None else qa_section(limits, result.parameters, result.validity),
+        internal=_rows(internal), fit=_fit_rows(result), calibration_detail=tuple(cal))
 
 
 __all__ = ["Finding", "Light", "LimitRow", "ParameterRow", "QASection", "ReportContent", "build_report",

@@ -70,16 +70,20 @@ def _qa_table(qa: QASection) -> str:
     return "".join(parts)
 
 
-def render_html(content: ReportContent) -> str:
-    c = content
-    parts = [f"<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>{escape(c.title)}</title>"
-             f"<style>{CSS}</style></head><body>", f"<h1>{escape(c.title)}</h1>"]
-    if c.qa is not None:
-        parts.append(_verdict_banner(c.qa))
-    parts.append(_pairs(c.header))
+def _parameter_table(title: str, rows) -> str:
+    parts = [f"<h2>{escape(title)}</h2><table class='params'><tr><th>parameter</th><th class='num'>value</th>"
+             "<th class='num'>± 1σ</th><th>unit</th><th class='num'>rel.</th><th>note</th></tr>"]
+    for p in rows:
+        parts.append(f"<tr><td>{escape(p.name)}</td><td class='num'>{escape(p.value)}</td>"
+                     f"<td class='num'>{escape(p.std)}</td><td>{escape(p.unit)}</td>"
+                     f"<td class='num'>{escape(p.relative)}</td><td>{escape(p.note)}</td></tr>")
+    parts.append("</table>")
+    return "".join(parts)
 
-    parts.append(f"<h2>Validity</h2><p>{_light(c.overall)}<b>Overall: {escape(c.overall)}</b> "
-                 f"&nbsp; peak excursion {escape(c.peak_displacement)}</p><ul style='list-style:none;padding:0'>")
+
+def _validity(c: ReportContent) -> str:
+    parts = [f"<h2>Validity</h2><p>{_light(c.overall)}<b>Overall: {escape(c.overall)}</b> "
+             f"&nbsp; peak excursion {escape(c.peak_displacement)}</p><ul style='list-style:none;padding:0'>"]
     for light in c.lights:
         parts.append(f"<li>{_light(light.status)}{escape(CHANNEL_TITLES.get(light.channel, light.channel))}: "
                      f"{escape(light.status)}")
@@ -88,25 +92,42 @@ def render_html(content: ReportContent) -> str:
                          f"<br><span class='remedy'>Remedy: {escape(f.remedy)}</span></div>")
         parts.append("</li>")
     parts.append("</ul>")
+    return "".join(parts)
+
+
+def render_html(content: ReportContent) -> str:
+    """The customer's part (parameters, model, validity, plots, calibration), then the appendix."""
+    c = content
+    parts = [f"<!DOCTYPE html>\n<html lang='en'><head><meta charset='utf-8'><title>{escape(c.title)}</title>"
+             f"<style>{CSS}</style></head><body>", f"<h1>{escape(c.title)}</h1>"]
+    if c.qa is not None:
+        parts.append(_verdict_banner(c.qa))
+    parts.append(_pairs(c.header))
     if c.qa is not None:
         parts.append(_qa_table(c.qa))
-
-    parts.append("<h2>Parameters</h2><table class='params'><tr><th>parameter</th><th class='num'>value</th>"
-                 "<th class='num'>± 1σ</th><th>unit</th><th class='num'>rel.</th><th>note</th></tr>")
-    for p in c.parameters:
-        parts.append(f"<tr><td>{escape(p.name)}</td><td class='num'>{escape(p.value)}</td>"
-                     f"<td class='num'>{escape(p.std)}</td><td>{escape(p.unit)}</td>"
-                     f"<td class='num'>{escape(p.relative)}</td><td>{escape(p.note)}</td></tr>")
-    parts.append("</table>")
-
-    parts.append("<h2>Model and fit quality</h2>" + _pairs(c.model))
+    parts.append(_parameter_table("Parameters", c.parameters))
+    parts.append("<h2>Model</h2>" + _pairs(c.model))
     for note in c.notes:
         parts.append(f"<p class='note'>{escape(note)}</p>")
+    parts.append(_validity(c))
+    shown = figures(c.result)
+    residuals = [(t, f) for t, f in shown if "residual" in t.lower()]      # engineering detail: the appendix
     parts.append("<h2>Plots</h2>")
-    for title, fig in figures(c.result):
+    for title, fig in shown:
+        if "residual" not in title.lower():
+            parts.append(f"<figure><figcaption>{escape(title)}</figcaption>{svg_of(fig)}</figure>")
+    parts.append("<h2>Calibration</h2>" + _pairs(c.calibration))
+
+    parts.append("<h1 class='appendix'>Appendix: engineering detail</h1>")
+    if c.fit:
+        parts.append("<h2>Fit</h2>" + _pairs(c.fit))
+    if c.internal:
+        parts.append(_parameter_table("Model's internal quantities", c.internal))
+    for title, fig in residuals:
         parts.append(f"<figure><figcaption>{escape(title)}</figcaption>{svg_of(fig)}</figure>")
     parts.append("<h2>Measurement settings</h2>" + _pairs(c.settings))
-    parts.append("<h2>Calibration</h2>" + _pairs(c.calibration))
+    parts.append("<h2>Calibration as recorded</h2>" + _pairs(c.calibration_detail or
+                                                           (("Calibration", "not recorded"),)))
     parts.append("<p class='note'>Values in SI are in the results JSON; uncertainties are one standard "
                  "deviation from the fit, scaled by the Birge ratio when the model does not fit within the "
                  "noise.</p></body></html>\n")

@@ -25,9 +25,16 @@ def format_number(value: float | None, std: float | None = None) -> str:
 
 
 def format_std(std: float | None) -> str:
+    """Two significant digits, written out ("0.000016", "1200"): an exponent is unreadable beside its value."""
     if std is None or not math.isfinite(std):
         return "–"
-    return f"{std:.2g}"
+    if std <= 0:
+        return "0"
+    decimals = 1 - int(math.floor(math.log10(std)))
+    if decimals > 10:
+        return f"{std:.2g}"
+    rounded = round(std, decimals)
+    return f"{rounded:.{max(0, decimals)}f}"
 
 
 def parameter_cells(p: ParameterValue) -> tuple[str, str, str, str]:

@@ -8,13 +8,12 @@ so nothing is clipped. A dry run of the layout counts the pages first: when
 slightly smaller plots (PLOT_SCALES) save a page, they are used, so that no
 last page holds only the few lines that ran over.
 
-The plots of one page are laid out together by matplotlib's constrained
-layout inside the band of the page they occupy; the text around them is
-placed by hand and lies outside that band.
+Each plot sits in fixed margins inside the band of the page it occupies (room\nfor its title, axis labels and tick labels); the text around it is placed by\nhand and lies outside that band.
 """
 from __future__ import annotations
 
 import io
+import logging
 import textwrap
 
 import matplotlib
@@ -30,6 +29,11 @@ from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals
 from analysis.limits import INTERVAL_K
 from analysis.report.qa import VERDICT_COLOURS, QASection
 
+# fontTools says every font it subsets at INFO, some 250 lines an export: noise on the user's terminal
+# (`linpar gui` logs at INFO). Their warnings still show.
+for _chatty in ("fontTools", "matplotlib"):
+    logging.getLogger(_chatty).setLevel(logging.WARNING)
+
 A4 = (8.27, 11.69)
 MARGIN = 0.7             # inches
 BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT = 8.5, 11.5, 15, 16
@@ -41,12 +45,27 @@ LINE = BODY_PT * GAP / 72
 KEEP_TOGETHER = 2.5      # inches: a shorter section is not split across pages
 PLOT_LEFT = 0.6 * MARGIN        # axis labels sit in the left margin's outer part: plots use the width
 PLOT_SHRINK = 0.8
+# A plot band's fixed margins, inches: its title above, the frequency axis' ticks and label below, the y axis'
+# label and tick labels on the left (of the plots' left edge, PLOT_LEFT), the gap between stacked axes.
+PLOT_TITLE, PLOT_X_LABELS, PLOT_Y_LABELS, PLOT_GAP = 0.3, 0.5, 0.75, 0.1
 PLOT_SCALES = (0.95, 0.9, 0.85, 0.8, 0.75, 0.7)    # tried in turn: the first that saves a page is used
 PLOT_HEIGHTS = {"impedance": 4.6, "hx": 4.6, "spl": 3.0, "residuals": 2.4}     # inches; residuals per channel
 
 
 def _chars(width_in: float) -> int:
     return max(12, int(width_in * 72 / (BODY_PT * EM)))
+
+
+class _DryPage:
+    """A page of a dry run: takes the text and shapes, draws nothing. Making real Figures only to count pages
+    cost the export seconds (a Figure and its texts per page, for each of up to 7 layouts tried)."""
+    dpi_scale_trans = None
+
+    def text(self, *args, **kwargs) -> None:
+        pass
+
+    def add_artist(self, artist) -> None:
+        pass
 
 
 class _Pages:
@@ -57,7 +76,7 @@ class _Pages:
         """pdf None: a dry run that only counts pages (nothing is plotted or saved)."""
         self.pdf, self.footer, self.content, self.page_no = pdf, footer, content, 0
         self.plot_scale, self.total = plot_scale, total
-        self.fig: Figure | None = None
+        self.fig: Figure | _DryPage | None = None
         self.y = 0.0
         self.plots: list[tuple[str, float, float]] = []      # (what, top, height) on the current page
 
@@ -67,7 +86,7 @@ class _Pages:
 
     def _new_page(self) -> None:
         self.close()
-        self.fig = Figure(figsize=A4)
+        self.fig = Figure(figsize=A4) if self.pdf is not None else _DryPage()
         self.page_no += 1
         self.y = MARGIN
         of = f" of {self.total}" if self.total else ""
@@ -170,25 +189,43 @@ class _Pages:
         self.plots.append((what, self.y, band))
         self.y += band
 
+    def _axes(self, top: float, height: float, rows: int, ratios=None, share: bool = False) -> list:
+        """`rows` axes stacked in a band `height` inches high from `top`, in fixed margins (inches): room for
+        a title above, the frequency axis' labels below, the y label and tick labels on the left. Fixed
+        margins, not constrained layout: that measured every text of the page twice and took a third of
+        an export's time."""
+        left, right = PLOT_LEFT + PLOT_Y_LABELS, A4[0] - MARGIN * 0.6
+        first = last = None
+        axes = []
+        ratios = ratios or [1] * rows
+        inner = height - PLOT_TITLE - PLOT_X_LABELS - PLOT_GAP * (rows - 1)
+        y = top + PLOT_TITLE
+        for ratio in ratios:
+            h = inner * ratio / sum(ratios)
+            ax = self.fig.add_axes(((left) / A4[0], 1 - (y + h) / A4[1], (right - left) / A4[0], h / A4[1]),
+                                   sharex=first if share else None)
+            first = first or ax
+            last = ax
+            axes.append(ax)
+            y += h + PLOT_GAP
+        if share:
+            for ax in axes:
+                if ax is not last:
+                    ax.tick_params(labelbottom=False)
+        return axes
+
     def _draw_plots(self) -> None:
-        if not self.plots:
-            return
         r = self.content.result
-        # The plots of a page follow one another (_flow writes no text between them): one band, laid out together.
-        top, bottom = self.plots[0][1], self.plots[-1][1] + self.plots[-1][2]
-        self.fig.set_layout_engine("constrained", h_pad=0.12, rect=(
-            PLOT_LEFT / A4[0], 1 - bottom / A4[1], 1 - (PLOT_LEFT + MARGIN * 0.6) / A4[0], (bottom - top) / A4[1]))
-        sub = self.fig.subfigures(len(self.plots), 1, height_ratios=[h for _, _, h in self.plots],
-                                  squeeze=False)[:, 0]
-        for sf, (what, _, _) in zip(sub, self.plots):
+        for what, top, band in self.plots:
             if what == "impedance":
-                draw_impedance(r, *sf.subplots(2, 1, sharex=True, height_ratios=[3, 2]))
+                draw_impedance(r, *self._axes(top, band, 2, [3, 2], share=True))
             elif what == "hx":
-                draw_hx(r, *sf.subplots(2, 1, sharex=True, height_ratios=[3, 2]))
+                draw_hx(r, *self._axes(top, band, 2, [3, 2], share=True))
             elif what == "spl":
-                draw_spl(r, sf.subplots())
-            else:
-                draw_residuals(r, sf.subplots(len(r.curves), 1, squeeze=False)[:, 0])
+                draw_spl(r, *self._axes(top, band, 1))
+            else:               # one band per channel, each with its title and frequency axis
+                n = len(r.curves)
+                draw_residuals(r, [self._axes(top + i * band / n, band / n, 1)[0] for i in range(n)])
 
 
 def _validity(pages: _Pages, c: ReportContent) -> None:
@@ -201,7 +238,7 @@ def _validity(pages: _Pages, c: ReportContent) -> None:
         for f in light.findings:
             pages.light(0.45, f.severity)
             pages.wrapped(f"{f.code}: {f.message}", x=0.7)
-            pages.wrapped(f"Remedy: {f.remedy}", x=0.7, color="#333333", style="italic")
+            pages.wrapped(f"Remedy: {f.remedy}", x=0.7, color="#333333")
 
 
 def _qa_table(pages: _Pages, qa: QASection) -> None:
@@ -227,7 +264,7 @@ def _qa_table(pages: _Pages, qa: QASection) -> None:
         pages.text(cols[0], row.name)
         pages.text(cols[1], row.outcome, weight="bold" if row.outcome in ("FAIL", "uncertain") else "normal",
                    color=colours.get(row.outcome, "#555555"))
-        pages.text(cols[2], row.value, ha="right", family="DejaVu Sans Mono")
+        pages.text(cols[2], row.value, ha="right")
         pages.text(cols[3], row.used, ha="right")
         for i in range(max(len(limit), len(margin))):
             if i < len(limit):
@@ -236,9 +273,9 @@ def _qa_table(pages: _Pages, qa: QASection) -> None:
             pages.line(margin[i] if i < len(margin) else "", x=cols[5], **grey)
 
 
-def _parameters(pages: _Pages, c: ReportContent) -> None:
-    pages.heading("Parameters")
-    cols = (0.0, 1.6, 2.6, 3.3, 4.0)   # name | value (right-aligned at) | ±1σ | unit | rel | note
+def _parameters(pages: _Pages, rows, title: str = "Parameters") -> None:
+    pages.heading(title)
+    cols = (0.0, 2.1, 3.1, 3.8, 4.5)   # name | value (right-aligned at) | ±1σ | unit | rel | note
     pages._room(LINE * 2)
     pages.text(cols[0], "parameter", weight="bold")
     pages.text(cols[1] + 0.6, "value", weight="bold", ha="right")
@@ -247,7 +284,7 @@ def _parameters(pages: _Pages, c: ReportContent) -> None:
     pages.text(cols[4], "rel.", weight="bold")
     pages.line("")
     previous = ""
-    for p in c.parameters:
+    for p in rows:
         # A missing value has no relative uncertainty: its note starts in that column. The same reason for
         # the next parameter (all the mechanical ones without a laser) is not repeated in full.
         x_note = cols[4] + (0.6 if p.relative else 0.0)
@@ -256,8 +293,8 @@ def _parameters(pages: _Pages, c: ReportContent) -> None:
         note_lines = textwrap.wrap(note, _chars(A4[0] - 2 * MARGIN - x_note))
         pages._room(LINE * max(1, len(note_lines)))
         pages.text(cols[0], p.name)
-        pages.text(cols[1] + 0.6, p.value, ha="right", family="DejaVu Sans Mono")
-        pages.text(cols[2] + 0.5, p.std, ha="right", family="DejaVu Sans Mono")
+        pages.text(cols[1] + 0.6, p.value, ha="right")
+        pages.text(cols[2] + 0.5, p.std, ha="right")
         pages.text(cols[3], p.unit)
         pages.text(cols[4], p.relative)
         for part in note_lines or [""]:
@@ -265,30 +302,43 @@ def _parameters(pages: _Pages, c: ReportContent) -> None:
 
 
 def _flow(pages: _Pages, c: ReportContent) -> None:
+    """The customer's pages (parameters, model, validity, plots, calibration), then the appendix on a page
+    of its own (fit statistics, correlations, the model's internal quantities, residuals, raw settings)."""
     for part in textwrap.wrap(c.title, int((A4[0] - 2 * MARGIN) * 72 / (TITLE_PT * 0.62))):
         pages.line(part, TITLE_PT, gap=1.6, weight="bold")
     if c.qa is not None:
         pages.banner(c.qa)
     pages.pairs(c.header, 1.5)
-    _validity(pages, c)
     if c.qa is not None:
         _qa_table(pages, c.qa)
-    _parameters(pages, c)
-    pages.section("Model and fit quality", c.model)
+    _parameters(pages, c.parameters)
+    pages.section("Model", c.model)
     for note in c.notes:
-        pages.wrapped(note, style="italic", color="#555555")
+        pages.wrapped(note, color="#555555")
+    _validity(pages, c)
 
     plots = ["impedance"] + (["hx"] if c.has_displacement else []) + (["spl"] if c.has_spl else [])
     if not c.result.curves:        # nothing was fitted (a broken measurement): the notes say why
         plots = []
-    heights = {**PLOT_HEIGHTS, "residuals": PLOT_HEIGHTS["residuals"] * len(c.result.curves)}
-    for i, what in enumerate(plots + (["residuals"] if plots else [])):
+    for i, what in enumerate(plots):
         if i == 0:      # the heading goes with the first plot, never alone at the foot of a page
-            pages.heading("Plots", keep=0.5 + PLOT_SHRINK * heights[what] * pages.plot_scale)
-        pages.plot(what, heights[what])
-
-    pages.section("Measurement settings", c.settings)
+            pages.heading("Plots", keep=0.5 + PLOT_SHRINK * PLOT_HEIGHTS[what] * pages.plot_scale)
+        pages.plot(what, PLOT_HEIGHTS[what])
     pages.section("Calibration", c.calibration)
+
+    pages.close()               # the appendix starts a page of its own
+    pages.line("Appendix: engineering detail", HEAD_PT + 2, gap=1.6, weight="bold")
+    if c.fit:
+        pages.section("Fit", c.fit)
+    if c.internal:
+        _parameters(pages, c.internal, "Model's internal quantities")
+    pages.section("Measurement settings", c.settings)
+    if c.calibration_detail:           # nothing recorded: the first page says so already
+        pages.section("Calibration as recorded", c.calibration_detail)
+    if plots:          # last: a plot may shrink to stay on the page, where text would run over onto a new one
+        residuals = PLOT_HEIGHTS["residuals"] * len(c.result.curves)
+        pages.heading("Residuals", keep=0.5 + PLOT_SHRINK * residuals * pages.plot_scale)
+        pages.plot("residuals", residuals)
     pages.close()
 
 

@@ -17,8 +17,20 @@ SPEC = "#2e7d32"             # specification limits (the product)
 LEFT_AXIS_WIDTH = 64
 
 
+class UnitAxis(OpaqueGridAxis):
+    """Unit numbers: whole units only (pyqtgraph put ticks at 0.5, 1.5, ... on a chart of 4 units)."""
+
+    def tickValues(self, minVal, maxVal, size):
+        levels = [(spacing, [v for v in values if float(v).is_integer()])
+                  for spacing, values in super().tickValues(minVal, maxVal, size) if spacing >= 1]
+        levels = [(spacing, values) for spacing, values in levels if values]
+        if not levels:
+            levels = [(1.0, [float(v) for v in range(int(np.ceil(minVal)), int(np.floor(maxVal)) + 1)])]
+        return levels
+
+
 def _axes():
-    return {"left": OpaqueGridAxis("left"), "bottom": OpaqueGridAxis("bottom")}
+    return {"left": OpaqueGridAxis("left"), "bottom": UnitAxis("bottom")}
 
 
 RIGHT_MARGIN = 0.14          # room right of the last unit for the lines' labels, clear of the points
@@ -118,7 +130,9 @@ class HistogramView(pg.PlotWidget):
     """The distribution of one parameter with its specification limits."""
 
     def __init__(self, parent=None):
-        super().__init__(parent, axisItems=_axes(), background="w")
+        # Counts of units up the side: whole numbers; the parameter's values along the bottom.
+        super().__init__(parent, axisItems={"left": UnitAxis("left"), "bottom": OpaqueGridAxis("bottom")},
+                         background="w")
         show_grid(self.getPlotItem())
         self.getPlotItem().getAxis("left").setWidth(LEFT_AXIS_WIDTH)
         self.setLabel("left", "units")

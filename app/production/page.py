@@ -12,6 +12,7 @@ CSV, JSON or Q-DAS AQDEF.
 from __future__ import annotations
 
 import html
+import shlex
 from pathlib import Path
 
 from PySide6.QtCore import Qt, QTimer, Signal
@@ -20,6 +21,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QFileDialog, QHBoxL
                                QTabWidget, QVBoxLayout, QWidget)
 
 from analysis.archive.backends import shown
+from analysis.production.capability_interval import MIN_UNITS, centred_interval, spread_interval, too_few
 from app import style
 from app.archive.filter import NO_DATE, date_edit
 from app.archive.page import archive_source
@@ -46,8 +48,27 @@ def _item(text: str, tooltip: str = "", colour: str | None = None) -> QTableWidg
     if tooltip:
         item.setToolTip(tooltip)
     if colour:
-        item.setForeground(Qt.GlobalColor.darkRed if colour == "red" else Qt.GlobalColor.darkGreen)
+        item.setForeground({"red": Qt.GlobalColor.darkRed, "grey": Qt.GlobalColor.gray}.get(
+            colour, Qt.GlobalColor.darkGreen))
     return item
+
+
+def _index_item(value: float | None, interval: tuple[float, float] | None, n: int) -> QTableWidgetItem:
+    """A capability index as an estimate: its value, its 95 % interval below it in the tooltip and after
+    it in the cell; green only when the whole interval clears LOW_CPK, red when the value is below it,
+    grey (no verdict) below MIN_UNITS units."""
+    if value is None:
+        return _item("–")
+    text = f"{value:.2f}"
+    if interval is not None:
+        text += f" ({interval[0]:.2f}–{interval[1]:.2f})"
+    why = too_few(n)
+    tip = (f"95 % confidence interval {interval[0]:.2f} to {interval[1]:.2f} from {n} units"
+           if interval is not None else "")
+    if why:
+        return _item(text, f"{why}. {tip}".strip(), "grey")
+    colour = "red" if value < LOW_CPK else ("green" if interval is not None and interval[0] >= LOW_CPK else None)
+    return _item(text, tip, colour)
 
 
 def _table(columns) -> QTableWidget:
@@ -197,7 +218,7 @@ class ProductionPage(QWidget):
         self._say("; ".join(data.notes), "note") if data.notes else self.message.hide()
         self._offer(self.station_combo, data.population.stations)
         self._offer(self.driver_combo, data.population.drivers)
-        self.summary.setText(self._summary_text(data.stats))
+        self.summary.setText(self._summary_text(data.stats, self._loaded_limits_file()))
         self._fill_stats(data.stats)
         self.export_button.setEnabled(len(data.population) > 0)
         self.computed.emit(data)
@@ -208,13 +229,26 @@ class ProductionPage(QWidget):
         for name in sorted(set(names) - known):
             combo.addItem(name, name)
 
+    def _loaded_limits_file(self) -> str:
+        """The limits file the QA page has loaded (it remembers it), for the command that stores it."""
+        from app.qa_view import LIMITS_KEY
+        q = getattr(self.settings, "qsettings", None)
+        return str(q.value(LIMITS_KEY, "") or "") if q is not None else ""
+
     @staticmethod
-    def _summary_text(stats) -> str:
+    def _summary_text(stats, loaded_limits: str = "") -> str:
         parts = [f"{stats.n_measurements} measurement(s): {stats.selection}"]
         if stats.excluded:
             parts.append("left out: " + ", ".join(f"{n} {why}" for why, n in stats.excluded.items()))
+        # The statistics use the archive's stored limits, not a file loaded on the QA page: say how to store it.
+        store = f"linpar qa limits --store {shlex.quote(loaded_limits or 'FILE')}"
         parts.append(f"limits version {stats.limits.version} ({stats.limits.name})" if stats.limits is not None
-                     else "no limits stored: Cp, Cpk, Pp, Ppk and yield need limits")
+                     else f"no limits stored: Cp, Cpk, Pp, Ppk and yield need the archive's limits; an engineer "
+                          f"stores them with: {store}")
+        few = [p.capability.n for p in stats.parameters.values() if p.capability.n < MIN_UNITS]
+        if stats.limits is not None and few:
+            parts.append(f"capability indices greyed: {max(few)} unit(s) or fewer, at least {MIN_UNITS} needed; "
+                         "the brackets are 95 % confidence intervals")
         if stats.first_pass_yield is not None:
             parts.append(f"first-pass yield {100 * stats.first_pass_yield:.1f} % as the stations judged")
         return "; ".join(parts) + "."
@@ -234,9 +268,9 @@ class ProductionPage(QWidget):
                                                            f"min {_number(c.minimum, s)}, max {_number(c.maximum, s)}"),
                      _item(_number(c.sigma_overall, s), f"within (moving range): {_number(c.sigma_within, s)}"),
                      _item(p.limit_text or "–")]
-            for value in (c.cp, c.cpk, c.pp, c.ppk):
-                cells.append(_item("–" if value is None else f"{value:.2f}",
-                                   colour=None if value is None else ("red" if value < LOW_CPK else "green")))
+            for value, interval in ((c.cp, spread_interval), (c.cpk, centred_interval), (c.pp, spread_interval),
+                                    (c.ppk, centred_interval)):
+                cells.append(_index_item(value, interval(value, c.n), c.n))
             cells.append(_item("–" if c.yield_fraction is None else f"{100 * c.yield_fraction:.1f} %"))
             cells.append(_item(str(alarms), colour="red" if alarms else None))
             for col, item in enumerate(cells):

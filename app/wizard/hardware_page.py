@@ -38,7 +38,8 @@ def remembered_device(saved) -> tuple[AudioDeviceChoice | None, str]:
 class HardwarePage(WizardPage):
     title = "Hardware"
     subtitle = ("The sound card that drives the amplifier and reads voltage and current, and the laser. The "
-                "virtual rig stands in for all of it when nothing else is there.")
+                "in-process simulator stands in for all of it when nothing else is there: choose it to try "
+                "linpar without hardware.")
 
     def __init__(self, state, session, parent=None, rig_name: str = DEFAULT_NAME, rig_runtime_dir: str | None = None):
         super().__init__(state, session, parent)
@@ -48,10 +49,10 @@ class HardwarePage(WizardPage):
         self.device_message = ""
         self._saved_device: AudioDeviceChoice | None = None
 
-        self.simulator_radio = QRadioButton("In-process simulator (the paper's driver)")
+        self.simulator_radio = QRadioButton("In-process simulator: no hardware needed (the paper's driver and a laser)")
         self.realtime_check = QCheckBox("in real time (off: as fast as the computer goes)")
         self.realtime_check.setChecked(True)
-        self.rig_radio = QRadioButton(f"JACK virtual rig '{rig_name}'")
+        self.rig_radio = QRadioButton(f"JACK virtual rig '{rig_name}': optional, tries the sound-card path through JACK")
         self.rig_status = rich_label()
         self.rig_refresh = QPushButton("Look again")
         self.soundcard_radio = QRadioButton("Sound card")
@@ -300,7 +301,8 @@ class HardwarePage(WizardPage):
             self.rig_refresh.setEnabled(False)
             self.rig_status.setText("Not on this system: " + why_not + ".")
         elif self.rig is None:
-            self.rig_status.setText(coloured("not running: start it with 'linpar rig start'", ERROR_COLOUR))
+            # Not an error: nobody needs the JACK rig to measure. Said plainly, in the page's own colour.
+            self.rig_status.setText("not started (to use it: 'linpar rig start' in a terminal, then Look again)")
         else:
             s = self.rig.state
             self.rig_status.setText(coloured(f"running (pid {s.pid}), JACK server '{s.jack_server}', "

@@ -32,7 +32,7 @@ def test_the_archive_keeps_the_parts_and_the_fit_errors(with_parts):
 def test_the_report_names_the_parts_and_each_curves_fit_error(with_parts):
     content = build_report(StoredResult.from_json(results_document(with_parts)), {})
     (mms,) = [row for row in content.parameters if row.name == "Mms"]
-    assert mms.note == "± 0.12 g noise, ± 0.9 g model"
+    assert mms.note == "± 0.12 g noise, ± 0.90 g model"        # two significant digits, written out
     rows = dict(content.model)
     assert rows["Fit error (impedance)"].endswith("% (rms misfit in its fitted band)")
     assert "Fit error (displacement)" in rows

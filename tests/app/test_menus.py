@@ -67,9 +67,12 @@ def test_exports_wait_for_a_result_then_write_report_and_data(qtbot, window, rec
     assert window.pages.currentWidget() is window.qa and window.qa.limits is not None
     report = tmp_path / "report.html"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(report), "HTML (*.html)"))
+    window.pages.setCurrentWidget(window.results)           # exported from the Results page, which stays shown
     with qtbot.waitSignal(window.qa.report_written, timeout=60_000):
         window.menus.export_report_action.trigger()
+    assert window.pages.currentWidget() is window.results
     assert "QA: FAIL" in report.read_text(encoding="utf-8")           # the paper's Bl is below LIMITS' 5.5
+    assert str(report) in window.status_label.text()
     data = tmp_path / "parameters.csv"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(data), "Parameters, CSV (*.csv)"))
     window.menus.export_data_action.trigger()

@@ -184,3 +184,32 @@ def test_values_show_at_most_four_digits_unless_all_digits_is_on(shown):
     full = _cell(table, "RE", VALUE)
     assert digits(full) > digits(short) and float(full) == pytest.approx(float(short), rel=1e-3)
     assert "±" in _cell(table, "RE", VALUE, Qt.ToolTipRole)       # every value explains itself
+
+
+def test_residuals_beyond_the_strip_are_pinned_at_its_edge_and_counted(shown):
+    """A misfit of thousands of sigma at the lowest lines (hidden physics) must not vanish off the strip."""
+    import dataclasses
+
+    from app.plots import EDGE, RESIDUAL_MAX_RANGE, beyond_range
+    plot = shown.impedance_plot
+    from app.result_curves import result_curves
+    curves = result_curves(shown.result).impedance
+    residual = np.array(curves.residual, dtype=complex)
+    low = np.arange(5)                                    # the lowest lines, as hidden physics below 20 Hz
+    residual[low] = 28_000.0 - 500j                       # far above: pinned at the top edge
+    residual[-1] = -5e3j                                  # one far below: the imaginary part
+    plot.set_curves(dataclasses.replace(curves, residual=residual), "Impedance")
+    up_f, up_y = plot.residual_beyond_up.xData, plot.residual_beyond_up.yData        # as given, not log10
+    down_f, down_y = plot.residual_beyond_down.xData, plot.residual_beyond_down.yData
+    assert sorted(up_f) == sorted(curves.freqs[low]) and list(down_f) == [curves.freqs[-1]]
+    low_edge, high_edge = plot.residual.viewRange()[1]
+    assert high_edge == pytest.approx(RESIDUAL_MAX_RANGE) and np.allclose(up_y, EDGE * high_edge)
+    assert np.allclose(down_y, EDGE * low_edge)              # inside the strip, where the eye finds them
+    words = f"{low.size + 1} points beyond ±30σ"
+    assert plot.beyond_text.startswith(words) and "2.8e+04σ" in plot.beyond_text
+    assert words in plot.residual.titleLabel.text
+    # Back to a good fit: no marker, no count.
+    plot.set_curves(curves, "Impedance")
+    assert plot.residual_beyond_up.getData()[0] is None or len(plot.residual_beyond_up.getData()[0]) == 0
+    assert plot.beyond_text == ""
+    assert beyond_range(curves.freqs, curves.residual, 1e9)[2] == ""

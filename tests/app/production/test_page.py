@@ -87,3 +87,52 @@ def test_the_archive_page_lists_a_server_named_by_the_environment(qtbot, window,
     assert not archive.root_button.isEnabled() and archive.rebuild_button.text() == "Send queue"
     page, data = show(qtbot, window)
     assert len(data.population) == 4 and data.location == pg_database.url("audrey")
+
+
+def _index_cells(page, name: str):
+    names = [page.stats_table.item(r, 0).text() for r in range(page.stats_table.rowCount())]
+    row = names.index(name)
+    return [page.stats_table.item(row, col) for col in range(5, 9)]         # Cp, Cpk, Pp, Ppk
+
+
+def test_four_units_grey_the_capability_indices_and_say_why(qtbot, window, measured, archive_root):
+    """The issue's case: Cpk 27.6 from 4 units was shown in green. Now greyed, with its interval and the reason."""
+    from PySide6.QtCore import Qt
+    open_archive(str(archive_root)).store_limits(LIMITS)
+    fill(str(archive_root), measured, n=4, drift_at=99)
+    page, data = show(qtbot, window)
+    assert "capability indices greyed" in page.summary.text() and "at least 25" in page.summary.text()
+    for item in _index_cells(page, "fs"):
+        if item.text() != "–":
+            assert item.foreground().color() == Qt.GlobalColor.gray
+            assert "only 4 units" in item.toolTip() and "(" in item.text()      # the interval in the cell
+
+
+def test_forty_units_show_intervals_and_a_verdict(qtbot, window, measured, archive_root):
+    from PySide6.QtCore import Qt
+    from analysis.production.capability_interval import centred_interval
+    open_archive(str(archive_root)).store_limits(LIMITS)
+    fill(str(archive_root), measured, n=40, drift_at=99)
+    page, data = show(qtbot, window)
+    assert "greyed" not in page.summary.text()
+    c = data.stats.parameters["fs"].capability
+    lo, hi = centred_interval(c.cpk, c.n)
+    cpk = _index_cells(page, "fs")[1]
+    assert cpk.text() == f"{c.cpk:.2f} ({lo:.2f}–{hi:.2f})"
+    colour = cpk.foreground().color()
+    assert colour != Qt.GlobalColor.gray
+    assert (colour == Qt.GlobalColor.darkGreen) == (lo >= 1.33)       # green only when the interval clears 1.33
+
+
+def test_without_stored_limits_the_page_says_the_command(qtbot, window, measured, archive_root):
+    fill(str(archive_root), measured, n=4, drift_at=99)
+    page, _ = show(qtbot, window)
+    assert "linpar qa limits --store FILE" in page.summary.text()
+
+
+def test_the_unit_axis_has_whole_units_only(qtbot):
+    from app.production.charts import UnitAxis
+    axis = UnitAxis("bottom")
+    for low, high in ((0.3, 4.6), (0.5, 40.5), (-2.0, 2000.0)):
+        values = [v for _, level in axis.tickValues(low, high, 600) for v in level]
+        assert values and all(float(v).is_integer() for v in values), (low, high, values)
