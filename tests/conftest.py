@@ -140,6 +140,25 @@ def pytest_runtest_teardown(item):
 
 # --- make test runs the tests in worker processes (pytest-xdist, --dist loadfile; tests/scheduling.py) ----------
 
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A test's record_property values as plain Python: xdist sends each report to the controller and cannot
+    serialise a numpy scalar (a worker dies with 'can't serialize numpy.float64' and its test is lost)."""
+    outcome = yield
+    report = outcome.get_result()
+    report.user_properties = [(name, _plain(value)) for name, value in report.user_properties]
+
+
+def _plain(value):
+    if hasattr(value, "item") and getattr(value, "ndim", None) == 0:      # a numpy scalar
+        return value.item()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    return value if value is None or isinstance(value, (bool, int, float, str)) else str(value)
+
+
 def pytest_collection_modifyitems(items):
     from tests.scheduling import rig_file_check
     rig_file_check(items)

@@ -25,12 +25,14 @@ import math
 
 import numpy as np
 
+from analysis.errors import LinparError
+
 #: A full-speed FTDI packet carries 62 bytes of data; a distance-only ILD1420 measurement is 3 bytes.
 PACKET_SAMPLES = 20
 MAX_LATENCY_S = 1.0         # beyond a second a link is broken, not late
 
 
-class UsbLinkError(ValueError):
+class UsbLinkError(LinparError, ValueError):
     """A link latency or jitter that no link has (negative, not finite, above MAX_LATENCY_S)."""
 
 

@@ -95,9 +95,9 @@ def test_a_silent_voltage_is_reported_exported_and_archived_as_judged(capsys, re
     code, out, _ = run(capsys, "report", recordings["silent-voltage"], "--html", tmp_path / "r.html",
                        "--limits", limits)
     html = (tmp_path / "r.html").read_text(encoding="utf-8")
-    assert code == 0 and "QA: FAIL — measurement invalid: voltage" in out and "[no-signal]" in out
+    assert code == 0 and "QA: INVALID: measure again — measurement invalid: voltage" in out and "[no-signal]" in out
     assert "the unit itself was not judged" in out
-    assert "QA: FAIL</span> measurement invalid" in html and "<b>no-signal</b>" in html
+    assert "QA: INVALID: measure again</span> measurement invalid" in html and "<b>no-signal</b>" in html
     assert "check that the amplifier is on" in html
     assert "Nothing was fitted" in html
     code, out, _ = run(capsys, "export", recordings["silent-voltage"], "--csv", tmp_path / "p.csv",
@@ -157,7 +157,7 @@ def test_current_equal_to_voltage_is_never_green_and_never_passes(capsys, record
     current = doc["validity"]["channels"]["current"]["findings"][0]
     assert current["code"] == "channel-copy" and "wiring" in current["remedy"]
     code, out, _ = run(capsys, "analyze", recordings["current-is-voltage"], "--limits", limits)
-    assert code == 2 and "QA: FAIL — measurement invalid: current" in out and "QA: PASS" not in out
+    assert code == 2 and "QA: INVALID: measure again — measurement invalid: current" in out and "QA: PASS" not in out
 
 
 def test_a_sample_rate_of_4_29_ghz_is_refused(capsys, recordings, tmp_path):
