@@ -162,7 +162,7 @@ def _resonance_lines(z_abs: np.ndarray, freqs: np.ndarray, re_ohm: float) -> np.
     return keep
 
 
-def sign_findings(spectra, re_ohm: float | None) -> list[Finding]:
+def sign_findings(spectra, re_ohm: float | None, laser_delay_s: float | None = None) -> list[Finding]:
     """The laser's sign from Z and Hx alone, whatever the model: U = Ze*I + Bl*s*X gives, line by line,
 
         Bl = (Z - Ze) / (s * Hx * Z)
@@ -170,7 +170,8 @@ def sign_findings(spectra, re_ohm: float | None) -> list[Finding]:
     (docs/physics.md section 1: Hx = Bl / (s*Zm*Z), Z - Ze = Bl^2 / Zm), real and positive for a cone that moves outward
     with a positive current. Taken where the motion dominates Z (|Z| > 2 RE, around fs, Ze ~ RE there);
     pointing the other way on most of those lines: the displacement's sign is inverted. An inverted sign
-    drags a fit's fs and Bl anywhere, so the fit's values are not used, only its RE."""
+    drags a fit's fs and Bl anywhere, so the fit's values are not used, only its RE and the laser's delay
+    (a laser 15 ms late turns Hx by 2 pi f 15 ms, a whole turn and more around fs: that is no inverted sign)."""
     hx = spectra.displacement
     if hx is None or not hx.has_phase or re_ohm is None or not re_ohm > 0:
         return []
@@ -178,6 +179,8 @@ def sign_findings(spectra, re_ohm: float | None) -> list[Finding]:
     common, z_at, x_at = np.intersect1d(z.bins, hx.bins, return_indices=True)
     zv, xv = z.value[z_at], hx.value[x_at]
     s = 2j * np.pi * z.freqs[z_at]
+    if laser_delay_s is not None and np.isfinite(laser_delay_s):
+        xv = xv * np.exp(s * laser_delay_s)         # the displacement as it was, before the link delayed it
     motional = _resonance_lines(np.abs(zv), z.freqs[z_at], re_ohm) & np.isfinite(xv) & (np.abs(xv) > 0)
     if np.count_nonzero(motional) < SIGN_MIN_LINES:
         return []
@@ -199,7 +202,7 @@ def plausibility_findings(recording, spectra, parameters: Mapping, sd_m2: float 
     found: dict[str, list[Finding]] = {}
     for finding in (*rate_findings(spectra.sample_rate, recording.extra),
                     *re_findings(parameters, recording.driver),
-                    *sign_findings(spectra, _value(parameters, "RE")),
+                    *sign_findings(spectra, _value(parameters, "RE"), _value(parameters, "tau_x")),
                     *mechanical_findings(parameters, sd_m2, peak_m)):
         found.setdefault(finding.channel, []).append(finding)
     return found
