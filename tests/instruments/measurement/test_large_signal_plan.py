@@ -22,7 +22,8 @@ from instruments.rig.engine import RIG_CALIBRATION
 from instruments.rig.in_process import InProcessRig
 from tests.large_signal_truth import KNOWN_LEVEL_V, KNOWN_OFFSET_M, KNOWN_X_BL_M, known_driver, relative_errors
 
-pytestmark = pytest.mark.timeout(240)
+# Real time, like the rig's tests: in their unit of the suite (tests/scheduling.py).
+pytestmark = [pytest.mark.timeout(240), pytest.mark.rig]
 # +-4 mm needs ~10.5 V RMS of multitone, 22 V peak, and ~5 A peak: the rig's chain (10 V out, 20 V and 2 A in at
 # full scale) would clip. This one has a 30 V amplifier, 40 V and 10 A inputs.
 LARGE_SIGNAL_CHAIN = dataclasses.replace(RIG_CALIBRATION, volts_per_fs_out=30.0, volts_per_fs_voltage_sense=40.0,

@@ -93,7 +93,11 @@ def test_the_full_path_recovers_the_paper_driver_with_the_files_written_before_t
     assert result.parameters["lambda"].value == pytest.approx(TRUTH["lambda"], abs=0.01)
     assert result.validity["overall"] == "green", result.validity
     assert outcome.alignment["clock_ppm"] == pytest.approx(37.0, abs=1.0)
-    assert len(frames) >= 8 and frames[-1].channels["displacement"].status != "unknown"
+    # The live view averages the periods in order and leaves out one it could not reach in time: how many
+    # frames came depends on the host's scheduling, their order and the last one's displacement do not.
+    counts = [f.n_periods for f in frames]
+    assert counts and counts == list(range(1, len(counts) + 1))
+    assert frames[-1].channels["displacement"].status != "unknown"
     sidecar = json.loads(outcome.sidecar_path.read_text())
     assert sidecar["measurement"]["displacement_source"] == "serial laser"
     assert sidecar["capture"]["laser_samples"] > 8 * 16384 / 12

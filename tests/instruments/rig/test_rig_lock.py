@@ -13,6 +13,9 @@ import pytest
 
 from instruments.rig.state import RigPaths, pid_alive, read_pid
 
+# Starts real JACK rigs: in the rig's unit of the suite, never beside another real-time rig (tests/scheduling.py).
+pytestmark = pytest.mark.rig
+
 REPO = Path(__file__).resolve().parents[3]
 
 
