@@ -99,7 +99,10 @@ class Limit:
         inside = (self.low is None or lo >= self.low) and (self.high is None or hi <= self.high)
         outside = (self.low is not None and hi < self.low) or (self.high is not None and lo > self.high)
         outcome = PASS if inside else FAIL if outside else UNCERTAIN
-        note = "" if known else "no uncertainty estimated: judged on the value alone"
+        if not known and outcome == PASS:
+            # A value without an uncertainty is no interval inside the limits: a pass the data do not support.
+            outcome = UNCERTAIN
+        note = "" if known else "no uncertainty estimated: a value inside the limits is not enough to pass"
         return Verdict(self, p.value, outcome == PASS, note, outcome, (lo, hi))
 
 

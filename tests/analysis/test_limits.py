@@ -134,8 +134,10 @@ def test_a_parameter_is_judged_by_its_interval_pass_fail_or_uncertain_across_a_l
     failed = judged_re(tmp_path, 3.30, 0.04)                               # 3.22 .. 3.38 wholly above
     assert failed["verdict"] == "fail" and "RE 0.15 Ω above max" in failed["why"]
     assert judged_re(tmp_path, 2.80, 0.01)["verdict"] == "fail"
-    alone = judged_re(tmp_path, 3.14, None)                                # no std: the value alone
-    assert alone["verdict"] == "pass" and "no uncertainty" in alone["parameters"][0]["note"]
+    alone = judged_re(tmp_path, 3.14, None)          # no std: no interval, so inside is not a pass
+    assert alone["verdict"] == "uncertain" and "no uncertainty" in alone["parameters"][0]["note"]
+    outside_alone = judged_re(tmp_path, 9.0, None)   # ... but a value outside the limits fails on its own
+    assert outside_alone["verdict"] == "fail"
 
 
 def test_one_failing_parameter_fails_the_unit_whatever_the_others_uncertainty(tmp_path):
