@@ -103,8 +103,13 @@ def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
     reported = _with_derived(fit.values, sd_m2)
     if describes_the_data(fit):
         return {}
+    indistinct = members(fit, data, cancel)
+    if len(indistinct) < 2:
+        # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
+        # the model part is not estimated, which is not the same as zero.
+        return {}
     spread = {name: 0.0 for name in reported}
-    for member in members(fit, data, cancel):
+    for member in indistinct:
         theirs = _with_derived(member.values, sd_m2)
         for name, value in reported.items():
             if name in theirs and math.isfinite(theirs[name]):

@@ -69,7 +69,7 @@ def test_the_stored_result_keeps_the_report_and_the_printed_report_shows_it(anal
     doc = results_document(result, rec)
     stored = StoredResult.from_json(doc)
     assert fit_report_text(stored.model_info["report"]) == result.fit.report()        # the same words later
-    model = dict(build_report(stored, {}, None, None).model)
+    appendix = dict(build_report(stored, {}, None, None).fit)        # the engineering detail: the appendix
     strongest = fit_report_json(result.fit)["correlations"][0]
-    assert f"{strongest['a']}–{strongest['b']} {strongest['r']:+.2f}" in model["Correlations (|r| ≥ 0.5)"]
+    assert f"{strongest['a']}–{strongest['b']} {strongest['r']:+.2f}" in appendix["Correlations (|r| ≥ 0.5)"]
     assert np.isfinite(doc["model"]["report"]["statistics"]["bic"])
