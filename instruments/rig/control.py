@@ -9,7 +9,9 @@ A Unix socket in the rig's private runtime directory: only the user reaches it.
 """
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 import socket
 import threading
 from pathlib import Path
@@ -24,13 +26,33 @@ class ControlError(LinparError, RuntimeError):
     pass
 
 
+# A Unix socket's path holds at most 107 bytes (sun_path); a runtime directory deep in a temporary folder
+# (a test worker's, a user's long home) passes that. Such a path is reached through the directory's open
+# descriptor, /proc/self/fd/N/control.sock, which Linux resolves like the path itself (the rig is Linux only).
+_SUN_PATH_MAX = 100
+
+
+@contextlib.contextmanager
+def _reachable(path: Path):
+    """The path to bind or connect to: the path itself, or the same file through its directory's descriptor."""
+    if len(os.fsencode(str(path))) <= _SUN_PATH_MAX:
+        yield str(path)
+        return
+    directory = os.open(path.parent, os.O_RDONLY)
+    try:
+        yield f"/proc/self/fd/{directory}/{path.name}"
+    finally:
+        os.close(directory)
+
+
 class ControlServer:
     def __init__(self, path: Path, handler: Handler):
         self.path = Path(path)
         self._handler = handler
         self.path.unlink(missing_ok=True)
         self._sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-        self._sock.bind(str(self.path))
+        with _reachable(self.path) as where:
+            self._sock.bind(where)
         self._sock.listen(8)
         self._sock.settimeout(0.2)
         self._stop = threading.Event()
@@ -73,7 +95,8 @@ def send_command(path: Path, request: dict[str, Any], timeout: float = 5.0) -> d
     with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as sock:
         sock.settimeout(timeout)
         try:
-            sock.connect(str(path))
+            with _reachable(Path(path)) as where:
+                sock.connect(where)
             sock.sendall((json.dumps(request) + "\n").encode())
             reply = json.loads(_read_line(sock))
         except (OSError, ValueError) as exc:

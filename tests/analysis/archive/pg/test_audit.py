@@ -134,6 +134,9 @@ def test_setup_migrates_an_existing_line_to_the_audited_schema(pg_server, measur
         conn.execute(f'DROP DATABASE "{name}" WITH (FORCE)')
 
 
+@pytest.mark.skip(reason="not yet a proof: on an idle machine the next store meets the cut session's lock in only "
+                         "3 of 5 runs (in the others it is stored at once and nothing is queued), and with the "
+                         "station's lock_timeout removed it did not hang either; issue 31's link-cut item stays open")
 def test_a_link_cut_at_the_station_mid_upload_never_hangs_the_next_store(pg_database, measured, monkeypatch):
     """The server keeps the cut session's transaction (and its row's lock) until its own timeouts end it: the
     next store waits on that lock at most the station's lock_timeout, says the measurement waits in the queue,
@@ -143,8 +146,10 @@ def test_a_link_cut_at_the_station_mid_upload_never_hangs_the_next_store(pg_data
     from tests.pace import paced
     from tests.tcp_proxy import TcpProxy
     import time
+    # The orphan must outlive the next store on a loaded machine (4 s did not, once: the next store then met
+    # no lock and the test saw nothing to queue), and the server's timeout must still end it within the test.
     monkeypatch.setattr(audit, "STATION_OPTIONS", "-c lock_timeout=2s -c statement_timeout=60s "
-                                                  "-c idle_in_transaction_session_timeout=4s")
+                                                  "-c idle_in_transaction_session_timeout=20s")
     path, doc = measured
     proxy = TcpProxy(pg_database.server.port)
     real, calls = upload_module.send_file, []
@@ -171,7 +176,7 @@ def test_a_link_cut_at_the_station_mid_upload_never_hangs_the_next_store(pg_data
         took = time.monotonic() - started
         assert took < paced(10.0), took
         assert station.pending >= 1 and any("queue" in n for n in station.notes), station.notes
-        deadline = time.monotonic() + paced(30.0)
+        deadline = time.monotonic() + paced(60.0)
         while time.monotonic() < deadline:        # the server's idle-in-transaction timeout ends the orphan
             with pg_database.admin() as conn:
                 if not conn.execute("SELECT count(*) FROM pg_stat_activity WHERE usename = 'station_a' AND "
