@@ -7,7 +7,7 @@ words that explain a verdict (words). The public names of analysis.diagnosis.can
 """
 from __future__ import annotations
 
-import importlib
+from analysis.lazy_exports import lazy_exports
 
 # Where each public name lives; a name is imported on first use only, so that
 # importing one submodule of the package does not load the rest.
@@ -25,15 +25,4 @@ _HOME = {
 
 __all__ = sorted(_HOME)
 
-
-def __getattr__(name: str):
-    home = _HOME.get(name)
-    if home is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{home}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_HOME))
+__getattr__, __dir__ = lazy_exports(__name__, _HOME)
