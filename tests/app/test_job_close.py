@@ -53,11 +53,12 @@ def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, 
 
 def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(qtbot, monkeypatch, tmp_path):
     """The identification cannot stop midway: Cancel frees the page now, the result that comes later is dropped."""
-    release = threading.Event()
+    entered, release = threading.Event(), threading.Event()
     late = object()
 
     def slow(stems):
-        release.wait(10)
+        entered.set()
+        release.wait(60)
         return late
     monkeypatch.setattr(app.large_signal.page, "large_signal", slow)
     page = app.large_signal.page.LargeSignalPage()
@@ -65,7 +66,9 @@ def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(
     finished = []
     monkeypatch.setattr(page, "on_finished", finished.append)
     page.analyse([tmp_path / "x.wav"])
-    qtbot.waitUntil(lambda: not page.choose_button.isEnabled())
+    # Cancel once the job runs: a job cancelled while it still waits for its thread says so at once (not late).
+    assert entered.wait(60), "the identification started"
+    assert not page.choose_button.isEnabled()
     page.jobs.cancel_button.click()
     assert page.choose_button.isEnabled() and not page.jobs.busy
     assert "Cancelled" in page.status.text()
