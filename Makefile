@@ -22,10 +22,11 @@ run: setup
 	@bash tools/run-gui.sh
 
 # Two worker processes (pytest-xdist): a test file stays in one worker, the JACK rig's tests all in one
-# (tests/scheduling.py). TEST_WORKERS=0 runs the tests in this process, one after another.
+# (tests/scheduling.py). TEST_WORKERS=0 runs the tests in this process, one after another. The 40 slowest
+# tests are listed at the end: where the suite's time goes, run after run.
 TEST_WORKERS ?= 2
 test: setup
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile tests
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=40 tests
 
 bench: setup
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench
