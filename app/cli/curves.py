@@ -82,8 +82,10 @@ def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
     from analysis.fit.model_uncertainty import model_uncertainty
     z, hx, notes = load_curves(args)
-    fitted = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes,
-                        method=getattr(args, "method", "joint"))
+    # No --model, no --method: fit_curves chooses (magnitude-only curves have their own defaults).
+    effects = None if args.model is None else model_effects(args.model)
+    fitted = fit_curves(z, hx, effects, args.sd, fit_range(args, args.hx_fmax), notes,
+                        method=getattr(args, "method", None))
     result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)
     if args.json:
         print_json(curve_json(result))
