@@ -55,6 +55,9 @@ from analysis.spectra import TransferFunction
 
 HX_MAX_OVER_FS = 4.0
 Z_MAX_OVER_FS = 5.0
+# The other Z bands whose fits the model part of magnitude-only curves spans (analysis.fit.model_uncertainty):
+# every one describes its lines about as well, and the data cannot say which band's blocked impedance is right.
+OTHER_Z_BANDS_OVER_FS = (3.0, 10.0)
 # The defaults for magnitude-only curves with Hx (module doc).
 MAGNITUDE_ONLY_METHOD = "alternating"
 MAGNITUDE_ONLY_EFFECTS = "lr2,creep-log-causal-fs"
@@ -127,6 +130,10 @@ class CurveAnalysis:
     validity: dict
     notes: tuple[str, ...] = ()
     data: FitData | None = None                  # what was fitted (the model part's refits fit it again)
+    # Magnitude-only curves: a model part even when the misfit is small (no phase to show what the model misses),
+    # spanning the fits over the other Z bands too.
+    model_part_always: bool = False
+    other_bands: tuple[FitData, ...] = ()
 
     @property
     def model(self) -> Model:
@@ -176,7 +183,12 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
     validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
-    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data)
+    other_bands = ()
+    if f_range.z_f_max is None and f_range.z_max_over_fs is not None:
+        other_bands = tuple(curve_data(impedance, hx, dataclasses.replace(f_range, z_max_over_fs=k))[0]
+                            for k in OTHER_Z_BANDS_OVER_FS if k != f_range.z_max_over_fs)
+    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data,
+                         magnitude_only(impedance, hx), other_bands)
 
 
 def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
