@@ -30,7 +30,7 @@ from analysis.fit.paper import _two_step_covariance, hx_step_parameters
 from analysis.fit.startvalues import linear_gain
 from analysis.model.composed import Model
 
-TOLERANCE = 1e-4
+TOLERANCE = 1e-3
 MAX_ROUNDS = 8
 
 

@@ -147,7 +147,7 @@ def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.
     out = []
     for data in bands:
         try:
-            other = fit_with(fit.method, data, fit.model, cancel=cancel)
+            other = fit_with(fit.method, data, fit.model, start=fit.values, cancel=cancel)
         except FitError:
             if cancel is not None and cancel.is_set():
                 raise
