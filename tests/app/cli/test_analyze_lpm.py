@@ -35,3 +35,5 @@ def test_the_eight_parameters_within_5_percent_and_their_std_covers_the_truth(an
         assert abs(p["value"] - truth_[key]) <= 2 * p["std"], (key, p)
         assert p["std_model"] > 0 and p["std_noise"] > 0, key       # both parts named
         assert p["std"] < 0.1 * abs(p["value"]), key                 # and not so wide that it says nothing
+    # The export's own fitted curves (LPM's "Fitted" columns) beside linpar's.
+    assert set(doc["reference_fit"]) == {"impedance", "displacement"}
