@@ -156,10 +156,11 @@ def default_choices(impedance: TransferFunction, hx: TransferFunction | None, ef
         effects = MAGNITUDE_ONLY_EFFECTS
         notes.append(f"magnitude-only curves: the model {MAGNITUDE_ONLY_EFFECTS} (the causal creep, every loss at "
                      "fs in RES)")
-    if method is None:
-        method = MAGNITUDE_ONLY_METHOD
-        notes.append("magnitude-only curves: fitted by the alternating two steps (Z for the electrical and motional "
-                     "parameters, Hx for Bl and the creep, repeated until they agree)")
+    if method is not None:          # a method by name: its fit over the whole range, as before
+        return effects, method, f_range, notes
+    method = MAGNITUDE_ONLY_METHOD
+    notes.append("magnitude-only curves: fitted by the alternating two steps (Z for the electrical and motional "
+                 "parameters, Hx for Bl and the creep, repeated until they agree)")
     if f_range.f_max is None and f_range.z_f_max is None and f_range.z_max_over_fs is None:
         f_range = dataclasses.replace(f_range, z_max_over_fs=Z_MAX_OVER_FS)
     return effects, method, f_range, notes

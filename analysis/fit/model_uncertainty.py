@@ -31,6 +31,8 @@ import math
 import threading
 from typing import Mapping
 
+import numpy as np
+
 from analysis.derived import ParameterValue, derived_from_values
 from analysis.effects import get_effect
 from analysis.fit.least_squares import FitData, FitError, FitResult
@@ -44,6 +46,7 @@ ALTERNATIVES = (("lr2", "lr3", "leach", "wright"), ("creep-log", "creep-log-caus
                 ("creep-log-causal-fs", "creep-log"))
 INDISTINCT_FACTOR = 4.0
 MISFIT_FROM = 4.0
+DC_EXCESS = 0.1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,9 +95,9 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
             drop_degenerate: bool = False) -> list[Member]:
     """The user's fit and the alternatives' fits that describe the data about as well (module doc).
 
-    drop_degenerate: leave out a fit whose RE, CMES, LCES, RES or Bl ended on a bound, or whose RE is below half
-    the reported one (on magnitude-only curves leach's K*w^n can take the place of RE, which then goes to 0: no
-    driver is like that)."""
+    drop_degenerate: leave out a fit whose RE, CMES, LCES, RES or Bl ended on a bound, or whose blocked impedance
+    is resistive at the lowest line (on magnitude-only curves leach's K*w^n, n small, can take RE's place:
+    no driver is like that)."""
     fits = [Member(fit.model.effect_ids, fit.chi2, dict(fit.values))]
     for model in alternative_models(fit.model):
         try:
@@ -103,7 +106,7 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
             if cancel is not None and cancel.is_set():
                 raise
             continue        # an alternative that does not converge is not one the data cannot reject
-        if drop_degenerate and _degenerate(other, fit):
+        if drop_degenerate and _degenerate(other, data):
             continue
         if math.isfinite(other.chi2):
             fits.append(Member(model.effect_ids, other.chi2, dict(other.values)))
@@ -135,11 +138,15 @@ def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
     return spread
 
 
-def _degenerate(other: FitResult, fit: FitResult) -> bool:
-    """A base parameter on a bound, or RE below half the reported one (the blocked impedance took its place)."""
+def _degenerate(other: FitResult, data: FitData) -> bool:
+    """A base parameter on a bound, or a blocked impedance whose resistance at the lowest line exceeds RE by more
+    than DC_EXCESS (it took RE's place: a coil's eddy currents and semi-inductance barely act at a few hertz)."""
     specs = {s.name: s for s in other.model.param_specs}
-    return (any(n in other.values and specs[n].on_bound(other.values[n]) for n in ("RE", "CMES", "LCES", "RES", "Bl"))
-            or other.values["RE"] < 0.5 * fit.values["RE"])
+    if any(n in other.values and specs[n].on_bound(other.values[n]) for n in ("RE", "CMES", "LCES", "RES", "Bl")):
+        return True
+    lowest = 2j * np.pi * np.array([data.impedance.freqs[0]])
+    excess = float(other.model.blocked_impedance(lowest, other.values).real[0]) - other.values["RE"]
+    return excess > DC_EXCESS * other.values["RE"]
 
 
 def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.Event | None) -> list[Member]:
