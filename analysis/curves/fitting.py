@@ -7,11 +7,21 @@ frequency range (FitRange):
   f_min where the measurement itself fails (a sweep starting at 5 Hz has
   nothing below it) and lower f_max where the blocked-impedance model stops
   describing the coil.
+- z_f_max bounds Z only (default: everything, but Z_MAX_OVER_FS * fs for magnitude-only curves with Hx,
+  below).
 - hx_f_max bounds Hx only (default HX_MAX_OVER_FS * fs, fs read off the
   impedance peak): above a few times fs the cone stops moving as a piston
   (breakup) and a laser on one spot no longer sees the lumped model's x,
   while Bl, which Hx is there to give, is fixed by the lines around and
   below fs.
+
+Magnitude-only curves with Hx (a Klippel LPM export: |Z| and |Hx|) are fitted by default
+(default_choices) with the alternating two steps (analysis.fit.alternating), the causal log creep with
+every loss at fs in RES (analysis.effects.creep_at_fs) beside lr2, and Z up to Z_MAX_OVER_FS * fs: there
+the blocked impedance lr2 still holds, while above it the coil's eddy currents, which no catalogue form
+follows over decades, would decide the motional parameters through the many high lines. Measured on
+LPM-like exports of four realistic drivers (docs/identification.md): every one of RE, fs, Qts, Qes, Qms,
+Bl, Mms and Cms within 3 %, where the joint fit of lr2 and creep-log over the whole export is 5-27 % off.
 
 Imported curves carry no per-line noise estimate of their own: each line's
 noise is estimated from the curve's local scatter (analysis.curves.noise, on
@@ -44,6 +54,13 @@ from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
 
 HX_MAX_OVER_FS = 4.0
+Z_MAX_OVER_FS = 5.0
+# The other Z bands whose fits the model part of magnitude-only curves spans (analysis.fit.model_uncertainty):
+# every one describes its lines about as well, and the data cannot say which band's blocked impedance is right.
+OTHER_Z_BANDS_OVER_FS = (3.0, 10.0)
+# The defaults for magnitude-only curves with Hx (module doc).
+MAGNITUDE_ONLY_METHOD = "alternating"
+MAGNITUDE_ONLY_EFFECTS = "lr2,creep-log-causal-fs"
 # Linearly spaced exports (0.5 Hz or 1 Hz steps up to kHz) put nearly every line
 # in the top decade, where the blocked-impedance model is weakest: thinned to
 # this many lines per decade, each decade counts alike, as in a log-spaced
@@ -71,6 +88,8 @@ class FitRange:
     f_max: float | None = None
     hx_f_max: float | None = None
     per_decade: int | None = LINES_PER_DECADE     # None: every line
+    z_f_max: float | None = None
+    z_max_over_fs: float | None = None              # bounds Z at this many times fs (read off the peak)
 
     def select(self, tf: TransferFunction, upper: float | None) -> TransferFunction:
         keep = log_thinned(tf.freqs, self.per_decade)
@@ -111,21 +130,52 @@ class CurveAnalysis:
     validity: dict
     notes: tuple[str, ...] = ()
     data: FitData | None = None                  # what was fitted (the model part's refits fit it again)
+    # Magnitude-only curves: a model part even when the misfit is small (no phase to show what the model misses),
+    # spanning the fits over the other Z bands too.
+    model_part_always: bool = False
+    other_bands: tuple[FitData, ...] = ()
 
     @property
     def model(self) -> Model:
         return self.fit.model
 
 
+def magnitude_only(impedance: TransferFunction, hx: TransferFunction | None) -> bool:
+    """True for |Z| and |Hx| without phase (a Klippel LPM export): the case the module doc's defaults are for."""
+    return hx is not None and not (impedance.has_phase and hx.has_phase)
+
+
+def default_choices(impedance: TransferFunction, hx: TransferFunction | None, effects, method: str | None,
+                    f_range: FitRange | None) -> tuple[object, str, FitRange, list[str]]:
+    """(effects, method, range, notes): what the user left open filled in as the module doc says."""
+    f_range = f_range or FitRange()
+    notes = []
+    if not magnitude_only(impedance, hx):
+        return effects, method or DEFAULT_METHOD, f_range, notes
+    if effects is None:
+        effects = MAGNITUDE_ONLY_EFFECTS
+        notes.append(f"magnitude-only curves: the model {MAGNITUDE_ONLY_EFFECTS} (the causal creep, every loss at "
+                     "fs in RES)")
+    if method is not None:          # a method by name: its fit over the whole range, as before
+        return effects, method, f_range, notes
+    method = MAGNITUDE_ONLY_METHOD
+    notes.append("magnitude-only curves: fitted by the alternating two steps (Z for the electrical and motional "
+                 "parameters, Hx for Bl and the creep, repeated until they agree)")
+    if f_range.f_max is None and f_range.z_f_max is None and f_range.z_max_over_fs is None:
+        f_range = dataclasses.replace(f_range, z_max_over_fs=Z_MAX_OVER_FS)
+    return effects, method, f_range, notes
+
+
 def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
                effects: Sequence[Effect] | str | None = None, sd_m2: float | None = None,
-               f_range: FitRange | None = None, notes: Sequence[str] = (), method: str = DEFAULT_METHOD
+               f_range: FitRange | None = None, notes: Sequence[str] = (), method: str | None = None
                ) -> CurveAnalysis:
     """Fit the model (effects; default lr2,creep-log) to imported Z and optional Hx curves, by `method`
-    (analysis.fit.methods: the paper's two steps suit magnitude-only exports)."""
+    (analysis.fit.methods; None: joint, but magnitude-only curves get the module doc's defaults)."""
+    effects, method, f_range, chosen = default_choices(impedance, hx, effects, method, f_range)
     if effects is None or isinstance(effects, str):
         effects = parse_effects(effects)
-    data, notes = curve_data(impedance, hx, f_range, notes)
+    data, notes = curve_data(impedance, hx, f_range, list(notes) + chosen)
     z, x = data.impedance, data.displacement
     model = Model(tuple(effects), with_displacement=x is not None)
     fit = fit_with(method, data, model)
@@ -134,7 +184,12 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     ranges = {tf.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for tf in (z, x) if tf is not None}
     validity = curve_validity(fit, ranges, [tf for tf in (z, x) if tf is not None], notes)
-    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data)
+    other_bands = ()
+    if f_range.z_f_max is None and f_range.z_max_over_fs is not None:
+        other_bands = tuple(curve_data(impedance, hx, dataclasses.replace(f_range, z_max_over_fs=k))[0]
+                            for k in OTHER_Z_BANDS_OVER_FS if k != f_range.z_max_over_fs)
+    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data,
+                         magnitude_only(impedance, hx), other_bands)
 
 
 def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
@@ -143,7 +198,13 @@ def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,
     f_range = f_range or FitRange()
     notes = list(notes)
     impedance, hx = (None if tf is None else _with_noise(tf, notes) for tf in (impedance, hx))
-    z = f_range.select(impedance, None)
+    z_max = f_range.z_f_max
+    if z_max is None and f_range.z_max_over_fs is not None:
+        fs = start_context(f_range.select(impedance, None)).fs
+        z_max = f_range.z_max_over_fs * fs
+        notes.append(f"Z fitted up to {z_max:.4g} Hz ({f_range.z_max_over_fs:g} x fs = {fs:.4g} Hz from the impedance "
+                     "peak): above it the blocked impedance's form no longer holds")
+    z = f_range.select(impedance, z_max)
     x = None
     if hx is not None:
         hx_max = f_range.hx_f_max

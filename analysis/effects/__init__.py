@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import Mapping
 
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.effects.catalogue import CATALOGUE
+from analysis.effects.catalogue import CATALOGUE, FORMS
 from analysis.errors import LinparError
 from analysis.model.defaults import DEFAULT_EFFECTS
 
@@ -36,6 +36,8 @@ def get_effect(effect_id: str, extra: Mapping[str, Effect] | None = None) -> Eff
         return extra[effect_id]
     if effect_id in CATALOGUE:
         return CATALOGUE[effect_id]
+    if effect_id in FORMS:
+        return FORMS[effect_id]
     from analysis.effects import registry
     for effect in registry.user_effects():
         if effect.id == effect_id:

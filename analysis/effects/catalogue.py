@@ -1,7 +1,7 @@
 """The built-in effects, by id: every effect the model lab can add (analysis.effects finds them by id)."""
 from __future__ import annotations
 
-from analysis.effects import breakup, channels, creep, enclosure, forcefactor, inductance, mechanical
+from analysis.effects import breakup, channels, creep, creep_at_fs, enclosure, forcefactor, inductance, mechanical
 from analysis.effects.base import Effect
 
 # Grouped by category; within a category the effects are alternatives (one per model).
@@ -33,3 +33,7 @@ _ALL: tuple[Effect, ...] = (
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}
+
+# Forms a fit uses by id that the catalogue leaves out: the same physics as one of its effects, re-expressed
+# (the Model lab and the diagnosis, which try the catalogue, would find them equal to it).
+FORMS: dict[str, Effect] = {e.id: e for e in (creep_at_fs.creep_log_causal_at_fs,)}

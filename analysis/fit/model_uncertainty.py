@@ -31,16 +31,22 @@ import math
 import threading
 from typing import Mapping
 
+import numpy as np
+
 from analysis.derived import ParameterValue, derived_from_values
 from analysis.effects import get_effect
 from analysis.fit.least_squares import FitData, FitError, FitResult
 from analysis.fit.methods import fit_with
 from analysis.model.composed import Model, ModelError
 
-# Each family: forms of one physics at one site, any of which a real driver may follow about as well.
-ALTERNATIVES = (("lr2", "lr3", "leach", "wright"), ("creep-log", "creep-log-causal"))
+# Each family: forms of one physics at one site, any of which a real driver may follow about as well. A model's
+# member is exchanged within the first family that holds it (creep-log-causal-fs, the causal creep with its loss
+# at fs in RES, is set against the lossless creep-log, whose RES means the same).
+ALTERNATIVES = (("lr2", "lr3", "leach", "wright"), ("creep-log", "creep-log-causal"),
+                ("creep-log-causal-fs", "creep-log"))
 INDISTINCT_FACTOR = 4.0
 MISFIT_FROM = 4.0
+DC_EXCESS = 0.1
 
 
 @dataclasses.dataclass(frozen=True)
@@ -58,7 +64,12 @@ def describes_the_data(fit: FitResult) -> bool:
 def alternative_models(model: Model) -> list[Model]:
     """`model` with each family's member exchanged for the family's other forms (every combination)."""
     variants = [tuple(model.effect_ids)]
+    exchanged: set[str] = set()
     for family in ALTERNATIVES:
+        here = [i for i in model.effect_ids if i in family and i not in exchanged]
+        if not here:
+            continue
+        exchanged.update(family)
         grown = []
         for ids in variants:
             here = [i for i in ids if i in family]
@@ -80,8 +91,13 @@ def alternative_models(model: Model) -> list[Model]:
     return models
 
 
-def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None) -> list[Member]:
-    """The user's fit and the alternatives' fits that describe the data about as well (module doc)."""
+def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None,
+            drop_degenerate: bool = False) -> list[Member]:
+    """The user's fit and the alternatives' fits that describe the data about as well (module doc).
+
+    drop_degenerate: leave out a fit whose RE, CMES, LCES, RES or Bl ended on a bound, or whose blocked impedance
+    is resistive at the lowest line (on magnitude-only curves leach's K*w^n, n small, can take RE's place:
+    no driver is like that)."""
     fits = [Member(fit.model.effect_ids, fit.chi2, dict(fit.values))]
     for model in alternative_models(fit.model):
         try:
@@ -90,6 +106,8 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
             if cancel is not None and cancel.is_set():
                 raise
             continue        # an alternative that does not converge is not one the data cannot reject
+        if drop_degenerate and _degenerate(other, data):
+            continue
         if math.isfinite(other.chi2):
             fits.append(Member(model.effect_ids, other.chi2, dict(other.values)))
     best = min(m.chi2 for m in fits)
@@ -97,13 +115,16 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
 
 
 def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
-                 cancel: threading.Event | None = None) -> dict[str, float]:
+                 cancel: threading.Event | None = None, always: bool = False,
+                 other_bands: tuple[FitData, ...] = ()) -> dict[str, float]:
     """Each parameter's model part (module doc); none when the model describes the data (the table is then
-    left as it is: its std is the noise's alone, as before)."""
+    left as it is: its std is the noise's alone, as before), unless `always` (magnitude-only curves, whose
+    misfit cannot show what the phase would). `other_bands`: the same curves over the other fit bands the
+    data cannot choose between; their fits are members too."""
     reported = _with_derived(fit.values, sd_m2)
-    if describes_the_data(fit):
+    if describes_the_data(fit) and not always:
         return {}
-    indistinct = members(fit, data, cancel)
+    indistinct = members(fit, data, cancel, drop_degenerate=always) + _band_members(fit, other_bands, cancel)
     if len(indistinct) < 2:
         # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
         # the model part is not estimated, which is not the same as zero.
@@ -115,6 +136,31 @@ def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
             if name in theirs and math.isfinite(theirs[name]):
                 spread[name] = max(spread[name], abs(theirs[name] - value))
     return spread
+
+
+def _degenerate(other: FitResult, data: FitData) -> bool:
+    """A base parameter on a bound, or a blocked impedance whose resistance at the lowest line exceeds RE by more
+    than DC_EXCESS (it took RE's place: a coil's eddy currents and semi-inductance barely act at a few hertz)."""
+    specs = {s.name: s for s in other.model.param_specs}
+    if any(n in other.values and specs[n].on_bound(other.values[n]) for n in ("RE", "CMES", "LCES", "RES", "Bl")):
+        return True
+    lowest = 2j * np.pi * np.array([data.impedance.freqs[0]])
+    excess = float(other.model.blocked_impedance(lowest, other.values).real[0]) - other.values["RE"]
+    return excess > DC_EXCESS * other.values["RE"]
+
+
+def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.Event | None) -> list[Member]:
+    """The user's model fitted over each other band (no chi^2 to compare: the bands hold different lines)."""
+    out = []
+    for data in bands:
+        try:
+            other = fit_with(fit.method, data, fit.model, start=fit.values, cancel=cancel)
+        except FitError:
+            if cancel is not None and cancel.is_set():
+                raise
+            continue
+        out.append(Member(fit.model.effect_ids, fit.chi2, dict(other.values)))
+    return out
 
 
 def _with_derived(values: Mapping[str, float], sd_m2: float | None) -> dict[str, float]:
@@ -147,5 +193,7 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
     if result.fit is None:
         return result
     data = getattr(result, "data", None) or FitData.from_spectra(result.spectra)
-    spread = model_spread(result.fit, data, result.sd_m2, cancel)
+    # Imported magnitude-only curves (analysis.curves.fitting) say whether they want it always, and their other bands.
+    spread = model_spread(result.fit, data, result.sd_m2, cancel, getattr(result, "model_part_always", False),
+                          getattr(result, "other_bands", ()))
     return dataclasses.replace(result, parameters=with_model_part(result.parameters, spread))

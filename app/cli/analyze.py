@@ -40,7 +40,8 @@ def analyze_recording(args: argparse.Namespace) -> int:
     from analysis.pipeline import analyze_path, result_json
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
     # The model part of each uncertainty (refits when the model misses the data by more than its noise).
-    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model), method=args.method))
+    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model),
+                                            method=args.method or "joint"))
     doc = result_json(result)
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)

@@ -49,8 +49,9 @@ def fit_range(args, hx_f_max=None):
     return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
 
 
-def load_curves(args: argparse.Namespace):
-    """(Z, Hx or None, notes) from --impedance/--hx or --uiv, checked for conflicting options."""
+def load_curves(args: argparse.Namespace, references: dict | None = None):
+    """(Z, Hx or None, notes) from --impedance/--hx or --uiv, checked for conflicting options; `references`
+    (when given) receives each channel's fitted curve of the exporting tool (a Klippel export's)."""
     from analysis.importers import read_curve, read_uiv
     if args.path and not (args.impedance or args.uiv or args.hx):
         used = [f"--{n.replace('_', '-')}" for n in CURVE_ONLY if getattr(args, n)]
@@ -71,28 +72,44 @@ def load_curves(args: argparse.Namespace):
         z_curve = read_curve(args.impedance, "impedance", args.phase)
         notes = [z_curve.describe()]
         z, hx = z_curve.transfer, None
+        refs = {"impedance": z_curve.reference}
         if args.hx:
             hx_curve = read_curve(args.hx, "displacement", args.phase, "mm/V" if args.mm_per_volt else None)
             hx = hx_curve.transfer
             notes.append(hx_curve.describe())
+            refs["displacement"] = hx_curve.reference
+        if references is not None:
+            references.update({k: v for k, v in refs.items() if v is not None})
     return z, hx, notes
 
 
 def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
+    from analysis.curves.reference import compare_with_reference
     from analysis.fit.model_uncertainty import model_uncertainty
-    z, hx, notes = load_curves(args)
-    fitted = fit_curves(z, hx, model_effects(args.model), args.sd, fit_range(args, args.hx_fmax), notes,
-                        method=getattr(args, "method", "joint"))
+    references: dict = {}
+    z, hx, notes = load_curves(args, references)
+    # No --model, no --method: fit_curves chooses (magnitude-only curves have their own defaults).
+    effects = None if args.model is None else model_effects(args.model)
+    fitted = fit_curves(z, hx, effects, args.sd, fit_range(args, args.hx_fmax), notes,
+                        method=getattr(args, "method", None))
     result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)
+    beside = compare_with_reference(result.fit, references)
     if args.json:
-        print_json(curve_json(result))
+        doc = curve_json(result)
+        if beside:
+            doc["reference_fit"] = beside
+        print_json(doc)
         return 0
     print(format_result(result))
     ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
     errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity["fit_error_percent"].items())
     print(f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)")
     print(f"note: {result.validity['note']}; {result.validity['uncertainties']}")
+    for name, c in beside.items():
+        print(f"the export's own fit of {name}, {c['band_hz'][0]:g}-{c['band_hz'][1]:g} Hz: fit error "
+              f"{c['tool_fit_error_percent']:.2g} % (linpar's {c['linpar_fit_error_percent']:.2g} %), "
+              f"{c['tool_vs_linpar_percent']:.2g} % rms from linpar's fitted curve")
     for note in result.notes:
         print(f"  {note}")
     return 0

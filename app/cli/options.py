@@ -66,9 +66,11 @@ def add_model_option(parser, default: Sequence[str] = DEFAULT_EFFECTS, why: str 
 
 def add_method_option(parser) -> None:
     """--method NAME: the identification (analysis.fit.methods; the names written out: no import of the fit)."""
-    parser.add_argument("--method", choices=("joint", "paper"), default="joint",
-                        help="joint: Z and Hx fitted together (default); paper: the seed paper's two steps, Z for "
-                             "the electrical parameters, then Hx for Bl and the creep with those held")
+    parser.add_argument("--method", choices=("joint", "paper", "alternating"), default=None,
+                        help="joint: Z and Hx fitted together (the default, but for magnitude-only |Z| and |Hx| "
+                             "curves: alternating); paper: the seed paper's two steps, Z for the electrical "
+                             "parameters, then Hx for Bl and the creep with those held; alternating: those two "
+                             "steps repeated until they agree, the creep fitted on Hx alone")
 
 
 def add_sd_option(parser, note: str = "") -> None:

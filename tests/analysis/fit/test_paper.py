@@ -53,4 +53,4 @@ def test_an_unknown_method_is_named_with_the_known_ones():
     with pytest.raises(UnknownMethodError, match="joint, paper") as info:
         check_method("magic")
     assert isinstance(info.value, LinparError)
-    assert tuple(METHODS) == ("joint", "paper")
+    assert tuple(METHODS) == ("joint", "paper", "alternating")
