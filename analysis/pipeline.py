@@ -54,6 +54,8 @@ class AnalysisResult:
     source: Path | None = None
     validity: dict = field(default_factory=lambda: {"overall": "unknown"})
     not_fitted: str | None = None
+    # The model part of the uncertainties (analysis.fit.model_uncertainty.ModelPart): None until estimated.
+    model_part: object | None = None
 
     @property
     def model(self) -> Model:
@@ -209,7 +211,10 @@ def analyze_path(path: str | Path, sd_m2: float | None = None,
 
 
 def result_json(result: AnalysisResult) -> dict:
-    """The object `linpar analyze --json` prints."""
+    """The object `linpar analyze --json` prints, the uncertainties with their model part (refitted here when
+    the caller has not: analysis.fit.model_uncertainty)."""
+    from analysis.fit.model_uncertainty import model_uncertainty
+    result = model_uncertainty(result)
     return {
         "parameters": {name: p.as_json() for name, p in result.parameters.items()},
         "model": model_json(result.fit) if result.fit is not None else

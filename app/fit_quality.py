@@ -11,6 +11,7 @@ import html
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QToolButton, QVBoxLayout, QWidget
 
+from analysis.fit.model_uncertainty import model_part_words, pending
 from analysis.fit.words import fit_headline, fit_is_at_noise
 from analysis.pipeline import AnalysisResult
 
@@ -33,6 +34,18 @@ def fit_error_words(result: AnalysisResult) -> str:
     return ", ".join(f"{name} {value:.2g} %" for name, value in errors.items()) + " (rms misfit of each curve)"
 
 
+ESTIMATING_TEXT = ("Model part: estimating… (refits with the other forms of the inductance and creep; until "
+                   "they end each ± is the noise's alone)")
+
+
+def model_part_html(result: AnalysisResult) -> str:
+    """The model part of the uncertainties: being estimated (refits in the background), or what it came to."""
+    if pending(result):
+        return f"<span style='color:{MISS_COLOUR}'><b>{html.escape(ESTIMATING_TEXT)}</b></span>"
+    words = model_part_words(result.validity)
+    return f"<b>Model part</b>: {html.escape(words.removeprefix('model part: '))}" if words else ""
+
+
 def headline_html(result: AnalysisResult) -> str:
     fit = result.fit
     if fit is None:
@@ -44,6 +57,7 @@ def headline_html(result: AnalysisResult) -> str:
     errors = fit_error_words(result)
     if errors:
         text += f"<br><b>Fit error</b>: {html.escape(errors)}"
+    text += f"<br>{model_part_html(result)}"
     if not fit.success:
         text += (f"<br><span style='color:{ERROR_COLOUR}'><b>The fit did not converge</b>: "
                  f"{html.escape(fit.message)}</span>")

@@ -1,6 +1,7 @@
 """The main window: menus, pages, the status bar, and the analysis of opened recordings."""
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 
@@ -48,12 +49,17 @@ class MainWindow(QMainWindow):
     analysis_failed = Signal(str)            # the message shown to the user
     analysis_cancelled = Signal()
     measurement_shown = Signal(object)       # MeasureOutcome, after the Results page shows it
+    # AnalysisOutcome with the model part of its uncertainties, after the Results page (and so QA) shows it;
+    # at once for a result whose model describes its data (nothing to refit).
+    model_part_shown = Signal(object)
 
     def __init__(self, settings: Settings | None = None, parent=None):
         style.configure_pyqtgraph()
         super().__init__(parent)
         self.settings = settings or Settings()
         self.worker = AnalysisWorker(self)
+        # The model part's jobs by id (start_model_part): what to do once each ends, however it ends.
+        self._model_part_jobs: dict[int, tuple] = {}
         self._started_at = 0.0
         self.setWindowTitle("linpar")
         self.setWindowIcon(style.app_icon())
@@ -62,7 +68,7 @@ class MainWindow(QMainWindow):
         self.results = ResultsView()
         self.model_lab = ModelLab()
         # The lab starts from each result the Results page shows; its versions go back there.
-        self.model_lab.model_adopted.connect(self.results.show_outcome)
+        self.model_lab.model_adopted.connect(self.on_model_adopted)
         self.wizard = MeasureWizard(self.settings.qsettings)
         self.qa = QAView(self.settings.qsettings)
         # Reports are written by the QA page from any page (File > Export report…): the window says how it went.
@@ -100,6 +106,9 @@ class MainWindow(QMainWindow):
 
         self._build_menus()
         self._build_status_bar()
+        # After the status bar's job controls: the Results page shows a model part before this hears of it.
+        for ended in (self.worker.finished, self.worker.failed, self.worker.cancelled):
+            ended.connect(self._model_part_ended)
         self._restore_window()
 
     # -- construction ------------------------------------------------------
@@ -178,7 +187,63 @@ class MainWindow(QMainWindow):
         fit = outcome.result.fit
         model = "fitted" if fit is not None else "nothing could be fitted"
         self.status_label.setText(f"Loaded {outcome.path} — {model}, analysed in {elapsed:.2g} s")
-        self.result_pages.after(lambda: self.analysis_shown.emit(outcome))
+        self.result_pages.after(lambda: (self.analysis_shown.emit(outcome), self.start_model_part(outcome)))
+
+    # -- the model part of the uncertainties (analysis.fit.model_uncertainty) -------------------------------
+    def start_model_part(self, outcome: AnalysisOutcome, then=None) -> None:
+        """Refit `outcome` (shown) with the other forms of its model in the background; the Results page says
+        "Model part: estimating…" meanwhile. `then(outcome)` runs once with whatever outcome is final: the one
+        with its model part, or `outcome` itself when nothing needs refitting or the refits fail or are cancelled
+        (also when another job replaces this one in the status bar: it listens to the runner, not to that)."""
+        from analysis.fit.model_uncertainty import pending
+        if not pending(outcome.result):
+            self.model_part_shown.emit(outcome)
+            if then is not None:
+                then(outcome)
+            return
+        job = self.worker.start_model_part(outcome)
+        self._model_part_jobs[job.id] = (outcome, then, time.monotonic())
+        self.jobs.run(job, "Model part: estimating…", self.on_model_part,
+                      lambda message: self.status_label.setText(
+                          f"The model part of the uncertainties could not be estimated: {message}"))
+
+    def on_model_part(self, final: AnalysisOutcome) -> None:
+        shown = self.results.show_model_part(final)
+        self.wizard.model_part_arrived(final)
+        started = self._model_part_jobs.get(final.job, (None, None, time.monotonic()))[2]
+        if shown:
+            self.status_label.setText(f"{self.status_label.text()}; the model part of the uncertainties "
+                                      f"{time.monotonic() - started:.2g} s later")
+
+    def _model_part_ended(self, job: int, final: object = None) -> None:
+        """Whatever became of a model part's job (the runner's signal): its `then`, and model_part_shown."""
+        entry = self._model_part_jobs.pop(job, None)
+        if entry is None:
+            return
+        outcome, then, _started = entry
+        if isinstance(final, AnalysisOutcome):
+            done = final
+        else:
+            # Cancelled or failed: the page says so (QA then judges on the noise alone, and says that too);
+            # `then` gets the result as it was, so that the archive's store estimates the part itself.
+            from analysis.fit.model_uncertainty import NOT_ESTIMATED, ModelPart, with_estimated
+            why = "cancelled" if final is None else f"the refits failed: {final}"
+            part = ModelPart(NOT_ESTIMATED, why=why)
+            done = dataclasses.replace(outcome, result=with_estimated(outcome.result, part))
+            self.results.show_model_part(done)
+            self.wizard.model_part_arrived(done)
+        # Once the lab and QA have it too (the Results page sent it on: show_model_part), as analysis_shown.
+        self.result_pages.after(lambda: self._model_part_done(done, then, done if done is final else outcome))
+
+    def _model_part_done(self, final: AnalysisOutcome, then, stored: AnalysisOutcome) -> None:
+        if then is not None:
+            then(stored)
+        self.model_part_shown.emit(final)
+
+    def on_model_adopted(self, outcome: AnalysisOutcome) -> None:
+        """A version of the Model lab's, adopted: shown, and its model part estimated as for an opened file's."""
+        self.results.show_outcome(outcome)
+        self.result_pages.after(lambda: self.start_model_part(outcome))
 
     def on_failed(self, path: Path, message: str) -> None:
         shown = self.results.result
@@ -215,8 +280,10 @@ class MainWindow(QMainWindow):
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {outcome.path.name}")
         self.status_label.setText(f"Measured {outcome.path}; storing it in the archive…")
-        # Stored once the lab and QA have it: the store's thread would slow their setting up (the GIL).
-        self.result_pages.after(lambda: (self.measurement_shown.emit(outcome), self._store_measured(outcome)))
+        # Stored once the lab and QA have it (the store's thread would slow their setting up: the GIL), and
+        # with the model part of its uncertainties once that is estimated (the archive's record, like the CLI's).
+        self.result_pages.after(lambda: (self.measurement_shown.emit(outcome), self.start_model_part(
+            outcome.analysis, lambda analysis: self._store_measured(dataclasses.replace(outcome, analysis=analysis)))))
 
     def _store_measured(self, outcome) -> None:
         """Into the archive, in its worker. Whatever happens there, the recording stays where it was written."""

@@ -92,6 +92,18 @@ def uncertainty_parts(p: ParameterValue) -> str:
     return ", ".join(parts)
 
 
+# The parameters whose two parts the line under the table names (every row's are in its tooltip).
+PARTS_NAMED = ("RE", "Bl", "Mms", "Kms", "fs", "Qts")
+
+
+def parts_summary(parameters: Mapping[str, ParameterValue]) -> str:
+    """"Of each ±1σ (noise and model): Mms ±0.12 g noise, ±0.9 g model; ...", or "" when no part was estimated."""
+    named = [f"{display_name(name)} {uncertainty_parts(parameters[name])}" for name in PARTS_NAMED
+             if name in parameters and parameters[name].value is not None and parameters[name].std_model is not None]
+    return ("Of each ±1σ, the noise's part and the model's (what the model misses): " + "; ".join(named)
+            if named else "")
+
+
 def value_with_unit(p: ParameterValue) -> str:
     """"3.02 Ω": the value as the table rounds it (at most 4 digits) and its unit, for a page with one cell."""
     if p.value is None:
@@ -252,12 +264,17 @@ class ParameterTable(QTableView):
         header.setSectionResizeMode(STD, QHeaderView.ResizeToContents)
         header.setSectionResizeMode(UNIT, QHeaderView.ResizeToContents)
         self.internal_folded = False
+        self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
         self.parameter_model.modelReset.connect(self._apply_spans)
         self.clicked.connect(self._on_clicked)
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
                        descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
         self.parameter_model.set_parameters(parameters, descriptions, sd_m2)
+        if self.parts_label is not None:
+            summary = parts_summary(parameters)
+            self.parts_label.setText(summary)
+            self.parts_label.setVisible(bool(summary))
 
     def set_all_digits(self, on: bool) -> None:
         self.parameter_model.set_all_digits(on)
@@ -299,4 +316,10 @@ def titled_parameter_table(title_html: str) -> tuple[QWidget, "ParameterTable"]:
     top.addWidget(all_digits)
     layout.addLayout(top)
     layout.addWidget(table, 1)
+    parts = QLabel()
+    parts.setWordWrap(True)
+    parts.setTextFormat(Qt.PlainText)
+    parts.hide()
+    table.parts_label = parts
+    layout.addWidget(parts)
     return box, table

@@ -37,6 +37,9 @@ LIMITS_MODULE, REPORT_MODULE = "analysis.limits", "analysis.report"
 NO_LIMITS = "QA limits need analysis/limits.py, which this installation does not have."
 NO_REPORT = "Reports need the analysis.report package, which this installation does not have."
 LIMITS_KEY = "qa/limits_file"
+ESTIMATING = "estimating"         # the verdict while the model part of the uncertainties is being estimated
+ESTIMATING_WHY = ("model part: estimating… each parameter is judged by its interval once that includes what "
+                  "the model misses (refits in the background)")
 NO_VERDICT = ("#e6e6e6", "#404040")         # (background, text) before there is anything to judge
 COLUMNS = ("Parameter", "Measured", "Limit", "Result")
 
@@ -98,7 +101,7 @@ def _interval_tip(verdict) -> str:
 
 
 class QAView(QWidget):
-    verdict_changed = Signal(str)       # "pass" | "fail" | "uncertain" | "invalid" | "not judged" | "none"
+    verdict_changed = Signal(str)       # "pass" | "fail" | "uncertain" | "invalid" | "not judged" | "none" | ESTIMATING
     report_written = Signal(str)
     report_failed = Signal(str)         # why; the window says it on whichever page is shown
 
@@ -252,7 +255,7 @@ class QAView(QWidget):
                                           "the parameters.")
             return
         self.limits_label.setText(f"<b>{html.escape(self.limits.name)}</b> ({html.escape(str(self.limits.path))})")
-        if self.result is None:
+        if self.result is None or self._estimating():
             return
         from analysis.qa_verdict import judge, outcome_word
         self.judgement = judge(self.limits, self.result.parameters, self.result.validity)
@@ -283,6 +286,8 @@ class QAView(QWidget):
     def _show_verdict(self, overall: str) -> None:
         if self.result is None:
             verdict, why = "none", "nothing to judge yet"
+        elif self._estimating():
+            verdict, why = ESTIMATING, ESTIMATING_WHY
         elif self.judgement is not None:
             verdict, why = self.judgement.verdict, self.judgement.why
         else:
@@ -290,7 +295,7 @@ class QAView(QWidget):
         from analysis.report.qa import VERDICT_COLOURS
         from analysis.validity.fit import VERDICT_HEADLINES
         background, text = VERDICT_COLOURS.get(verdict, NO_VERDICT)
-        title = VERDICT_HEADLINES.get(verdict, "NO VERDICT")
+        title = VERDICT_HEADLINES.get(verdict, "JUDGING…" if verdict == ESTIMATING else "NO VERDICT")
         self.verdict_label.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; "
                                          f"border: 1px solid {text}; border-radius: 4px; }}")
         self.verdict_label.setText(f"<span style='font-size:20pt'><b>{html.escape(title)}</b></span><br>"
@@ -298,6 +303,12 @@ class QAView(QWidget):
         if verdict != self.verdict:
             self.verdict = verdict
             self.verdict_changed.emit(verdict)
+
+    def _estimating(self) -> bool:
+        """Limits loaded and the result's model part still being estimated: judged once it is (the interval
+        includes it), never first on the noise alone (a false FAIL, or UNCERTAIN, for a few seconds)."""
+        from analysis.fit.model_uncertainty import pending
+        return self.limits is not None and self.result is not None and pending(self.result)
 
     def _fit_error_line(self) -> str:
         """Each curve's fit error against the limits' tolerance: what decided that the unit could be judged."""

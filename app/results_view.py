@@ -1,7 +1,6 @@
 """The Results page: validity, fit quality, Z / Hx / SPL plots and the parameter table."""
 from __future__ import annotations
 
-import dataclasses
 import html
 
 from PySide6.QtCore import Qt, Signal
@@ -159,6 +158,23 @@ class ResultsView(QWidget):
         self.stack.setCurrentWidget(self.content)
         self.result_changed.emit(result)
 
+    def show_model_part(self, outcome: AnalysisOutcome) -> bool:
+        """The same result with the model part of its uncertainties (AnalysisWorker.start_model_part): the table
+        and the fit's words updated, the pages that follow this one told. False (nothing shown) when the page
+        has moved on to another result meanwhile."""
+        shown = self.result
+        if shown is None or shown.fit is not outcome.result.fit:
+            return False
+        result = outcome.result
+        if shown.sd_m2 != result.sd_m2:         # Sd edited while the refits ran: the parts at the Sd shown
+            from analysis.fit.model_uncertainty import with_sd
+            result = with_sd(result, parameter_table(result.fit, shown.sd_m2), shown.sd_m2)
+        self.result = result
+        self.fit_quality.set_result(result)
+        self._show_parameters(result)
+        self.result_changed.emit(result)
+        return True
+
     def clear(self) -> None:
         self.result = self.curves = None
         self.impedance_plot.clear_curves()
@@ -172,9 +188,10 @@ class ResultsView(QWidget):
         """Sd feeds only derived parameters (Vas, eta0, SPL): recomputed here, no new fit needed."""
         if self.result is None or self.result.fit is None:
             return
-        # parameter_table propagates through the covariance: milliseconds, fine on the GUI thread.
-        result = dataclasses.replace(self.result, sd_m2=sd_m2,
-                                     parameters=parameter_table(self.result.fit, sd_m2))
+        # parameter_table propagates through the covariance: milliseconds, fine on the GUI thread; the model
+        # part comes again from the members already fitted (analysis.fit.model_uncertainty.with_sd).
+        from analysis.fit.model_uncertainty import with_sd
+        result = with_sd(self.result, parameter_table(self.result.fit, sd_m2), sd_m2)
         self.result = result
         self._show_parameters(result)
         self.result_changed.emit(result)

@@ -24,6 +24,8 @@ def run(workdir: Path) -> list[Row]:
     t_analysis = median_time(lambda: analyze_path(path), repeats=7)
     rows.append(at_most("analysis in process (read, spectra, fit, derived)", t_analysis, "s", 0.3))
 
+    rows += model_part_rows(path)
+
     cmd = [sys.executable, "-m", "app.cli", "analyze", str(path), "--json"]
     t_process = median_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeats=5)
     rows.append(at_most("whole 'linpar analyze' process", t_process, "s", 1.5))
@@ -49,6 +51,30 @@ def run(workdir: Path) -> list[Row]:
     t_serial = median_time(lambda: diagnose(data, textbook), repeats=1, warmup=0)
     rows.append(Row("  the same diagnosis on one core", t_serial, "s", "", None))
     rows += diagnosis_rows(data)
+    return rows
+
+
+def model_part_rows(standard: Path) -> list[Row]:
+    """The model part of the uncertainties (analysis.fit.model_uncertainty). On the standard recording the
+    model describes the data: nothing is refitted, the full result is the statistical one. On a realistic
+    woofer (tests/realistic_drivers.py) it refits the other forms of the inductance and creep: the GUI shows
+    the statistical result at once and the parts after these refits (in its background); the CLI waits."""
+    from analysis.fit.model_uncertainty import model_uncertainty
+    from analysis.pipeline import analyze_path, analyze_recording
+    from tests.realistic_drivers import realistic_recording
+
+    clean = analyze_path(standard)
+    rows = [at_most("model part of the standard recording (nothing to refit)",
+                    median_time(lambda: model_uncertainty(clean), repeats=7), "s", 0.01)]
+    woofer = realistic_recording("woofer", 0)
+    statistical = analyze_recording(woofer)
+    rows.append(Row("realistic woofer: statistical result (what the GUI shows first)",
+                    median_time(lambda: analyze_recording(woofer), repeats=3), "s", "", None))
+    rows.append(Row("realistic woofer: its model part's refits (in the GUI's background)",
+                    median_time(lambda: model_uncertainty(statistical), repeats=3, warmup=0), "s", "", None))
+    rows.append(Row("realistic woofer: the full result (statistical and model part)",
+                    median_time(lambda: model_uncertainty(analyze_recording(woofer)), repeats=3, warmup=0), "s",
+                    "", None))
     return rows
 
 

@@ -29,6 +29,8 @@ production-1280x720.png and production-1920x1080.png: the Production page
 over 240 units from three stations, fs drifting 2 sigma up from unit 150 and
 station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
+--only model-part: the Results page of a realistic woofer while its model part is estimated and after, and
+its report's first page, at both sizes (tools/screenshots_model_part.py).
 --only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
 (tools/screenshots_verdicts.py).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
@@ -517,6 +519,11 @@ def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     return written
 
 
+def model_part_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_model_part import model_part_screenshots as shots
+    return shots(app, window, folder, out)
+
+
 def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_verdicts import verdict_screenshots
     return verdict_screenshots(app, window, folder, out)
@@ -526,7 +533,8 @@ ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect
         "large-signal": large_signal_screenshots, "production": production_screenshots,
         "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
         "verdicts": verdicts_screenshots, "real-like": real_like_screenshots,
-        "first-window": first_window_screenshots, "production-counts": production_counts_screenshots}
+        "first-window": first_window_screenshots, "production-counts": production_counts_screenshots,
+        "model-part": model_part_screenshots}
 
 
 def main(argv: list[str]) -> int:

@@ -71,7 +71,12 @@ def results_document(result, recording=None) -> dict:
     A result with nothing fitted (a broken measurement: analysis.validity.fit) is kept too, so that it can
     be archived, reported and exported as judged: its parameters are "not measured" with the reason, its
     model has no effects and says why under "not_fitted", and it has no curves.
+
+    Every archived or reported result goes through here, so its uncertainties include the model part
+    (analysis.fit.model_uncertainty: refitted here when the caller has not; the same result when it has).
     """
+    from analysis.fit.model_uncertainty import model_uncertainty
+    result = model_uncertainty(result)
     fit = result.fit
     parameters = {}
     for name, p in result.parameters.items():

@@ -5,14 +5,16 @@ header of analysis.session one item a line: driver, serial, date, operator,
 station, template, software; and the exporting software), then one row per
 parameter, columns
 
-    parameter, value, std, unit, display_value, display_std, display_unit, note
+    parameter, value, std, unit, display_value, display_std, display_unit, note, std_noise, std_model
 
 (value and std in SI; display_* = SI x display_scale; an empty value with a
-note says why it is missing). Decimal point '.', comma-separated, UTF-8,
+note says why it is missing; std is the total standard uncertainty, std_noise and
+std_model its two parts in SI, empty where the analysis did not estimate them:
+analysis.fit.model_uncertainty). Decimal point '.', comma-separated, UTF-8,
 RFC 4180 quoting. A reader skips the '#' lines (pandas: comment="#").
 
 JSON ("linpar-parameters/1"): the driver header, the parameters keyed by
-name ({value, std, unit, display_unit, display_scale, reason}), the model
+name ({value, std, unit, display_unit, display_scale, reason; std_noise and std_model where estimated}), the model
 (effects, reduced chi^2 per channel, AIC, BIC) and the overall validity.
 """
 from __future__ import annotations
@@ -28,7 +30,8 @@ from analysis.session import comment_lines
 from analysis.text_boundary import spreadsheet_cell
 
 JSON_FORMAT = "linpar-parameters/1"
-CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note")
+CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note",
+               "std_noise", "std_model")
 
 
 def _num(x) -> str:
@@ -46,7 +49,7 @@ def parameters_csv(result: StoredResult, header: Mapping | None = None) -> str:
         writer.writerow([p.name, _num(p.value), _num(p.std), p.unit,
                          _num(p.value * p.display_scale) if ok else "",
                          _num(p.std * abs(p.display_scale)) if ok and p.std is not None else "",
-                         p.display_unit, spreadsheet_cell(p.reason or "")])
+                         p.display_unit, spreadsheet_cell(p.reason or ""), _num(p.std_noise), _num(p.std_model)])
     return buf.getvalue()
 
 
@@ -57,7 +60,9 @@ def parameters_json(result: StoredResult, header: Mapping | None = None) -> str:
         "driver": {k: v for k, v in dict(header or {}).items() if v},
         "sd_m2": result.sd_m2,
         "parameters": {p.name: {"value": p.value, "std": p.std, "unit": p.unit, "display_unit": p.display_unit,
-                                "display_scale": p.display_scale, **({"reason": p.reason} if p.reason else {})}
+                                "display_scale": p.display_scale, **({"reason": p.reason} if p.reason else {}),
+                                **{k: v for k, v in (("std_noise", p.std_noise), ("std_model", p.std_model))
+                                   if v is not None}}
                        for p in result.parameters.values()},
         "model": {k: info.get(k) for k in ("effects", "chi2_red", "aic", "bic", "n_data", "n_parameters", "converged")},
         "validity": result.overall,

@@ -21,14 +21,20 @@ std for RE, Bl, Mms and Kms; see tests/analysis/fit/test_model_uncertainty.py.
 
 When the model describes the recording (every channel's reduced chi^2 below MISFIT_FROM: the misfit
 within twice the noise) nothing is refitted and nothing changes: no model part is reported. The refits take a few seconds: a
-separate step after the statistical result (the GUI can show that at once and run this in the
-background; `linpar analyze` runs it before printing).
+separate step after the statistical result (the GUI shows that at once and runs this in the background;
+`linpar analyze`, `measure`, `archive store` and `report` run it before they print or store).
+
+Every place that shows, stores or judges a result passes it through `model_uncertainty` (once: a result
+that carries its ModelPart is returned as it is), so the same recording reads the same everywhere. What was
+done is kept on the result (`model_part`) and in its validity's "model_part" ({"state", "seconds"}), which
+the archive record, the reports and the JSON carry.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
 import threading
+import time
 from typing import Mapping
 
 import numpy as np
@@ -48,12 +54,51 @@ INDISTINCT_FACTOR = 4.0
 MISFIT_FROM = 4.0
 DC_EXCESS = 0.1
 
+# What was done about the model part (ModelPart.state; the validity's "model_part" in the JSON).
+ESTIMATED = "estimated"             # refitted: std_model on every parameter the members give
+NOT_NEEDED = "not needed"           # the model describes the data: std is the noise's alone
+NOT_ESTIMATED = "not estimated"     # misfit, but no alternative the data cannot reject (or none to exchange)
+ESTIMATING = "estimating"           # not a state of a result: what a page says while the refits run
+
 
 @dataclasses.dataclass(frozen=True)
 class Member:
     effects: tuple[str, ...]
     chi2: float
     values: dict[str, float]
+
+
+@dataclasses.dataclass(frozen=True)
+class ModelPart:
+    """What the model part of a result's uncertainties came to (module doc): kept with the result, so that a
+    change of Sd (derived parameters only) recomputes the parts from the same members without refitting."""
+    state: str                          # ESTIMATED | NOT_NEEDED | NOT_ESTIMATED
+    members: tuple[Member, ...] = ()    # ESTIMATED: the fits the data cannot tell apart, the user's first
+    seconds: float = 0.0                # how long the refits took
+    why: str = ""                       # NOT_ESTIMATED for another reason than the module doc's (cancelled)
+
+    def as_json(self) -> dict:
+        return {"state": self.state, "seconds": round(self.seconds, 2),
+                "models": [list(m.effects) for m in self.members], **({"why": self.why} if self.why else {})}
+
+    def spread(self, values: Mapping[str, float], sd_m2: float | None) -> dict[str, float]:
+        """Each parameter's model part around `values` (the reported fit's), derived ones at `sd_m2`."""
+        if self.state != ESTIMATED:
+            return {}
+        reported = _with_derived(values, sd_m2)
+        spread = {name: 0.0 for name in reported}
+        for member in self.members:
+            theirs = _with_derived(member.values, sd_m2)
+            for name, value in reported.items():
+                if name in theirs and math.isfinite(theirs[name]):
+                    spread[name] = max(spread[name], abs(theirs[name] - value))
+        return spread
+
+
+def pending(result) -> bool:
+    """True when `result` still lacks a model part it needs: a fit that misses its data, not yet refitted."""
+    fit = getattr(result, "fit", None)
+    return fit is not None and getattr(result, "model_part", None) is None and not describes_the_data(fit)
 
 
 def describes_the_data(fit: FitResult) -> bool:
@@ -114,6 +159,22 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
     return [m for m in fits if m.chi2 <= INDISTINCT_FACTOR * best]
 
 
+def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event | None = None, always: bool = False,
+                        other_bands: tuple[FitData, ...] = ()) -> ModelPart:
+    """The refits' outcome (module doc): NOT_NEEDED when the model describes the data (nothing is refitted),
+    unless `always`; `other_bands` as model_spread's."""
+    if describes_the_data(fit) and not always:
+        return ModelPart(NOT_NEEDED)
+    started = time.perf_counter()
+    indistinct = members(fit, data, cancel, drop_degenerate=always) + _band_members(fit, other_bands, cancel)
+    seconds = time.perf_counter() - started
+    if len(indistinct) < 2:
+        # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
+        # the model part is not estimated, which is not the same as zero.
+        return ModelPart(NOT_ESTIMATED, seconds=seconds)
+    return ModelPart(ESTIMATED, tuple(indistinct), seconds)
+
+
 def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
                  cancel: threading.Event | None = None, always: bool = False,
                  other_bands: tuple[FitData, ...] = ()) -> dict[str, float]:
@@ -121,21 +182,7 @@ def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
     left as it is: its std is the noise's alone, as before), unless `always` (magnitude-only curves, whose
     misfit cannot show what the phase would). `other_bands`: the same curves over the other fit bands the
     data cannot choose between; their fits are members too."""
-    reported = _with_derived(fit.values, sd_m2)
-    if describes_the_data(fit) and not always:
-        return {}
-    indistinct = members(fit, data, cancel, drop_degenerate=always) + _band_members(fit, other_bands, cancel)
-    if len(indistinct) < 2:
-        # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
-        # the model part is not estimated, which is not the same as zero.
-        return {}
-    spread = {name: 0.0 for name in reported}
-    for member in indistinct:
-        theirs = _with_derived(member.values, sd_m2)
-        for name, value in reported.items():
-            if name in theirs and math.isfinite(theirs[name]):
-                spread[name] = max(spread[name], abs(theirs[name] - value))
-    return spread
+    return estimate_model_part(fit, data, cancel, always, other_bands).spread(fit.values, sd_m2)
 
 
 def _degenerate(other: FitResult, data: FitData) -> bool:
@@ -189,11 +236,45 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
     """`result` (an analysis.pipeline.AnalysisResult, or an analysis.curves.fitting.CurveAnalysis) with each parameter's
     model part (module doc), the alternatives fitted by the result's own method.
 
-    The same result when nothing was fitted; the refits honour `cancel` (FitCancelled)."""
-    if result.fit is None:
+    The same result when nothing was fitted or when it already carries its model part (every output calls
+    this: the refits run once); the refits honour `cancel` (FitCancelled)."""
+    if result.fit is None or getattr(result, "model_part", None) is not None:
         return result
     data = getattr(result, "data", None) or FitData.from_spectra(result.spectra)
     # Imported magnitude-only curves (analysis.curves.fitting) say whether they want it always, and their other bands.
-    spread = model_spread(result.fit, data, result.sd_m2, cancel, getattr(result, "model_part_always", False),
-                          getattr(result, "other_bands", ()))
-    return dataclasses.replace(result, parameters=with_model_part(result.parameters, spread))
+    part = estimate_model_part(result.fit, data, cancel, getattr(result, "model_part_always", False),
+                               getattr(result, "other_bands", ()))
+    return with_estimated(result, part)
+
+
+def with_estimated(result, part: ModelPart):
+    """`result` with `part`'s spread in its parameters' std, and `part` kept on it and in its validity."""
+    changes = {"parameters": with_model_part(result.parameters, part.spread(result.fit.values, result.sd_m2)),
+               "validity": {**result.validity, "model_part": part.as_json()}}
+    if "model_part" in {f.name for f in dataclasses.fields(result)}:
+        changes["model_part"] = part
+    return dataclasses.replace(result, **changes)
+
+
+def with_sd(result, parameters: Mapping[str, ParameterValue], sd_m2: float | None):
+    """`result`'s statistical table recomputed at another Sd (`parameters`), its model part applied again from the
+    same members (no refit): what the Results page shows when the user edits Sd."""
+    part = getattr(result, "model_part", None)
+    spread = part.spread(result.fit.values, sd_m2) if part is not None else {}
+    return dataclasses.replace(result, sd_m2=sd_m2, parameters=with_model_part(parameters, spread))
+
+
+def model_part_words(validity: Mapping | None) -> str:
+    """What a result's model part came to, in one sentence (its validity's "model_part"); "" before it is estimated."""
+    entry = (validity or {}).get("model_part") or {}
+    state = entry.get("state")
+    if state == ESTIMATED:
+        n = len(entry.get("models") or ())
+        return (f"model part: estimated from {n} models the data cannot tell apart (their refits took "
+                f"{float(entry.get('seconds') or 0):.1f} s); each 1-sigma is its total with the noise's")
+    if state == NOT_NEEDED:
+        return "model part: none (the model describes the measurement within its noise)"
+    if state == NOT_ESTIMATED:
+        why = entry.get("why") or "the model misses the measurement, but no other form fits about as well"
+        return f"model part: not estimated ({why}); each 1-sigma is the noise's alone"
+    return ""

@@ -146,6 +146,10 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))
+    from analysis.fit.model_uncertainty import model_part_words
+    words = model_part_words(result.validity)
+    if words:           # what each ± holds besides the noise (analysis.fit.model_uncertainty)
+        rows.append(("Model part", words.removeprefix("model part: ")))
     chi = _chi2_text(info)
     if chi:
         rows.append(("Fit quality", f"reduced χ² {chi}; 1 means the model fits within the noise"))

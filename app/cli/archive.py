@@ -133,8 +133,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _store(archive, args) -> int:
+    from analysis.fit.model_uncertainty import model_uncertainty
     from analysis.pipeline import analyze_path
-    result = analyze_path(args.path, args.sd, model_effects(args.model))
+    # The record's uncertainties with their model part, as `linpar analyze` prints them.
+    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model)))
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)

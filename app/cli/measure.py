@@ -158,6 +158,7 @@ def run(args: argparse.Namespace) -> int:
     for path in (outcome.recording_path, outcome.sidecar_path, outcome.raw_path):
         if path is not None:
             say(f"wrote {path}")
+    outcome = _with_model_part(outcome)
     archived = None if args.no_archive else _store(args, outcome, plan, measured_at)
     result = outcome.result
     if args.json:
@@ -168,6 +169,18 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(format_result(result))
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
+
+
+def _with_model_part(outcome):
+    """The outcome with its result's model part (analysis.fit.model_uncertainty), inline: what is printed and
+    what is stored are then the same numbers `linpar analyze` and the GUI give for this recording."""
+    from analysis.fit.model_uncertainty import model_uncertainty, pending
+    if outcome.result is None:
+        return outcome
+    if pending(outcome.result):
+        say("the model misses the measurement beyond its noise: refitting with the other forms of its "
+            "inductance and creep for the model part of the uncertainties")
+    return dataclasses.replace(outcome, result=model_uncertainty(outcome.result))
 
 
 class _Cancel(threading.Event):

@@ -53,6 +53,9 @@ def format_result(result) -> str:
         if errors:
             lines.append("fit error: " + ", ".join(f"{k} {v:.2g} %" for k, v in errors.items())
                          + " (rms misfit of each curve in its fitted band)")
+        from analysis.fit.model_uncertainty import model_part_words
+        if model_part_words(result.validity):
+            lines.append(model_part_words(result.validity))
         if not fit.success:
             lines.append(f"warning: the fit did not converge: {fit.message}")
         report = fit.report()

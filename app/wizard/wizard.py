@@ -8,6 +8,8 @@ Next disabled until it is None.
 """
 from __future__ import annotations
 
+import dataclasses
+
 from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QListWidget, QListWidgetItem, QPushButton,
                                QScrollArea, QStackedWidget, QVBoxLayout, QWidget)
@@ -145,6 +147,16 @@ class MeasureWizard(QWidget):
         self.driver_page.serial_edit.clear()
         self.driver_page.serial_edit.setFocus()
         self.go_to(0)
+
+    def model_part_arrived(self, analysis) -> None:
+        """The measurement's analysis (app.workers.AnalysisOutcome) again, its uncertainties with their model part
+        (estimated in the background after the statistical result): the Results step shows it too."""
+        outcome = self.state.outcome
+        if outcome is None or outcome.analysis.result.fit is not analysis.result.fit:
+            return          # another measurement since: not this one's
+        self.state.outcome = dataclasses.replace(outcome, analysis=analysis)
+        if self.current is self.results_page:
+            self.results_page.enter()
 
     def shutdown(self, wait_ms: int) -> bool:
         return self.session.shutdown(wait_ms)

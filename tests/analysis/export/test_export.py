@@ -110,4 +110,4 @@ def test_the_parameters_csv_carries_the_traceability_header(stored):
         assert sum(value in line for line in comments) == 1
     assert comments[-1].startswith("# exported by linpar")
     first_row = text.splitlines()[len(comments)]
-    assert first_row == "parameter,value,std,unit,display_value,display_std,display_unit,note"
+    assert first_row == "parameter,value,std,unit,display_value,display_std,display_unit,note,std_noise,std_model"
