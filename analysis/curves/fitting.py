@@ -35,6 +35,7 @@ same way, with one real number per line instead of two.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
@@ -46,7 +47,7 @@ from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
 from analysis.fit.error import fit_error_percent, rms_relative_residual
-from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitResult, component_sigma
+from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitError, FitResult, component_sigma
 from analysis.fit.startvalues import start_context
 from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model
@@ -179,6 +180,8 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
     z, x = data.impedance, data.displacement
     model = Model(tuple(effects), with_displacement=x is not None)
     fit = fit_with(method, data, model)
+    if chosen:
+        fit = _admissible(fit, data, notes)
     fit, held = covariance_with_bounds(fit, lambda v: weighted_residual(model, v, data))
     if held:
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
@@ -190,6 +193,32 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
                             for k in OTHER_Z_BANDS_OVER_FS if k != f_range.z_max_over_fs)
     return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data,
                          magnitude_only(impedance, hx), other_bands)
+
+
+def _admissible(fit: FitResult, data: FitData, notes: list[str]) -> FitResult:
+    """The default model's fit, or, when it is no driver's (analysis.fit.model_uncertainty.degenerate: a base
+    parameter on a bound, or the blocked impedance taking RE's place at the lowest line), the best fit among the
+    model's alternatives that is one. Seen on magnitude-only curves of a driver with a strong lossless creep
+    (lambda 0.38): the causal law's fit put RE on its bound and R2 in its place."""
+    from analysis.fit.model_uncertainty import alternative_models, degenerate
+    if not degenerate(fit, data):
+        return fit
+    others = []
+    for model in alternative_models(fit.model):
+        try:
+            other = fit_with(fit.method, data, model)
+        except FitError:
+            continue
+        if math.isfinite(other.chi2) and not degenerate(other, data):
+            others.append(other)
+    if not others:
+        notes.append("the default model's fit ended on a bound or with RE taken by the blocked impedance, and no "
+                     "alternative model did better: check the values marked on a bound")
+        return fit
+    best = min(others, key=lambda f: f.chi2)
+    notes.append(f"the default model {'+'.join(fit.model.effect_ids)} ended on a bound or with RE taken by the "
+                 f"blocked impedance: fitted with {'+'.join(best.model.effect_ids)} instead")
+    return best
 
 
 def curve_data(impedance: TransferFunction, hx: TransferFunction | None = None,

@@ -151,7 +151,7 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
             if cancel is not None and cancel.is_set():
                 raise
             continue        # an alternative that does not converge is not one the data cannot reject
-        if drop_degenerate and _degenerate(other, data):
+        if drop_degenerate and degenerate(other, data):
             continue
         if math.isfinite(other.chi2):
             fits.append(Member(model.effect_ids, other.chi2, dict(other.values)))
@@ -185,7 +185,7 @@ def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
     return estimate_model_part(fit, data, cancel, always, other_bands).spread(fit.values, sd_m2)
 
 
-def _degenerate(other: FitResult, data: FitData) -> bool:
+def degenerate(other: FitResult, data: FitData) -> bool:
     """A base parameter on a bound, or a blocked impedance whose resistance at the lowest line exceeds RE by more
     than DC_EXCESS (it took RE's place: a coil's eddy currents and semi-inductance barely act at a few hertz)."""
     specs = {s.name: s for s in other.model.param_specs}

@@ -177,4 +177,4 @@ def test_analyze_by_the_papers_method(capsys, rec_path):
 
 def test_analyze_refuses_an_unknown_method(capsys, rec_path):
     assert main(["analyze", str(rec_path), "--method", "magic"]) == 2
-    assert "invalid choice: 'magic' (choose from 'joint', 'paper')" in capsys.readouterr().err
+    assert "invalid choice: 'magic' (choose from 'joint', 'paper', 'alternating')" in capsys.readouterr().err
