@@ -45,8 +45,13 @@ class NotAnalysable(LinparError):
     """A recording whose channels leave nothing to fit (message: which and why, with the remedy)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AnalysisResult:
+    """A recording's analysis: its parameters, the fit they came from and its judged channels.
+
+    `report()` is the text `linpar analyze` prints, `as_json()` the object `linpar analyze --json` prints.
+    """
+
     spectra: Spectra
     fit: FitResult | None               # None: nothing could be fitted (not_fitted says why)
     parameters: dict[str, ParameterValue]
@@ -58,6 +63,15 @@ class AnalysisResult:
     @property
     def model(self) -> Model:
         return require_fit(self).model
+
+    def report(self) -> str:
+        """The parameter table, the fit's summary, the validity and the fit's report (analysis.result_text)."""
+        from analysis.result_text import format_result
+        return format_result(self)
+
+    def as_json(self) -> dict:
+        """The parameters, the model and the validity as JSON-ready values (result_json)."""
+        return result_json(self)
 
 
 def require_fit(result: AnalysisResult, doing: str = "") -> FitResult:
@@ -127,8 +141,9 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     sd = resolve_sd(recording, sd_m2)
     if usable.impedance is not None:
         model = Model(effects, with_displacement=False)
-        return AnalysisResult(spectra, None, unmeasured_table(model, usable.impedance), sd, recording.source,
-                              validity.as_json(), usable.impedance)
+        return AnalysisResult(spectra=spectra, fit=None, parameters=unmeasured_table(model, usable.impedance),
+                              sd_m2=sd, source=recording.source, validity=validity.as_json(),
+                              not_fitted=usable.impedance)
     data = FitData.from_spectra(spectra)
     model = Model(effects, with_displacement=data.displacement is not None)
     start = start_of(data, model, cancel) if start_of is not None else None
@@ -144,7 +159,8 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     judged["fit_error_percent"] = fit_error_percent(fit)       # what QA judges the model's misfit by
     if heating is not None:
         judged["heating"] = heating.as_json()
-    return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged)
+    return AnalysisResult(spectra=spectra, fit=fit, parameters=parameters, sd_m2=sd, source=recording.source,
+                          validity=judged)
 
 
 def without_coil_heating(recording: Recording, spectra: Spectra, validity: Validity,
