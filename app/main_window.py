@@ -14,7 +14,6 @@ from app.job_controls import JobControls
 from app.large_signal.page import LargeSignalPage
 from app.menus import Menus
 from app.model_lab.page import ModelLab
-from app.placeholders import PlaceholderPage
 from app.production.page import ProductionPage
 from app.qa_view import QAView
 from app.results_view import ResultsView
@@ -92,7 +91,7 @@ class MainWindow(QMainWindow):
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
-            self.pages.addTab(built[name] if name in built else PlaceholderPage(name), name)
+            self.pages.addTab(built[name], name)
         # A first start (no window saved yet) opens on the wizard's first step: a newcomer starts by measuring.
         first_start = self.settings.window_geometry()[0] is None
         self.pages.setCurrentWidget(self.wizard if first_start else self.results)
