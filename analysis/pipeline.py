@@ -34,7 +34,7 @@ from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.plausibility import plausibility_findings
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
-from analysis.validity.fit import FitChannels, fit_channels, misfit_findings
+from analysis.validity.fit import UnusableChannels, misfit_findings, unusable_channels
 
 
 # Displacement lines below which Hx carries too little to fit Bl (and a delay) from.
@@ -136,14 +136,14 @@ def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None 
 
 def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effects: Sequence[Effect] | None,
               cancel: threading.Event | None, start_of: StartOf | None, method: str) -> AnalysisResult:
-    validity, usable, spectra = _judged(recording, spectra)
+    validity, unusable, spectra = _judged(recording, spectra)
     effects = tuple(default_effects() if effects is None else effects)
     sd = resolve_sd(recording, sd_m2)
-    if usable.impedance is not None:
+    if unusable.impedance is not None:
         model = Model(effects, with_displacement=False)
-        return AnalysisResult(spectra=spectra, fit=None, parameters=unmeasured_table(model, usable.impedance),
+        return AnalysisResult(spectra=spectra, fit=None, parameters=unmeasured_table(model, unusable.impedance),
                               sd_m2=sd, source=recording.source, validity=validity.as_json(),
-                              not_fitted=usable.impedance)
+                              not_fitted=unusable.impedance)
     data = FitData.from_spectra(spectra)
     model = Model(effects, with_displacement=data.displacement is not None)
     start = start_of(data, model, cancel) if start_of is not None else None
@@ -152,7 +152,7 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     if corrected is not spectra:        # the noise estimate was the drift's: fit again on the honest one
         spectra = corrected
         fit = fit_with(method, FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
-    parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
+    parameters = parameter_table(fit, sd, unusable.displacement or NO_DISPLACEMENT)
     # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
     implausible = plausibility_findings(recording, spectra, parameters, sd, validity.peak_displacement_m)
     judged = validity.with_findings(merged(misfit_findings(fit), implausible)).as_json()
@@ -175,21 +175,21 @@ def without_coil_heating(recording: Recording, spectra: Spectra, validity: Valid
     return without_heating(recording, spectra, heating), heating
 
 
-def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChannels, Spectra]:
+def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, UnusableChannels, Spectra]:
     """The channels judged, what they leave to fit, and the spectra without an unusable displacement."""
     capture = checked_capture(recording)      # a sidecar that cannot be judged is refused at once
     validity = assess(recording, spectra, capture)
-    usable = fit_channels(validity)
+    unusable = unusable_channels(validity)
     x = spectra.displacement
-    if usable.displacement is None and x is not None and usable.impedance is None:
+    if unusable.displacement is None and x is not None and unusable.impedance is None:
         lines = int(np.sum(np.isfinite(x.value) & (x.freqs > 0)))
         if lines < MIN_X_LINES:     # e.g. a displacement_max_hz below the excitation: Bl from nothing
-            usable = dataclasses.replace(usable, displacement=(
+            unusable = dataclasses.replace(unusable, displacement=(
                 f"the displacement cannot be used: {lines} of its lines lie in the laser's band (at least "
                 f"{MIN_X_LINES} are needed for Bl); check the sidecar's displacement_max_hz and the laser's rate"))
-    if usable.displacement is not None and x is not None:
+    if unusable.displacement is not None and x is not None:
         spectra = dataclasses.replace(spectra, displacement=None)
-    return validity, usable, spectra
+    return validity, unusable, spectra
 
 
 def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
@@ -197,10 +197,10 @@ def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
     heating taken out of the noise (and said under "heating") when the current drifts; NotAnalysable
     naming the file and `doing` when the impedance has none."""
     with naming_the_file(recording):
-        validity, usable, spectra = _judged(recording, estimate_spectra(recording))
-    if usable.impedance is not None:
+        validity, unusable, spectra = _judged(recording, estimate_spectra(recording))
+    if unusable.impedance is not None:
         where = f"{recording.source}: " if recording.source is not None else ""
-        raise NotAnalysable(f"{where}cannot {doing}: {usable.impedance}")
+        raise NotAnalysable(f"{where}cannot {doing}: {unusable.impedance}")
     judged = validity.as_json()
     if any(f.code == DRIFT for f in validity.channels["current"].findings):
         # RE for the words only (the correction does not need it): the lowest real part of Z, as the fit starts
