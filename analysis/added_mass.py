@@ -247,8 +247,9 @@ def _fit_result(model, values, data, masses, labels, curve_impedance, result) ->
         channels[label] = ChannelFit(label, tf.freqs, tf.value, z, std, chi2, n, chi2 / dof, tf.has_phase)
     chi2 = sum(c.chi2 for c in channels.values())
     varying = tuple(n[:-1] if n == "lambda_" else n for n in result.var_names)
-    return FitResult(model, values, {n: None for n in values}, varying, None, channels, chi2, n_total,
-                     bool(result.success), str(result.message), int(result.nfev), noise_known=False)
+    return FitResult(model=model, values=values, stderr={n: None for n in values}, varying=varying, covar=None,
+                     channels=channels, chi2=chi2, n_data=n_total, success=bool(result.success),
+                     message=str(result.message), nfev=int(result.nfev), noise_known=False)
 
 
 def model_free_dual_mass(free: TransferFunction, first: TransferFunction, m1_kg: float,

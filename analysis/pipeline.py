@@ -34,7 +34,7 @@ from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.plausibility import plausibility_findings
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
-from analysis.validity.fit import FitChannels, fit_channels, misfit_findings
+from analysis.validity.fit import UnusableChannels, misfit_findings, unusable_channels
 
 
 # Displacement lines below which Hx carries too little to fit Bl (and a delay) from.
@@ -45,8 +45,13 @@ class NotAnalysable(LinparError):
     """A recording whose channels leave nothing to fit (message: which and why, with the remedy)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AnalysisResult:
+    """A recording's analysis: its parameters, the fit they came from and its judged channels.
+
+    `report()` is the text `linpar analyze` prints, `as_json()` the object `linpar analyze --json` prints.
+    """
+
     spectra: Spectra
     fit: FitResult | None               # None: nothing could be fitted (not_fitted says why)
     parameters: dict[str, ParameterValue]
@@ -60,6 +65,15 @@ class AnalysisResult:
     @property
     def model(self) -> Model:
         return require_fit(self).model
+
+    def report(self) -> str:
+        """The parameter table, the fit's summary, the validity and the fit's report (analysis.result_text)."""
+        from analysis.result_text import format_result
+        return format_result(self)
+
+    def as_json(self) -> dict:
+        """The parameters, the model and the validity as JSON-ready values (result_json)."""
+        return result_json(self)
 
 
 def require_fit(result: AnalysisResult, doing: str = "") -> FitResult:
@@ -124,13 +138,14 @@ def analyze_spectra(recording: Recording, spectra: Spectra, sd_m2: float | None 
 
 def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effects: Sequence[Effect] | None,
               cancel: threading.Event | None, start_of: StartOf | None, method: str) -> AnalysisResult:
-    validity, usable, spectra = _judged(recording, spectra)
+    validity, unusable, spectra = _judged(recording, spectra)
     effects = tuple(default_effects() if effects is None else effects)
     sd = resolve_sd(recording, sd_m2)
-    if usable.impedance is not None:
+    if unusable.impedance is not None:
         model = Model(effects, with_displacement=False)
-        return AnalysisResult(spectra, None, unmeasured_table(model, usable.impedance), sd, recording.source,
-                              validity.as_json(), usable.impedance)
+        return AnalysisResult(spectra=spectra, fit=None, parameters=unmeasured_table(model, unusable.impedance),
+                              sd_m2=sd, source=recording.source, validity=validity.as_json(),
+                              not_fitted=unusable.impedance)
     data = FitData.from_spectra(spectra)
     model = Model(effects, with_displacement=data.displacement is not None)
     start = start_of(data, model, cancel) if start_of is not None else None
@@ -139,14 +154,15 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     if corrected is not spectra:        # the noise estimate was the drift's: fit again on the honest one
         spectra = corrected
         fit = fit_with(method, FitData.from_spectra(spectra), model, start=fit.values, cancel=cancel)
-    parameters = parameter_table(fit, sd, usable.displacement or NO_DISPLACEMENT)
+    parameters = parameter_table(fit, sd, unusable.displacement or NO_DISPLACEMENT)
     # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
     implausible = plausibility_findings(recording, spectra, parameters, sd, validity.peak_displacement_m)
     judged = validity.with_findings(merged(misfit_findings(fit), implausible)).as_json()
     judged["fit_error_percent"] = fit_error_percent(fit)       # what QA judges the model's misfit by
     if heating is not None:
         judged["heating"] = heating.as_json()
-    return AnalysisResult(spectra, fit, parameters, sd, recording.source, judged)
+    return AnalysisResult(spectra=spectra, fit=fit, parameters=parameters, sd_m2=sd, source=recording.source,
+                          validity=judged)
 
 
 def without_coil_heating(recording: Recording, spectra: Spectra, validity: Validity,
@@ -161,21 +177,21 @@ def without_coil_heating(recording: Recording, spectra: Spectra, validity: Valid
     return without_heating(recording, spectra, heating), heating
 
 
-def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, FitChannels, Spectra]:
+def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, UnusableChannels, Spectra]:
     """The channels judged, what they leave to fit, and the spectra without an unusable displacement."""
     capture = checked_capture(recording)      # a sidecar that cannot be judged is refused at once
     validity = assess(recording, spectra, capture)
-    usable = fit_channels(validity)
+    unusable = unusable_channels(validity)
     x = spectra.displacement
-    if usable.displacement is None and x is not None and usable.impedance is None:
+    if unusable.displacement is None and x is not None and unusable.impedance is None:
         lines = int(np.sum(np.isfinite(x.value) & (x.freqs > 0)))
         if lines < MIN_X_LINES:     # e.g. a displacement_max_hz below the excitation: Bl from nothing
-            usable = dataclasses.replace(usable, displacement=(
+            unusable = dataclasses.replace(unusable, displacement=(
                 f"the displacement cannot be used: {lines} of its lines lie in the laser's band (at least "
                 f"{MIN_X_LINES} are needed for Bl); check the sidecar's displacement_max_hz and the laser's rate"))
-    if usable.displacement is not None and x is not None:
+    if unusable.displacement is not None and x is not None:
         spectra = dataclasses.replace(spectra, displacement=None)
-    return validity, usable, spectra
+    return validity, unusable, spectra
 
 
 def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
@@ -183,10 +199,10 @@ def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
     heating taken out of the noise (and said under "heating") when the current drifts; NotAnalysable
     naming the file and `doing` when the impedance has none."""
     with naming_the_file(recording):
-        validity, usable, spectra = _judged(recording, estimate_spectra(recording))
-    if usable.impedance is not None:
+        validity, unusable, spectra = _judged(recording, estimate_spectra(recording))
+    if unusable.impedance is not None:
         where = f"{recording.source}: " if recording.source is not None else ""
-        raise NotAnalysable(f"{where}cannot {doing}: {usable.impedance}")
+        raise NotAnalysable(f"{where}cannot {doing}: {unusable.impedance}")
     judged = validity.as_json()
     if any(f.code == DRIFT for f in validity.channels["current"].findings):
         # RE for the words only (the correction does not need it): the lowest real part of Z, as the fit starts

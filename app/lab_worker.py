@@ -177,8 +177,9 @@ def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, f
     job.check()
     if taken is not None:
         t = taken
-        first = Step(start, (), residuals.describe(start),
-                     Candidate(t.action, t.effect, t.replaces, t.fitted.fit, t.delta_bic, t.error, t.flags))
+        first = Step(fit=start, candidates=(), residual=residuals.describe(start),
+                     chosen=Candidate(action=t.action, effect=t.effect, replaces=t.replaces, fit=t.fitted.fit,
+                                      delta_bic=t.delta_bic, error=t.error, flags=t.flags))
         result = dataclasses.replace(result, steps=(first,) + result.steps)
     return diagnosis_outcome(base, result, follow)
 

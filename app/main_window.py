@@ -10,20 +10,20 @@ from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTa
 
 from app import style
 from app.archive.page import ArchivePage
-from app.job_book import failure_text
 from app.job_controls import JobControls
 from app.large_signal.page import LargeSignalPage
 from app.menus import Menus
 from app.model_lab.page import ModelLab
-from app.placeholders import PlaceholderPage
 from app.production.page import ProductionPage
 from app.qa_view import QAView
 from app.results_view import ResultsView
 from app.series_page import SeriesPage
 from app.settings import Settings
+from app.unfinished import ask_unfinished, offer_unfinished
 from app.staged_fanout import StagedFanOut
 from app.window_fit import fit_window
 from app.wizard import MeasureWizard
+from app.wizard.archive_meta import measurement_meta
 from app.workers import AnalysisOutcome, AnalysisWorker
 
 RECORDING_SUFFIXES = (".wav", ".json")
@@ -98,7 +98,7 @@ class MainWindow(QMainWindow):
         self.pages = QTabWidget()
         self.pages.setDocumentMode(True)
         for name in PAGE_ORDER:
-            self.pages.addTab(built[name] if name in built else PlaceholderPage(name), name)
+            self.pages.addTab(built[name], name)
         # A first start (no window saved yet) opens on the wizard's first step: a newcomer starts by measuring.
         first_start = self.settings.window_geometry()[0] is None
         self.pages.setCurrentWidget(self.wizard if first_start else self.results)
@@ -287,14 +287,7 @@ class MainWindow(QMainWindow):
 
     def _store_measured(self, outcome) -> None:
         """Into the archive, in its worker. Whatever happens there, the recording stays where it was written."""
-        request = outcome.request
-        driver = request.driver
-        meta = {"driver": driver.name, "serial": driver.serial,
-                "operator": driver.operator, "station": driver.station,
-                "settings": {"template": request.template.as_json(), "level_v_rms": request.level_v,
-                             "level_reason": request.level_reason, "hardware": request.hardware.describe()},
-                "calibration": {"corrections": request.corrections.to_dict()}}
-        self.archive.store_measurement(outcome.path, outcome.analysis.result, meta)
+        self.archive.store_measurement(outcome.path, outcome.analysis.result, measurement_meta(outcome.request))
 
     @Slot(str, str)
     def on_archived(self, measurement_id: str, recording: str) -> None:
@@ -325,44 +318,14 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def offer_unfinished(self, directory: Path | None = None) -> list[str]:
-        """Offer each measurement whose process died before writing it: keep it, analyse it, or discard it.
-
-        instruments.measurement.recovery finds them (a journal whose process is gone) and turns one into a
-        recording marked partial. Returns the choices made, in order (for tests and the log).
-        """
-        from instruments.measurement.recovery import discard, find_unfinished, recover
-        choices = []
-        for unfinished in find_unfinished(directory or self.measurement_folder()):
-            choice = self.ask_unfinished(unfinished)
-            choices.append(choice)
-            try:
-                if choice in ("keep", "analyse"):
-                    path = recover(unfinished)
-                    self.status_label.setText(f"Kept the unfinished measurement as {path}")
-                    if choice == "analyse":
-                        self.open_path(path)
-                elif choice == "discard":
-                    discard(unfinished)
-            except Exception as exc:  # noqa: BLE001 - the GUI's error boundary (job_book.failure_text)
-                self.show_error(f"Cannot recover {unfinished.name}",
-                                failure_text(exc, f"recovering {unfinished.name}"))
-        return choices
+        """Offer each measurement whose process died before writing it: keep it, analyse it, or discard it
+        (app.unfinished). Returns the choices made, in order (for tests and the log)."""
+        return offer_unfinished(directory or self.measurement_folder(), ask=self.ask_unfinished,
+                                open_path=self.open_path, say=self.status_label.setText, show_error=self.show_error)
 
     def ask_unfinished(self, unfinished) -> str:
         """'analyse', 'keep', 'discard' or 'later' (asked again at the next start)."""
-        box = QMessageBox(QMessageBox.Question, "Unfinished measurement",
-                          "A measurement was cut short (the program stopped before writing it):\n\n"
-                          f"{unfinished.describe()}", parent=self)
-        buttons = {}
-        if not unfinished.problem:
-            buttons[box.addButton("Keep and analyse", QMessageBox.AcceptRole)] = "analyse"
-            buttons[box.addButton("Keep", QMessageBox.ApplyRole)] = "keep"
-        buttons[box.addButton("Discard", QMessageBox.DestructiveRole)] = "discard"
-        later = box.addButton("Later", QMessageBox.RejectRole)
-        buttons[later] = "later"
-        box.setDefaultButton(later)
-        box.exec()
-        return buttons.get(box.clickedButton(), "later")
+        return ask_unfinished(self, unfinished)
 
     # -- slots of the menus ------------------------------------------------
     @Slot()

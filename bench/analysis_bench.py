@@ -6,7 +6,7 @@ import sys
 import tracemalloc
 from pathlib import Path
 
-from bench.common import Row, at_most, median_time, standard_recording
+from bench.common import Row, at_most, child_times, median_time, standard_recording
 
 
 def run(workdir: Path) -> list[Row]:
@@ -29,6 +29,7 @@ def run(workdir: Path) -> list[Row]:
     cmd = [sys.executable, "-m", "app.cli", "analyze", str(path), "--json"]
     t_process = median_time(lambda: subprocess.run(cmd, check=True, capture_output=True), repeats=5)
     rows.append(at_most("whole 'linpar analyze' process", t_process, "s", 1.5))
+    rows += startup_rows(path)
 
     rec = read_recording(path)
     samples = rec.data.size
@@ -76,6 +77,23 @@ def model_part_rows(standard: Path) -> list[Row]:
                     median_time(lambda: model_uncertainty(analyze_recording(woofer)), repeats=3, warmup=0), "s",
                     "", None))
     return rows
+
+
+# The floor of `linpar analyze`: a process that reads the recording and takes its FFTs, and nothing else.
+FLOOR = ("import sys\n"
+         "from analysis.recording.format import read_recording\n"
+         "from analysis.spectra import estimate_spectra\n"
+         "estimate_spectra(read_recording(sys.argv[1]))")
+
+
+def startup_rows(path: Path) -> list[Row]:
+    """`linpar analyze REC --json` as a whole process against the floor (issue 28: at most 1.3 times it), in CPU
+    time (user + sys of the child: what an idle machine's wall time would be) and in wall time."""
+    floor_cpu, floor_wall = child_times([sys.executable, "-c", FLOOR, str(path)])
+    cpu, wall = child_times([sys.executable, "-m", "app.cli", "analyze", str(path), "--json"])
+    return [at_most("whole 'linpar analyze --json' / read+FFT floor, CPU time", cpu / floor_cpu, "x", 1.3),
+            Row(f"  CPU {cpu:.2f} s against {floor_cpu:.2f} s; wall {wall:.2f} s against {floor_wall:.2f} s",
+                wall / floor_wall, "x", "", None)]
 
 
 def diagnosis_rows(clean_data) -> list[Row]:

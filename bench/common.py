@@ -1,7 +1,9 @@
 """Shared bits of the benchmarks: timing, rows, the standard recording."""
 from __future__ import annotations
 
+import os
 import statistics
+import subprocess
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,6 +36,23 @@ def median_time(fn: Callable[[], object], repeats: int = 5, warmup: int = 1,
         fn()
         times.append(clock() - t0)
     return statistics.median(times)
+
+
+def child_times(cmd: list[str], repeats: int = 5) -> tuple[float, float]:
+    """Median (CPU seconds, wall seconds) of running `cmd` as a child process. The CPU time is the child's user +
+    system time (its threads and the children it waited for, from wait4): on a machine shared with others it is
+    what the wall time would be on an idle one, where the wall time measures the others too."""
+    cpu, wall = [], []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(child.pid, 0)
+        wall.append(time.perf_counter() - t0)
+        cpu.append(usage.ru_utime + usage.ru_stime)
+        if status != 0:
+            raise RuntimeError(f"{' '.join(cmd)}: exit status {status}: {child.stderr.read().decode()[-500:]}")
+        child.stderr.close()
+    return statistics.median(cpu), statistics.median(wall)
 
 
 def at_most(name: str, value: float, unit: str, limit: float) -> Row:

@@ -122,8 +122,10 @@ def log_thinned(freqs: np.ndarray, per_decade: int | None) -> np.ndarray:
     return keep
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class CurveAnalysis:
+    """Imported curves' fit: `report()` is the text `linpar analyze --impedance ...` prints, `as_json()` its JSON."""
+
     fit: FitResult
     parameters: dict[str, ParameterValue]
     sd_m2: float | None
@@ -139,6 +141,13 @@ class CurveAnalysis:
     @property
     def model(self) -> Model:
         return self.fit.model
+
+    def report(self) -> str:
+        from analysis.result_text import format_curve_result
+        return format_curve_result(self)
+
+    def as_json(self) -> dict:
+        return curve_json(self)
 
 
 def magnitude_only(impedance: TransferFunction, hx: TransferFunction | None) -> bool:
@@ -191,8 +200,9 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
     if f_range.z_f_max is None and f_range.z_max_over_fs is not None:
         other_bands = tuple(curve_data(impedance, hx, dataclasses.replace(f_range, z_max_over_fs=k))[0]
                             for k in OTHER_Z_BANDS_OVER_FS if k != f_range.z_max_over_fs)
-    return CurveAnalysis(fit, parameter_table(fit, sd_m2), sd_m2, ranges, validity, tuple(notes), data,
-                         magnitude_only(impedance, hx), other_bands)
+    return CurveAnalysis(fit=fit, parameters=parameter_table(fit, sd_m2), sd_m2=sd_m2, ranges=ranges,
+                         validity=validity, notes=tuple(notes), data=data,
+                         model_part_always=magnitude_only(impedance, hx), other_bands=other_bands)
 
 
 def _admissible(fit: FitResult, data: FitData, notes: list[str]) -> FitResult:

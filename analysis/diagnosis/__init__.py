@@ -14,6 +14,7 @@ from analysis.lazy_exports import lazy_exports
 _HOME = {
     "MIN_BIC_GAIN": "candidates",
     "MAX_STEPS": "candidates",
+    "Action": "candidates",
     "Candidate": "candidates",
     "Step": "candidates",
     "Diagnosis": "candidates",

@@ -21,6 +21,7 @@ import dataclasses
 import threading
 from concurrent.futures import Executor
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Callable
 
 import numpy as np
@@ -46,13 +47,21 @@ SCREENS_PER_TASK = 5
 # every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.
 FAR_CHI2 = 100.0
 
-__all__ = ["MIN_BIC_GAIN", "MAX_STEPS", "Candidate", "Step", "Diagnosis", "candidate_models", "rank_candidates",
-           "diagnose", "explain"]
+__all__ = ["MIN_BIC_GAIN", "MAX_STEPS", "Action", "Candidate", "Step", "Diagnosis", "candidate_models",
+           "rank_candidates", "diagnose", "explain"]
 
 
-@dataclass(frozen=True)
+class Action(StrEnum):
+    """A candidate's move: an effect of a category the model lacks added, or the model's one of its category
+    replaced (str-valued: the JSON says "add" or "replace")."""
+
+    ADD = "add"
+    REPLACE = "replace"
+
+
+@dataclass(frozen=True, kw_only=True)
 class Candidate:
-    action: str                  # "add" or "replace"
+    action: Action
     effect: Effect
     replaces: Effect | None
     fit: FitResult | None        # None when the refit failed
@@ -70,7 +79,7 @@ class Candidate:
         return self.assessment is not None and self.assessment.accepted
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Step:
     fit: FitResult
     candidates: tuple[Candidate, ...]   # ranked, best first, from this step's model
@@ -79,8 +88,11 @@ class Step:
     flags: tuple[Flag, ...] = ()        # of this step's model (and the step cap on the last one)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Diagnosis:
+    """The greedy path from a start model, its first candidates ranked and the sites of what is left
+    (analysis.diagnosis.result.DiagnosisResult adds the recording's words, its text and its JSON)."""
+
     steps: tuple[Step, ...]
     sites: tuple[SiteResult, ...] = ()   # of the final model, best first
     step_cap_reached: bool = False
@@ -115,7 +127,7 @@ class Diagnosis:
 
 
 def candidate_models(model: Model, effects: tuple[Effect, ...] | None = None
-                     ) -> list[tuple[str, Effect, Effect | None, Model]]:
+                     ) -> list[tuple[Action, Effect, Effect | None, Model]]:
     """Every model one move away: add an effect of a new category, or swap one within its category.
 
     `effects`: what may be tried (default: the catalogue and the registered effects of the user's own).
@@ -130,10 +142,10 @@ def candidate_models(model: Model, effects: tuple[Effect, ...] | None = None
         current = present.get(effect.category)
         try:
             if current is None:
-                moves.append(("add", effect, None, model.with_effects(model.effects + (effect,))))
+                moves.append((Action.ADD, effect, None, model.with_effects(model.effects + (effect,))))
             elif current.id != effect.id:
                 swapped = tuple(effect if e is current else e for e in model.effects)
-                moves.append(("replace", effect, current, model.with_effects(swapped)))
+                moves.append((Action.REPLACE, effect, current, model.with_effects(swapped)))
         except ModelError:
             continue
     return moves
@@ -239,9 +251,9 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     for index, (action, effect, replaces, _) in enumerate(moves):
         fit, error = outcomes[index]
         flags = acceptance.candidate_flags(current, fit, effect)
-        candidates.append(Candidate(action, effect, replaces, fit,
-                                    (fit.bic - current.bic) if fit else float("inf"), error, flags,
-                                    acceptance.assess(current, fit, effect, flags)))
+        candidates.append(Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
+                                    delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
+                                    flags=flags, assessment=acceptance.assess(current, fit, effect, flags)))
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
 
 
@@ -326,7 +338,8 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
         ranked = rank_candidates(data, current, executor, cancel)
         sites = _SiteFits(data, current, executor)
         ranked, best = choose(current, ranked, sites)
-        steps.append(Step(current, ranked, residuals.describe(current), best, _model_flags(current)))
+        steps.append(Step(fit=current, candidates=ranked, residual=residuals.describe(current), chosen=best,
+                          flags=_model_flags(current)))
         if best is None or not follow:
             break
         current = best.fit
@@ -335,9 +348,10 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
             cap = Flag(acceptance.STEP_CAP, f"the path stopped at its cap of {max_steps} step(s): the last model "
                                             "was not ranked further")
             sites = _SiteFits(data, current, executor)
-            steps.append(Step(current, (), residuals.describe(current), None, _model_flags(current) + (cap,)))
+            steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current), chosen=None,
+                              flags=_model_flags(current) + (cap,)))
             break
-    result = Diagnosis(tuple(steps), (), capped)
+    result = Diagnosis(steps=tuple(steps), step_cap_reached=capped)
     if not locate:
         return result
     if progress:

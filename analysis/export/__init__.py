@@ -8,12 +8,14 @@ EXPORTERS, found by the registry (registry.py): a new format is one module.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
-from analysis.archive.atomic import write_atomic
-from analysis.archive.results import StoredResult
 from analysis.export.curves import ExportError
 from analysis.export.registry import Exporter, exporters
+from analysis.files import write_atomic
+
+if TYPE_CHECKING:      # a type only: listing the formats (the CLI's parser) loads no archive
+    from analysis.archive.results import StoredResult
 
 
 def export_bytes(kind: str, result: StoredResult, header: Mapping | None = None) -> bytes:

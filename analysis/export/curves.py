@@ -16,15 +16,17 @@ SPL_VOLTAGE), which needs Hx (the laser) and Sd.
 """
 from __future__ import annotations
 
-from typing import Iterable, Mapping
+from typing import TYPE_CHECKING, Iterable, Mapping
 
 import numpy as np
 
-from analysis.archive.results import StoredResult
 from analysis.errors import LinparError
 from analysis.export.registry import Exporter
 from analysis.session import trace_line
 from analysis.spl import predicted_spl
+
+if TYPE_CHECKING:      # a type only: listing the formats (the CLI's parser) loads no archive
+    from analysis.archive.results import StoredResult
 
 MODEL_PER_DECADE = 100
 SPL_VOLTAGE = 2.83

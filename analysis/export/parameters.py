@@ -22,12 +22,14 @@ from __future__ import annotations
 import csv
 import io
 import json
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
-from analysis.archive.results import StoredResult
 from analysis.export.registry import Exporter
 from analysis.session import comment_lines
 from analysis.text_boundary import spreadsheet_cell
+
+if TYPE_CHECKING:      # a type only: listing the formats (the CLI's parser) loads no archive
+    from analysis.archive.results import StoredResult
 
 JSON_FORMAT = "linpar-parameters/1"
 CSV_COLUMNS = ("parameter", "value", "std", "unit", "display_value", "display_std", "display_unit", "note",

@@ -104,13 +104,15 @@ from __future__ import annotations
 import math
 import re
 from decimal import Decimal
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
-from analysis.archive.results import StoredResult
 from analysis.derived import C_SOUND, RHO
 from analysis.export.registry import Exporter
+
+if TYPE_CHECKING:      # a type only: listing the formats (the CLI's parser) loads no archive
+    from analysis.archive.results import StoredResult
 
 ENCODING = "utf-8"
 NEWLINE = "\r\n"

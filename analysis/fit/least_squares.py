@@ -22,7 +22,7 @@ from __future__ import annotations
 import functools
 import keyword
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping
 
 import lmfit
@@ -103,7 +103,7 @@ class ChannelFit:
         return (self.model - self.measured) / (self.std / np.sqrt(2.0))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class FitResult:
     model: Model
     values: dict[str, float]
@@ -117,7 +117,6 @@ class FitResult:
     message: str
     nfev: int
     noise_known: bool = True      # False: weights are relative, uncertainties come from the scatter
-    extras: dict = field(default_factory=dict)
     method: str = "joint"         # how it was identified (analysis.fit.methods)
 
     @property
@@ -396,5 +395,6 @@ def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], 
     if covar is not None:
         for i, name in enumerate(varying):
             stderr[name] = float(np.sqrt(covar[i, i])) if covar[i, i] >= 0 else None
-    return FitResult(model, values, stderr, varying, covar, channels, chi2, n_total, success, message, nfev,
-                     noise_known, method=method)
+    return FitResult(model=model, values=values, stderr=stderr, varying=varying, covar=covar, channels=channels,
+                     chi2=chi2, n_data=n_total, success=success, message=message, nfev=nfev, noise_known=noise_known,
+                     method=method)

@@ -3,7 +3,7 @@
 The mechanism every way of analysing a recording shares (analysis.pipeline,
 the measurement's analysis step, the GUI), in three steps:
 
-1. `fit_channels(validity)`: the channels are judged before anything is
+1. `unusable_channels(validity)`: the channels are judged before anything is
    fitted. A channel with no signal, or that copies another (a wiring
    fault), carries nothing to fit. The impedance needs the voltage and the
    current; without it nothing is fitted, and the result keeps its judged
@@ -58,8 +58,9 @@ MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar dia
 
 
 @dataclass(frozen=True, slots=True)
-class FitChannels:
-    """What can be fitted: None where a channel can be used, else why it cannot (a finding and its remedy)."""
+class UnusableChannels:
+    """Which channels cannot be fitted, and why: None where a channel can be used, else the reason (a finding
+    and its remedy). `unusable.impedance is not None` reads as it means: the impedance is unusable."""
 
     impedance: str | None
     displacement: str | None       # None also when the recording has no displacement at all
@@ -75,13 +76,13 @@ def _unusable(validity: Validity, name: str) -> str | None:
     return None
 
 
-def fit_channels(validity: Validity) -> FitChannels:
+def unusable_channels(validity: Validity) -> UnusableChannels:
     impedance = _unusable(validity, "voltage") or _unusable(validity, "current")
     displacement = _unusable(validity, "displacement")
     if impedance is None and displacement is None:
-        return FitChannels(None, None)
-    return FitChannels(impedance and f"the impedance cannot be fitted: {impedance}",
-                       displacement and f"the displacement cannot be used: {displacement}")
+        return UnusableChannels(None, None)
+    return UnusableChannels(impedance and f"the impedance cannot be fitted: {impedance}",
+                            displacement and f"the displacement cannot be used: {displacement}")
 
 
 def misfit_findings(fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS) -> dict[str, list[Finding]]:

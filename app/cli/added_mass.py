@@ -5,10 +5,10 @@ import argparse
 
 from analysis.bounds import ADDED_MASS_G
 from analysis.model.defaults import ADDED_MASS_EFFECTS
+from analysis.result_text import format_value
 from app.cli.curves import add_range_options, fit_range
 from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects
 from app.cli.output import print_json
-from app.cli.result_text import format_value
 
 
 def register(sub) -> None:

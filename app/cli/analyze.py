@@ -6,7 +6,6 @@ import argparse
 from app.cli import curves, effects
 from app.cli.options import add_json_option, add_method_option, add_model_option, add_sd_option, model_effects
 from app.cli.output import print_json
-from app.cli.result_text import format_result
 
 EXIT_QA_FAIL = 1
 
@@ -36,19 +35,17 @@ def run(args: argparse.Namespace) -> int:
 
 def analyze_recording(args: argparse.Namespace) -> int:
     from analysis import limits as qa
-    from analysis.fit.model_uncertainty import model_uncertainty
-    from analysis.pipeline import analyze_path, result_json
+    from analysis.api import analyze
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
-    # The model part of each uncertainty (refits when the model misses the data by more than its noise).
-    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model),
-                                            method=args.method or "joint"))
-    doc = result_json(result)
+    # With the model part of each uncertainty (refits when the model misses the data by more than its noise).
+    result = analyze(args.path, sd_m2=args.sd, effects=model_effects(args.model), method=args.method or "joint")
+    doc = result.as_json()
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)
     if args.json:
         print_json(doc)
     else:
-        print(format_result(result))
+        print(result.report())
         if limits is not None:
             print("\n" + qa.format_verdicts(limits, result.parameters, result.validity))
     if limits is None:

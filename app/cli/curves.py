@@ -8,9 +8,9 @@ from __future__ import annotations
 import argparse
 
 from analysis.bounds import FREQUENCY
+from analysis.result_text import format_result
 from app.cli.options import CliError, model_effects, number
 from app.cli.output import print_json
-from app.cli.result_text import format_result
 
 CURVE_OPTIONS = ("impedance", "uiv")
 # Options that mean something for imported curves only: with a recording they are refused, not ignored.

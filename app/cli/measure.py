@@ -58,7 +58,6 @@ from app.cli.devices import LASER_ANALOG, say
 from app.cli.options import (CliError, add_json_option, add_model_option, add_sd_option, model_effects, name_text,
                              number)
 from app.cli.output import print_json
-from app.cli.result_text import format_result
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
 EXIT_NOT_STORED, EXIT_INTERRUPTED = 3, 130
@@ -107,7 +106,6 @@ def run(args: argparse.Namespace) -> int:
     """One measurement (the single plan), or the large-signal plan's steps (app.cli.large_signal)."""
     if args.plan == "large-signal":
         return large_signal.run_plan(args)
-    from analysis.pipeline import result_json
     from instruments.measurement.recovery import find_unfinished, run_journaled
     from instruments.measurement.runner import MeasurementCancelled
 
@@ -162,12 +160,12 @@ def run(args: argparse.Namespace) -> int:
     archived = None if args.no_archive else _store(args, outcome, plan, measured_at)
     result = outcome.result
     if args.json:
-        doc = result_json(result)
+        doc = result.as_json()
         if archived is not None:
             doc = {**doc, "archive": archived}
         print_json(doc)
     else:
-        print(format_result(result))
+        print(result.report())
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
 
 

@@ -20,7 +20,6 @@ from pathlib import Path
 from app.cli import output
 from app.cli.options import CliError, add_json_option
 from app.cli.output import print_json
-from app.cli.result_text import format_result
 
 
 def register(sub) -> None:
@@ -93,12 +92,12 @@ def _list(found: dict, folder: Path, as_json: bool) -> int:
 
 
 def _analysis(wav: Path, as_json: bool):
-    from analysis.pipeline import analyze_path, result_json
+    from analysis.pipeline import analyze_path
     result = analyze_path(wav)
     if as_json:
-        return result_json(result)
+        return result.as_json()
     print(f"{wav}:")
-    print(format_result(result))
+    print(result.report())
     return None
 
 

@@ -15,6 +15,7 @@ _HOME = {
     "ChiSquareChart": "page",
     "EMPTY_TEXT": "page",
     "EffectCatalogue": "page",
+    "LabSession": "session",
     "LabVersion": "page",
     "ModelLab": "page",
     "ResidualPanel": "page",

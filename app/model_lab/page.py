@@ -10,14 +10,12 @@ already. The current version is handed back to the Results page
 """
 from __future__ import annotations
 
-import dataclasses
 import html
 from pathlib import Path
 
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
 
-from analysis.derived import parameter_table
 from analysis.diagnosis import acceptance, residuals
 from analysis.errors import LinparError
 from analysis.fit.least_squares import FitData
@@ -30,6 +28,7 @@ from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
 from app.model_lab.sites import SitePanel
+from app.model_lab.session import LabSession
 from app.model_lab.versions import LabVersion, changed_model, move_text
 from app.parameter_table import titled_parameter_table
 from app.result_curves import result_curves
@@ -49,11 +48,7 @@ class ModelLab(QWidget):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.worker = LabWorker(self)
-        self.base: AnalysisResult | None = None     # the recording as the Results page analysed it
-        self.data: FitData | None = None
-        self.versions: list[LabVersion] = []
-        self.diagnosis: DiagnosisOutcome | None = None
-        self.diagnosis_version = 0                  # the version the shown candidates are one move from
+        self.session = LabSession()                 # the recording, the versions, the diagnosis (no Qt)
         self.new_effect_dialog = None               # the "New effect…" dialog while it is open
 
         self.empty = QLabel(EMPTY_TEXT)
@@ -125,10 +120,26 @@ class ModelLab(QWidget):
         self.candidates.selected_changed.connect(self.on_candidate_selected)
         self._update_buttons()
 
-    # -- state -------------------------------------------------------------
+    # -- state (the session's) ----------------------------------------------
+    @property
+    def base(self) -> AnalysisResult | None:
+        return self.session.base
+
+    @property
+    def data(self) -> FitData | None:
+        return self.session.data
+
+    @property
+    def versions(self) -> list[LabVersion]:
+        return self.session.versions
+
+    @property
+    def diagnosis(self) -> DiagnosisOutcome | None:
+        return self.session.diagnosis
+
     @property
     def current(self) -> LabVersion | None:
-        return self.versions[-1] if self.versions else None
+        return self.session.current
 
     @property
     def busy(self) -> bool:
@@ -137,20 +148,17 @@ class ModelLab(QWidget):
     @Slot(object)
     def set_result(self, result: AnalysisResult) -> None:
         """A result from the Results page: a new recording restarts the lab from its model."""
-        if self.base is not None and result.spectra is self.base.spectra:
+        if self.session.is_same_recording(result):
             # The same recording: the Results page shows one of our versions, or Sd was edited.
-            self._sync_sd(result.sd_m2)
+            if self.session.set_sd(result.sd_m2):
+                self._show_parameters()
             return
         self.jobs.drop()
+        self.session.restart(result)
         if result.fit is None:          # a broken measurement: nothing the lab could start from
-            self.base, self.data, self.versions = None, None, []
             self.empty.setText(f"Nothing to model: {result.not_fitted}")
             self.stack.setCurrentWidget(self.empty)
             return
-        self.base = result
-        self.data = FitData.from_spectra(result.spectra)
-        self.versions = []
-        self.diagnosis, self.diagnosis_version = None, 0
         self.candidates.set_outcome(None)
         self.site_panel.set_sites(())
         self.views.setCurrentWidget(self.chart)
@@ -166,27 +174,10 @@ class ModelLab(QWidget):
         self.jobs.drop()
         return self.worker.shutdown(wait_ms)
 
-    def _sync_sd(self, sd_m2: float | None) -> None:
-        if self.base is None or sd_m2 == self.base.sd_m2:
-            return
-        self.base = dataclasses.replace(self.base, sd_m2=sd_m2)
-        version = self.versions[-1]
-        self.versions[-1] = dataclasses.replace(version, fitted=self._with_sd(version.fitted))
-        self._show_parameters()
-
-    def _with_sd(self, fitted: LabFit) -> LabFit:
-        """`fitted` with the lab's current Sd (it feeds derived parameters only; milliseconds)."""
-        if fitted.result.sd_m2 == self.base.sd_m2:
-            return fitted
-        result = dataclasses.replace(fitted.result, sd_m2=self.base.sd_m2,
-                                     parameters=parameter_table(fitted.fit, self.base.sd_m2))
-        return dataclasses.replace(fitted, result=result)
-
     def _add_version(self, fitted: LabFit, how: str, adopt: bool = True, announce: bool = True) -> LabVersion:
-        version = LabVersion(len(self.versions) + 1, self._with_sd(fitted), how)
-        self.versions.append(version)
+        version = self.session.add(fitted, how)
         self._show_current()
-        if self.diagnosis is not None and self.diagnosis_version != version.number:
+        if self.diagnosis is not None and not self.session.diagnosis_is_current:
             self.candidates.mark_stale(version.number)
             self.site_panel.mark_stale(version.number)
         if adopt and announce:
@@ -266,7 +257,7 @@ class ModelLab(QWidget):
 
     def _diagnosed_site(self):
         """The site the diagnosis of the current version named first (None: no diagnosis, or no site needed)."""
-        if self.diagnosis is None or self.current is None or self.diagnosis_version != self.current.number:
+        if not self.session.diagnosis_is_current:
             return None
         sites = self.diagnosis.sites
         return sites[0].site if sites and self.site_panel.shown_site else None
@@ -290,7 +281,7 @@ class ModelLab(QWidget):
         if self.current is None or self.busy:
             return
         taken = None
-        if self.diagnosis is not None and self.diagnosis_version == self.current.number:
+        if self.session.diagnosis_is_current:
             taken = self.diagnosis.chosen     # ranked already: the path goes on from the one it would take
         self._run(self.worker.diagnose(self.base, self.data, self.current.fitted.fit, follow=True, taken=taken),
                   f"Following the greedy path from version {self.current.number}…",
@@ -327,7 +318,7 @@ class ModelLab(QWidget):
             last = step == len(outcome.path)
             self._add_version(fitted, f"greedy path from version {start}, step {step}: "
                                       f"{move_text(previous, fitted.fit.model)}", announce=last)
-        self.diagnosis, self.diagnosis_version = outcome, self.current.number
+        self.session.diagnosed(outcome)
         self.candidates.set_outcome(outcome, self.current.number, self.current.effects)
         self.site_panel.set_sites(outcome.sites)
         if outcome.verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED) and self.site_panel.shown_site:

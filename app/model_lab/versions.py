@@ -2,10 +2,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from analysis.effects import get_effect
 from analysis.model.composed import Model
-from app.lab_worker import LabFit
+
+if TYPE_CHECKING:       # a type only: the versions (and app.model_lab.session) import no Qt
+    from app.lab_worker import LabFit
 
 
 @dataclass(frozen=True, slots=True)

@@ -39,6 +39,7 @@ import threading
 import time
 from dataclasses import dataclass
 from datetime import datetime
+from enum import StrEnum
 from pathlib import Path
 from typing import Any, Callable, Sequence
 
@@ -89,7 +90,18 @@ class MeasurementProgress:
     message: str = ""
 
 
-@dataclass(frozen=True)
+class EndedBy(StrEnum):
+    """How a measurement ended (str-valued: the sidecar's "ended_by" reads the same as before)."""
+
+    COMPLETE = "complete"
+    CANCELLED = "cancelled"
+    LASER = "laser"
+    XRUN = "xrun"
+    AUDIO = "audio"
+    CRASH = "crash"             # written from the journal after a crash (instruments.measurement.recovery)
+
+
+@dataclass(frozen=True, kw_only=True)
 class MeasurementOutcome:
     recording_path: Path | None      # NAME.wav; None when fewer than 2 whole periods were captured
     raw_path: Path | None            # NAME.laser.npz, with the serial laser
@@ -97,7 +109,7 @@ class MeasurementOutcome:
     result: AnalysisResult | None    # None for a partial measurement (or analyse=False)
     periods: int
     partial: bool
-    ended_by: str                    # "complete" | "cancelled" | "laser" | "xrun" | "audio"
+    ended_by: EndedBy
     message: str                     # one line; "" when complete
     alignment: dict | None = None
 
@@ -172,16 +184,16 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
     aligned, laser_info, raw_path = None, None, None
     if reader is not None:
         report("aligning", captured.n_periods)
-        if ended_by == "complete" and reader.failure:
-            ended_by, message = "laser", reader.failure
+        if ended_by is EndedBy.COMPLETE and reader.failure:
+            ended_by, message = EndedBy.LASER, reader.failure
         aligned, align_problem = _align(blocks, timed, starts, plan, audio.sample_rate, multitone.excited_bins)
-        if align_problem and ended_by == "complete":
-            ended_by, message = "laser", align_problem
+        if align_problem and ended_by is EndedBy.COMPLETE:
+            ended_by, message = EndedBy.LASER, align_problem
         laser_info = _laser_info(reader, aligned, audio.sample_rate, plan)
     live.emit_ready()
     n_kept = captured.n_periods if aligned is None else aligned.periods
     report("writing", n_kept)
-    partial = ended_by != "complete"
+    partial = ended_by is not EndedBy.COMPLETE
     recording = _recording(captured, aligned, n_kept, multitone.excited_bins, plan, audio, laser_info, ended_by,
                            message, serial)
     if reader is not None:
@@ -192,8 +204,9 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
     wav_path = write_recording(stem, recording)[0] if recording is not None else None
     if wav_path is not None:
         recording = read_recording(wav_path)      # what is analysed is what is on disk, as `linpar analyze` reads it
-    outcome = MeasurementOutcome(wav_path, raw_path, recording, None, n_kept, partial, ended_by, message,
-                                 None if aligned is None else laser_info.get("alignment"))
+    outcome = MeasurementOutcome(recording_path=wav_path, raw_path=raw_path, recording=recording, result=None,
+                                 periods=n_kept, partial=partial, ended_by=ended_by, message=message,
+                                 alignment=None if aligned is None else laser_info.get("alignment"))
     if partial:
         kept = (f"{n_kept} whole period(s) kept in {wav_path}" if wav_path else
                 f"{n_kept} whole period(s) captured, too few for a recording (2 needed)")
@@ -201,7 +214,7 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
             kept += f" (of {captured.n_periods} captured, the laser's stream covers {n_kept})"
         if raw_path is not None:
             kept += f"; raw laser stream in {raw_path}"
-        error = MeasurementCancelled if ended_by == "cancelled" else MeasurementFailed
+        error = MeasurementCancelled if ended_by is EndedBy.CANCELLED else MeasurementFailed
         raise error(f"{message}; {kept} (marked partial)", outcome)
     result = None
     if analyse:
@@ -209,8 +222,7 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
         result = analyse_measurement(recording, effects=default_effects(serial) if effects is None else effects,
                                      cancel=cancel)
     report("done", n_kept)
-    return MeasurementOutcome(wav_path, raw_path, recording, result, n_kept, False, "complete", "",
-                              outcome.alignment)
+    return dataclasses.replace(outcome, result=result)
 
 
 def default_effects(serial_laser: bool) -> tuple:
@@ -243,21 +255,21 @@ def _capture(timed: TimedAudio, multitone, plan: MeasurementPlan, on_capture) ->
 
 
 def _how_it_ended(failure: str | None, reader: LaserReader | None, timed: TimedAudio,
-                  cancel: threading.Event | None) -> tuple[str, str]:
+                  cancel: threading.Event | None) -> tuple[EndedBy, str]:
     if failure is None:
-        return "complete", ""
+        return EndedBy.COMPLETE, ""
     if reader is not None and reader.failure:
-        return "laser", f"the laser failed: {reader.failure}"
+        return EndedBy.LASER, f"the laser failed: {reader.failure}"
     if timed.xrun_at is not None:
-        return "xrun", (f"the audio driver reported an xrun at input sample {timed.xrun_at} (samples lost or "
+        return EndedBy.XRUN, (f"the audio driver reported an xrun at input sample {timed.xrun_at} (samples lost or "
                         f"invented): the measurement ended, as the driver left its steady state and the audio "
                         f"clock jumped; close other programs or raise the audio buffer, and measure again")
     if cancel is not None and cancel.is_set():
-        return "cancelled", "the measurement was cancelled"
+        return EndedBy.CANCELLED, "the measurement was cancelled"
     if failure == "cancelled":
-        return "cancelled", "the measurement was stopped"
+        return EndedBy.CANCELLED, "the measurement was stopped"
     # capture() ends its message with how many periods it kept; the runner says what it kept itself.
-    return "audio", "the sound card failed: " + _CAPTURE_KEPT.sub("", failure)
+    return EndedBy.AUDIO, "the sound card failed: " + _CAPTURE_KEPT.sub("", failure)
 
 
 def _without_silence(captured: CapturedSignals) -> CapturedSignals:
@@ -354,7 +366,7 @@ def _laser_info(reader: LaserReader, aligned: AlignedDisplacement | None, audio_
 
 
 def _recording(captured: CapturedSignals, aligned: AlignedDisplacement | None, n: int, excited_bins,
-               plan: MeasurementPlan, audio: AudioInterface, laser_info: dict | None, ended_by: str, message: str,
+               plan: MeasurementPlan, audio: AudioInterface, laser_info: dict | None, ended_by: EndedBy, message: str,
                serial: bool) -> Recording | None:
     if n < 2:
         return None

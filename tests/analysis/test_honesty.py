@@ -28,7 +28,8 @@ SD = 0.0133
 def _truth_table() -> dict:
     model = Model(parse_effects(DEFAULT))
     values = dict(PAPER.parameters)
-    exact = FitResult(model, values, {k: 0.0 for k in values}, tuple(values), None, {}, 0.0, 1, True, "", 0)
+    exact = FitResult(model=model, values=values, stderr={k: 0.0 for k in values}, varying=tuple(values), covar=None,
+                      channels={}, chi2=0.0, n_data=1, success=True, message="", nfev=0)
     return parameter_table(exact, SD)
 
 

@@ -9,7 +9,6 @@ import pytest
 from analysis.archive.results import StoredResult, results_document
 from analysis.pipeline import analyze_recording
 from analysis.report import build_report
-from app.cli.result_text import format_result
 from tests.builders import TYPICAL_NOISE, recording
 
 
@@ -39,7 +38,7 @@ def test_the_report_names_the_parts_and_each_curves_fit_error(with_parts):
 
 
 def test_analyze_text_has_noise_and_model_columns_and_the_fit_error(with_parts):
-    text = format_result(with_parts)
+    text = with_parts.report()
     header = text.splitlines()[0]
     assert "noise" in header and "model" in header
     (mms,) = [line for line in text.splitlines() if line.startswith("Mms ")]

@@ -11,13 +11,12 @@ import app.workers
 from analysis.fit.least_squares import FitCancelled
 from analysis.recording.format import RecordingError, read_recording
 from app.main_window import MainWindow
-from app.placeholders import PAGES, PlaceholderPage
 from app.settings import MAX_RECENT
 
 from .conftest import ANALYSIS_TIMEOUT_MS, open_and_wait
 
 
-def test_pages_are_built_and_none_is_a_placeholder(window):
+def test_every_page_is_built(window):
     names = [window.pages.tabText(i) for i in range(window.pages.count())]
     assert names == ["Measure", "Results", "Model lab", "Series", "Large signal", "QA", "Production", "Archive"]
     assert window.pages.widget(0) is window.wizard
@@ -25,8 +24,7 @@ def test_pages_are_built_and_none_is_a_placeholder(window):
     assert window.pages.widget(3) is window.series
     assert window.pages.widget(4) is window.large_signal
     assert window.pages.widget(5) is window.qa
-    assert window.findChildren(PlaceholderPage) == []
-    assert PAGES == {}
+    assert window.pages.widget(6) is window.production and window.pages.widget(7) is window.archive
 
 
 def test_analysis_runs_in_a_worker_thread(qtbot, window, recordings, monkeypatch):

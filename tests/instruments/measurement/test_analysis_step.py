@@ -9,7 +9,8 @@ from instruments.measurement.analysis_step import with_delay_verdict
 def result(displacement_status="green") -> AnalysisResult:
     channels = {name: {"status": "green", "findings": []} for name in ("voltage", "current")}
     channels["displacement"] = {"status": displacement_status, "findings": []}
-    return AnalysisResult(None, None, {}, None, validity={"overall": "green", "channels": channels})
+    return AnalysisResult(spectra=None, fit=None, parameters={}, sd_m2=None,
+                          validity={"overall": "green", "channels": channels})
 
 
 def test_a_delay_the_data_place_changes_no_light_and_is_reported():

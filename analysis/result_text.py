@@ -1,10 +1,11 @@
-"""The text `linpar analyze` (and measure, recover) prints for a fitted recording or imported curves."""
+"""A result's text report: what `AnalysisResult.report()` and `CurveAnalysis.report()` return, and what
+`linpar analyze` (and measure, recover) prints for a fitted recording or imported curves."""
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:        # the analysis loads when a command runs, not for `linpar --help`
+if TYPE_CHECKING:
     from analysis.derived import ParameterValue
 
 
@@ -67,4 +68,16 @@ def format_result(result) -> str:
             lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
     if fit is not None:
         lines += ["", report]           # the fit's own report (analysis.fit.report): correlations, bounds
+    return "\n".join(lines)
+
+
+def format_curve_result(result) -> str:
+    """An analysis.curves.fitting.CurveAnalysis said (not imported here: it imports this module): format_result's
+    text, then the band each curve was fitted over, the fit errors and the notes on the curves (how far to
+    trust numbers no validity check has judged)."""
+    ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
+    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity["fit_error_percent"].items())
+    lines = [format_result(result), f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)",
+             f"note: {result.validity['note']}; {result.validity['uncertainties']}"]
+    lines += [f"  {note}" for note in result.notes]
     return "\n".join(lines)

@@ -1,0 +1,88 @@
+"""The model lab's session (app.model_lab.session): its versions, Sd and diagnosis, without a window or Qt."""
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from analysis.diagnosis import residuals
+from analysis.effects import parse_effects
+from analysis.fit.least_squares import fit_model
+from analysis.model.composed import Model
+from analysis.pipeline import AnalysisResult, analyze_recording
+from app.lab_worker import LabFit, lab_fit
+from app.model_lab.session import LabSession
+from app.result_curves import result_curves
+from tests.builders import TYPICAL_NOISE, recording
+
+REPO = Path(__file__).resolve().parents[3]
+
+
+def test_the_session_imports_no_qt():
+    code = "import sys, app.model_lab.session\nprint(sorted(m for m in sys.modules if m.startswith('PySide6')))"
+    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
+
+
+@pytest.fixture(scope="module")
+def base() -> AnalysisResult:
+    return analyze_recording(recording(noise=TYPICAL_NOISE, n_periods=2, seed=5))
+
+
+def first_version(result: AnalysisResult) -> LabFit:
+    return LabFit(result, result_curves(result), residuals.describe(result.fit))
+
+
+def test_versions_are_numbered_and_the_last_is_current(base):
+    session = LabSession()
+    assert session.current is None and not session.diagnosis_is_current
+    session.restart(base)
+    assert session.base is base and session.data is not None and session.versions == []
+    first = session.add(first_version(base), "as fitted")
+    textbook = fit_model(session.data, Model(parse_effects("none")))
+    second = session.add(lab_fit(base, textbook), "removed both effects")
+    assert (first.number, second.number) == (1, 2) and session.current is second
+    assert second.effects == "textbook" and second.how == "removed both effects"
+
+
+def test_sd_follows_the_results_page_on_the_current_version(base):
+    session = LabSession()
+    session.restart(base)
+    session.add(first_version(base), "as fitted")
+    vas = session.current.fitted.result.parameters["Vas"].value
+    assert session.set_sd(base.sd_m2) is False                     # unchanged: nothing to redo
+    assert session.is_same_recording(dataclasses.replace(base, sd_m2=0.02))
+    assert session.set_sd(0.02) is True
+    assert session.base.sd_m2 == 0.02 and session.current.fitted.result.sd_m2 == 0.02
+    # Vas grows with Sd squared (Vas = rho c^2 Cms Sd^2).
+    new_vas = session.current.fitted.result.parameters["Vas"].value
+    assert new_vas == pytest.approx(vas * (0.02 / base.sd_m2) ** 2, rel=1e-9)
+    assert session.add(first_version(base), "again").fitted.result.sd_m2 == 0.02     # new versions take it too
+
+
+def test_a_diagnosis_is_current_until_the_next_version(base):
+    session = LabSession()
+    session.restart(base)
+    session.add(first_version(base), "as fitted")
+    session.diagnosed(object())         # what the worker's DiagnosisOutcome is does not matter to the session
+    assert session.diagnosis_is_current and session.diagnosis_version == 1
+    session.add(first_version(base), "refitted")
+    assert session.diagnosis is not None and not session.diagnosis_is_current
+
+
+def test_a_new_recording_restarts_and_a_broken_one_leaves_nothing(base):
+    session = LabSession()
+    session.restart(base)
+    session.add(first_version(base), "as fitted")
+    session.diagnosed(object())
+    other = analyze_recording(recording(noise=TYPICAL_NOISE, n_periods=2, seed=6))
+    assert not session.is_same_recording(other)
+    session.restart(other)
+    assert session.base is other and session.versions == [] and session.diagnosis is None
+    broken = dataclasses.replace(other, fit=None, not_fitted="the current is silent")
+    session.restart(broken)
+    assert session.base is None and session.data is None and session.current is None
