@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (QAbstractButton, QAbstractItemView, QComboBox, QG
 
 from app.fit_quality import DETAILS
 
-from .conftest import ANALYSIS_TIMEOUT_MS, open_and_wait
+from .conftest import analysis_wait_ms, open_and_wait
 from tests.app.wizard.test_wizard_helpers import choose_simulator, run_job, to_hardware
 
 # A Python repr: Name(...) nested, Name(key=...), or <... object at 0x...>.

@@ -20,8 +20,9 @@ from app.archive.page import ROOT_KEY
 from app.archive.table import FIRST_PARAMETER, HEADERS
 from tests.builders import DRIVERS, TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
-from tests.app.conftest import ANALYSIS_TIMEOUT_MS
-from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
+from tests.app.conftest import analysis_wait_ms
+from tests.app.wizard.test_wizard_helpers import job_wait_ms, skip_to_measure
+from tests.pace import wait_ms
 
 # key: (builders driver, driver name, serial, operator, measured_at)
 STORED = {
@@ -103,7 +104,7 @@ def test_the_filter_narrows_the_list_once_the_typing_stops(qtbot, window, archiv
     page = show_page(window)
     qtbot.keyClicks(page.filters.driver_edit, "w18")
     assert len(shown_ids(page)) == 4                      # not yet: the list waits for the typing to stop
-    with qtbot.waitSignal(page.listed, timeout=5000):
+    with qtbot.waitSignal(page.listed, timeout=wait_ms(30)):
         pass
     assert set(shown_ids(page)) == {ids["paper"], ids["red"]}
     page.filters.validity_combo.setCurrentIndex(page.filters.validity_combo.findData("red"))
@@ -258,7 +259,7 @@ def test_a_wizard_measurement_ends_up_in_the_archive(qtbot, window, settings, tm
     wizard.driver_page.operator_edit.setText("ana")
     wizard.driver_page.station_edit.setText("bench 3")
     skip_to_measure(qtbot, wizard, realtime=False, template="midrange")
-    with qtbot.waitSignal(window.archive.stored, timeout=JOB_TIMEOUT_MS) as stored:
+    with qtbot.waitSignal(window.archive.stored, timeout=job_wait_ms()) as stored:
         wizard.measure_page.start_button.click()
     outcome = wizard.state.outcome
     mid, recording_path = stored.args
@@ -291,7 +292,7 @@ def test_a_narrow_window_puts_the_filters_on_two_rows(qtbot, window, archive):
     page = show_page(window)
     assert page.filters.rows == 1
     window.resize(700, 500)               # the page must not set the window's minimum width
-    qtbot.waitUntil(lambda: window.width() == 700)
-    qtbot.waitUntil(lambda: page.filters.rows == 2)
+    qtbot.waitUntil(lambda: window.width() == 700, timeout=wait_ms(5))
+    qtbot.waitUntil(lambda: page.filters.rows == 2, timeout=wait_ms(5))
     assert page.filters.driver_edit.isVisible() and page.filters.until_edit.isVisible()
     assert page.filters.until_edit.geometry().right() <= page.filters.width()

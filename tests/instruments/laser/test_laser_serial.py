@@ -14,6 +14,7 @@ from instruments.laser import LaserError, LaserSpec, concatenate_blocks, open_la
 from instruments.laser.ild1420 import DEFAULT_BAUDRATE, ErrorPlan, LaserErrorCode
 from instruments.laser.ild1420.emulator import LaserEmulator
 from instruments.laser.ild1420.frames import encode_measurements
+from tests.pace import paced
 
 
 def ild1420(port, baudrate=None, **options):
@@ -21,10 +22,10 @@ def ild1420(port, baudrate=None, **options):
     return open_laser(LaserSpec("ild1420", port, baudrate, options=options))
 
 
-def collect(sensor, n, timeout=3.0):
-    """At least n measurements, as one block."""
+def collect(sensor, n, timeout=10.0):
+    """At least n measurements, as one block (`timeout` for an idle machine, at its pace now)."""
     blocks, total = [], 0
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + paced(timeout)
     while total < n:
         assert time.monotonic() < deadline, f"only {total} of {n} measurements arrived"
         block = sensor.read_block(0.2)
@@ -34,10 +35,10 @@ def collect(sensor, n, timeout=3.0):
     return concatenate_blocks(blocks)
 
 
-def drain_until_lost(sensor, timeout=3.0, blocks=None):
+def drain_until_lost(sensor, timeout=10.0, blocks=None):
     """(counters of ``blocks`` and of all blocks still to come, the error text)."""
     blocks = list(blocks or [])
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + paced(timeout)
     with pytest.raises(LaserError, match="laser link lost") as lost:
         while True:
             assert time.monotonic() < deadline, "the lost link was never reported"
@@ -229,7 +230,7 @@ def test_distance_only_has_no_counter_nor_time_stamp(rig):
 
 def test_a_full_queue_drops_the_oldest_blocks_and_counts_them(rig):
     sensor, emulator = rig(queue_blocks=3)
-    deadline = time.monotonic() + 3
+    deadline = time.monotonic() + paced(10)
     while sensor.stats.queue_overflows < 5:
         assert time.monotonic() < deadline
         time.sleep(0.01)  # let the reader fill the queue: nothing to wait on but the stream
