@@ -107,7 +107,7 @@ def test_knowing_the_models_loads_nothing_posix_only_nor_pyserial():
             "laser.open_laser(laser.LaserSpec(simulated=True)).open()\n"
             "bad = sorted(m for m in ('pty', 'tty', 'termios', 'fcntl', 'serial') if m in sys.modules)\n"
             "print(bad); sys.exit(1 if bad else 0)")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=ROOT)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(60), cwd=ROOT)
     assert done.returncode == 0, done.stdout + done.stderr
 
 
