@@ -128,7 +128,7 @@ def test_recent_files_are_remembered_newest_first(qtbot, window, recordings, set
     assert [a.data() for a in actions] == expected
     assert "paper.wav" in actions[0].text()
     # Opening from the menu analyses that file.
-    with qtbot.waitSignal(again.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(again.analysis_shown, timeout=analysis_wait_ms()) as blocker:
         actions[1].trigger()
     assert blocker.args[0].path == recordings["no_sd"].resolve()
 
@@ -161,7 +161,7 @@ def test_dropping_a_recording_opens_it(qtbot, window, recordings):
     mime = QMimeData()
     mime.setUrls([QUrl.fromLocalFile(str(recordings["paper"].with_suffix(".json")))])
     event = QDropEvent(QPoint(10, 10), Qt.CopyAction, mime, Qt.LeftButton, Qt.NoModifier)
-    with qtbot.waitSignal(window.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.analysis_shown, timeout=analysis_wait_ms()):
         window.dropEvent(event)
     assert event.isAccepted()
 

@@ -131,7 +131,7 @@ def test_open_shows_the_stored_measurement_on_the_results_page(qtbot, window, ar
     page = show_page(window)
     row = shown_ids(page).index(ids["mid"])
     rect = page.table.visualRect(page.table.proxy.index(row, HEADERS.index("Driver")))
-    with qtbot.waitSignal(window.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.analysis_shown, timeout=analysis_wait_ms()):
         qtbot.mouseClick(page.table.viewport(), Qt.LeftButton, pos=rect.center())
         qtbot.mouseDClick(page.table.viewport(), Qt.LeftButton, pos=rect.center())
     result = window.results.result
@@ -149,7 +149,7 @@ def test_compare_three_overlays_their_curves_and_tabulates_their_parameters(qtbo
     page = show_page(window)
     select(page, {ids["paper"], ids["mid"], ids["big"]})
     assert page.selection_label.text() == "3 selected"
-    with qtbot.waitSignal(page.comparison_shown, timeout=ANALYSIS_TIMEOUT_MS) as shown:
+    with qtbot.waitSignal(page.comparison_shown, timeout=analysis_wait_ms()) as shown:
         page.compare_button.click()
     order = ["big", "mid", "paper"]                        # as the list shows them: newest first
     assert list(shown.args[0].comparison.ids) == [ids[k] for k in order]
@@ -202,7 +202,7 @@ def test_a_corrupted_index_is_rebuilt_and_the_page_still_lists(qtbot, window, ar
     broken = archive_root / "measurements" / "not-a-measurement"
     broken.mkdir()
     (broken / "measurement.json").write_text("{", encoding="utf-8")
-    with qtbot.waitSignal(page.rebuilt, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(page.rebuilt, timeout=analysis_wait_ms()):
         page.rebuild_button.click()
     assert set(shown_ids(page)) == set(ids.values())
     assert "4 measurement(s); 1 folder(s) skipped" in page.message.text()
@@ -214,7 +214,7 @@ def test_archive_errors_are_messages_on_the_page(qtbot, window, archive, archive
     page = show_page(window)
     (Archive(archive_root).get(ids["mid"]).folder / "results.json").write_text("[1, 2", encoding="utf-8")
     select(page, {ids["mid"], ids["big"]})
-    with qtbot.waitSignal(page.worker.failed, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(page.worker.failed, timeout=analysis_wait_ms()):
         page.compare_button.click()
     assert "Cannot compare" in page.message.text() and "results.json" in page.message.text()
     (Archive(archive_root).get(ids["big"]).folder / "recording.wav").unlink()
@@ -244,7 +244,7 @@ def test_a_store_that_fails_keeps_the_recording_and_says_so(qtbot, window, measu
     path, _ = measured["paper"]
     archive_root.write_text("not a folder", encoding="utf-8")
     result = analyze_recording(read_recording(path))
-    with qtbot.waitSignal(window.archive.store_failed, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.archive.store_failed, timeout=analysis_wait_ms()):
         window.archive.store_measurement(path.with_suffix(".wav"), result, {"driver": "x"})
     assert "NOT stored in the archive" in window.status_label.text()
     assert path.with_suffix(".wav").is_file()

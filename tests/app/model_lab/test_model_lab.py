@@ -78,13 +78,13 @@ def _chi2(lab: ModelLab) -> dict[str, float]:
 
 def _toggle(qtbot, lab: ModelLab, effect_id: str, checked: bool):
     """Check or uncheck an effect as a click on its box does, and wait for the refit's version."""
-    with qtbot.waitSignal(lab.version_added, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(lab.version_added, timeout=analysis_wait_ms()) as blocker:
         lab.catalogue.item(effect_id).setCheckState(0, Qt.Checked if checked else Qt.Unchecked)
     return blocker.args[0]
 
 
 def _diagnose(qtbot, lab: ModelLab, button=None):
-    with qtbot.waitSignal(lab.diagnosis_shown, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(lab.diagnosis_shown, timeout=analysis_wait_ms()) as blocker:
         qtbot.mouseClick(button or lab.candidates.diagnose_button, Qt.LeftButton)
     return blocker.args[0]
 
@@ -179,7 +179,7 @@ def test_unchecking_an_effect_refits_and_raises_chi2(qtbot, make_lab, full_resul
 
 
 def test_checking_a_second_effect_of_a_category_swaps_it(qtbot, lab):
-    with qtbot.waitSignal(lab.version_added, timeout=ANALYSIS_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(lab.version_added, timeout=analysis_wait_ms()) as blocker:
         lab.catalogue.item("lr3").setCheckState(0, Qt.Checked)
         assert lab.catalogue.checked() == ("lr3",)         # swapped at once, before the refit ends
     version = blocker.args[0]
