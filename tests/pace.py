@@ -17,10 +17,10 @@ SPIN_S = 0.03        # CPU time of one probe: long enough to span several schedu
 PROBES = 5
 
 
-def machine_pace() -> float:
+def machine_pace(probes: int = PROBES) -> float:
     """Median over a few probes of wall time / this thread's CPU time while it spins; at least 1."""
     ratios = []
-    for _ in range(PROBES):
+    for _ in range(probes):
         wall, cpu = time.perf_counter(), time.thread_time()
         while time.thread_time() - cpu < SPIN_S:
             pass
@@ -31,3 +31,13 @@ def machine_pace() -> float:
 def paced(seconds: float) -> float:
     """A time bound written for an idle machine, at the machine's pace now."""
     return seconds * machine_pace()
+
+
+WAIT_PROBES = 2      # a wait's timeout needs the pace roughly, and is asked for often
+
+
+def wait_ms(seconds: float) -> int:
+    """The timeout of a wait on work (qtbot.waitSignal, waitUntil), in ms: `seconds` written for an idle
+    machine, at the pace when the wait begins. A timeout bounds a hang, never a speed: give the work several
+    times what it takes on an idle machine, and the load that slows the work stretches the wait too."""
+    return int(1000 * seconds * machine_pace(WAIT_PROBES))

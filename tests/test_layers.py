@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.pace import paced
+
 REPO = Path(__file__).resolve().parent.parent
 LINT_IMPORTS = shutil.which("lint-imports", path=str(Path(sys.executable).parent)) or shutil.which("lint-imports")
 pytestmark = pytest.mark.skipif(LINT_IMPORTS is None,
@@ -22,7 +24,7 @@ pytestmark = pytest.mark.skipif(LINT_IMPORTS is None,
 def lint_imports(cwd: Path, pythonpath: Path | None = None) -> subprocess.CompletedProcess:
     env = {**os.environ, **({"PYTHONPATH": str(pythonpath)} if pythonpath else {})}
     return subprocess.run([LINT_IMPORTS, "--no-cache"], cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=120)
+                          timeout=paced(120))
 
 
 def test_the_layers_contracts_are_kept():

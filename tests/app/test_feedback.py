@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from PySide6.QtCore import Qt
 
-from .conftest import ANALYSIS_TIMEOUT_MS
-from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, choose_simulator, skip_to_measure, to_hardware
+from .conftest import analysis_wait_ms
+from tests.app.wizard.test_wizard_helpers import choose_simulator, job_wait_ms, skip_to_measure, to_hardware
 
 
 def _shows_work(progress, cancel, text: str) -> None:
@@ -19,7 +19,7 @@ def _shows_work(progress, cancel, text: str) -> None:
 
 def _wait_idle(qtbot, jobs) -> None:
     if jobs.busy:
-        with qtbot.waitSignal(jobs.busy_changed, timeout=JOB_TIMEOUT_MS, check_params_cb=lambda busy: not busy):
+        with qtbot.waitSignal(jobs.busy_changed, timeout=job_wait_ms(), check_params_cb=lambda busy: not busy):
             pass
 
 
@@ -52,7 +52,7 @@ def test_the_measurement_shows_its_work_on_the_click(qtbot, window, settings, tm
 
 
 def test_opening_a_recording_and_diagnosing_show_their_work_on_the_click(qtbot, window, recordings):
-    with qtbot.waitSignal(window.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.analysis_shown, timeout=analysis_wait_ms()):
         window.open_path(recordings["paper"])
         _shows_work(window.jobs.progress, window.jobs.cancel_button, window.jobs.text.text())
     lab = window.model_lab
@@ -60,7 +60,7 @@ def test_opening_a_recording_and_diagnosing_show_their_work_on_the_click(qtbot, 
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     _shows_work(lab.jobs.progress, lab.jobs.cancel_button, lab.jobs.text.text())
     assert not lab.candidates.diagnose_button.isEnabled()
-    with qtbot.waitSignal(lab.job_cancelled, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(lab.job_cancelled, timeout=analysis_wait_ms()):
         qtbot.mouseClick(lab.jobs.cancel_button, Qt.LeftButton)
 
 
@@ -78,7 +78,7 @@ def test_series_and_large_signal_analyses_show_their_work_at_once(qtbot, window,
     _shows_work(large.jobs.progress, large.jobs.cancel_button, large.jobs.text.text())
     qtbot.mouseClick(large.jobs.cancel_button, Qt.LeftButton)
     # The workers' threads end before the window goes: a thread emitting into a deleted page raises.
-    assert series.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)
-    assert large.worker.pool.waitForDone(ANALYSIS_TIMEOUT_MS)
+    assert series.worker.pool.waitForDone(analysis_wait_ms())
+    assert large.worker.pool.waitForDone(analysis_wait_ms())
     qtbot.waitUntil(lambda: large.choose_button.isEnabled() and panel.choose_button.isEnabled(),
-                    timeout=ANALYSIS_TIMEOUT_MS)
+                    timeout=analysis_wait_ms())

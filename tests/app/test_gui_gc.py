@@ -7,6 +7,7 @@ import threading
 from PySide6.QtWidgets import QMenu
 
 from app import gui_gc
+from tests.pace import wait_ms
 
 
 def test_a_qt_cycle_made_in_the_gui_thread_is_not_freed_by_a_worker_thread(qapp, qtbot):
@@ -30,5 +31,5 @@ def test_a_qt_cycle_made_in_the_gui_thread_is_not_freed_by_a_worker_thread(qapp,
     worker.start()
     worker.join()
     assert freed_in == []
-    qtbot.waitUntil(lambda: bool(freed_in), timeout=3000)      # the GUI thread's timer collects it
+    qtbot.waitUntil(lambda: bool(freed_in), timeout=wait_ms(30))   # the GUI thread's timer collects it
     assert freed_in == [threading.main_thread().name]

@@ -14,6 +14,7 @@ from PySide6.QtCore import QCoreApplication, QEvent
 import app.large_signal.page
 import app.main_window
 import app.series_page
+from tests.pace import wait_ms
 
 
 def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, monkeypatch):
@@ -24,7 +25,7 @@ def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, 
     def held(result):
         def work(*args, **kwargs):
             entered.release()
-            release.wait(30)
+            release.wait(240)
             return result(*args, **kwargs)
         return work
     monkeypatch.setattr(app.series_page, "analyze_path", held(real_analyze_path))
@@ -38,7 +39,7 @@ def test_closing_the_window_mid_job_raises_nothing(qtbot, settings, recordings, 
     window.series.analyse("repeatability", [recordings["paper"], recordings["no_sd"]])
     window.large_signal.analyse([recordings["paper"]])
     for _ in range(2):
-        assert entered.acquire(timeout=30), "both jobs started"
+        assert entered.acquire(timeout=wait_ms(30) / 1000), "both jobs started"
     # The jobs go on the moment their page's runner is being destroyed, as a slow one would.
     for runner in (window.series.worker, window.large_signal.worker):
         runner.destroyed.connect(lambda *_: release.set())
@@ -58,7 +59,7 @@ def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(
 
     def slow(stems):
         entered.set()
-        release.wait(60)
+        release.wait(240)
         return late
     monkeypatch.setattr(app.large_signal.page, "large_signal", slow)
     page = app.large_signal.page.LargeSignalPage()
@@ -67,11 +68,11 @@ def test_cancel_lets_the_large_signal_page_go_at_once_and_drops_the_late_result(
     monkeypatch.setattr(page, "on_finished", finished.append)
     page.analyse([tmp_path / "x.wav"])
     # Cancel once the job runs: a job cancelled while it still waits for its thread says so at once (not late).
-    assert entered.wait(60), "the identification started"
+    assert entered.wait(wait_ms(60) / 1000), "the identification started"
     assert not page.choose_button.isEnabled()
     page.jobs.cancel_button.click()
     assert page.choose_button.isEnabled() and not page.jobs.busy
     assert "Cancelled" in page.status.text()
-    with qtbot.waitSignal(page.worker.cancelled, timeout=10_000):
+    with qtbot.waitSignal(page.worker.cancelled, timeout=wait_ms(10)):
         release.set()          # inside: the late job may say it was cancelled before a waiter outside would listen
     assert finished == []

@@ -12,6 +12,8 @@ from app.main_window import MainWindow, PAGE_ORDER
 from app.menus import DEPENDENCIES, guide_markdown
 from app.settings import Settings
 
+from tests.pace import wait_ms
+
 from .conftest import open_and_wait
 from .test_qa_view import LIMITS
 
@@ -68,7 +70,7 @@ def test_exports_wait_for_a_result_then_write_report_and_data(qtbot, window, rec
     report = tmp_path / "report.html"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a, **k: (str(report), "HTML (*.html)"))
     window.pages.setCurrentWidget(window.results)           # exported from the Results page, which stays shown
-    with qtbot.waitSignal(window.qa.report_written, timeout=60_000):
+    with qtbot.waitSignal(window.qa.report_written, timeout=wait_ms(60)):
         window.menus.export_report_action.trigger()
     assert window.pages.currentWidget() is window.results
     assert "QA: FAIL" in report.read_text(encoding="utf-8")           # the paper's Bl is below LIMITS' 5.5

@@ -13,8 +13,10 @@ from app.qa_view import NO_LIMITS, NO_REPORT, QAView
 from instruments.simulation import faults
 from tests.builders import needs_pdftotext, pdf_text
 
-from .conftest import open_and_wait
 from tests.app.wizard.test_wizard_helpers import plain
+from tests.pace import wait_ms
+
+from .conftest import open_and_wait
 
 LIMITS = {"format": "linpar-limits/1", "name": "paper QA", "parameters": {
     "RE": {"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
@@ -90,7 +92,7 @@ def test_a_zeroed_current_is_judged_red_not_refused(qtbot, window, zeroed_curren
     # The report of the broken measurement is written, and says why.
     assert qa.export_button.isEnabled()
     target = tmp_path / "broken-report.pdf"
-    with qtbot.waitSignal(qa.report_written, timeout=60_000):
+    with qtbot.waitSignal(qa.report_written, timeout=wait_ms(60)):
         qa.export_to(target)
     assert "Written" in qa.export_label.text()
     text = " ".join(pdf_text(target).split())
@@ -149,7 +151,7 @@ def test_the_report_is_written_off_the_gui_thread(qtbot, window, recordings, tmp
     qa = window.qa
     assert qa.export_button.isEnabled()
     target = tmp_path / "paper-report.html"
-    with qtbot.waitSignal(qa.report_written, timeout=60_000) as written:
+    with qtbot.waitSignal(qa.report_written, timeout=wait_ms(60)) as written:
         qa.export_to(target)
         assert not qa.export_jobs.progress.isHidden() and not qa.export_jobs.cancel_button.isHidden()
     assert str(target) in written.args[0]
@@ -165,7 +167,7 @@ def test_a_cancelled_export_writes_nothing(qtbot, window, recordings, tmp_path):
     qa = window.qa
     target = tmp_path / "cancelled.pdf"
     qa.export_to(target)
-    with qtbot.waitSignal(qa.export_jobs.busy_changed, timeout=60_000):
+    with qtbot.waitSignal(qa.export_jobs.busy_changed, timeout=wait_ms(60)):
         qa.export_jobs.cancel_button.click()
     assert "cancelled" in qa.export_label.text()
     assert not target.exists()
@@ -178,7 +180,7 @@ def test_the_report_carries_the_loaded_limits_verdict(qtbot, window, recordings,
     qa = window.qa
     assert qa.load_limits(limits_file) and qa.verdict == "fail"            # Bl 5.23 T*m against >= 5.5
     target = tmp_path / "paper-qa.html"
-    with qtbot.waitSignal(qa.report_written, timeout=60_000):
+    with qtbot.waitSignal(qa.report_written, timeout=wait_ms(60)):
         qa.export_to(target)
     page = target.read_text(encoding="utf-8")
     assert "QA: FAIL" in page and "limits.json" in page and "paper QA" in page

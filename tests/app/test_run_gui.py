@@ -8,6 +8,8 @@ from pathlib import Path
 
 from PySide6.QtCore import QObject, Signal
 
+from tests.pace import paced
+
 
 ROOT = Path(__file__).resolve().parents[2]
 RUN = "import sys; from app.main import run_gui; sys.exit(run_gui(sys.argv[1] if len(sys.argv) > 1 else None))"
@@ -23,7 +25,7 @@ def _env(tmp_path, **extra) -> dict[str, str]:
 
 def _run(tmp_path, *args, **env) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", RUN, *map(str, args)], cwd=ROOT, env=_env(tmp_path, **env),
-                          capture_output=True, text=True, timeout=120)
+                          capture_output=True, text=True, timeout=paced(120))
 
 
 def test_offscreen_run_opens_a_recording_and_exits_cleanly(tmp_path, recordings):

@@ -5,6 +5,7 @@ from analysis.recording.format import write_recording
 from app.series_page import SeriesPage
 from instruments.simulation.level_series import write_level_series
 from tests.builders import TYPICAL_NOISE, recording
+from tests.pace import wait_ms
 
 
 @pytest.fixture
@@ -18,7 +19,7 @@ def test_repeatability_of_three_recordings_shows_mean_and_spread(qtbot, page, tm
     paths = []
     for seed in range(3):
         paths += list(write_recording(tmp_path / f"rep{seed}", recording(noise=TYPICAL_NOISE, n_periods=4, seed=seed)))
-    with qtbot.waitSignal(page.worker.finished, timeout=60_000):
+    with qtbot.waitSignal(page.worker.finished, timeout=wait_ms(60)):
         page.analyse("repeatability", paths)
     table = page.repeat_table
     rows = {table.item(r, 0).text(): r for r in range(table.rowCount())}
@@ -30,7 +31,7 @@ def test_repeatability_of_three_recordings_shows_mean_and_spread(qtbot, page, tm
 
 def test_level_series_shows_fs_falling_with_excursion(qtbot, page, tmp_path):
     paths = write_level_series(tmp_path, levels_v=(0.3, 10.0))
-    with qtbot.waitSignal(page.worker.finished, timeout=120_000):
+    with qtbot.waitSignal(page.worker.finished, timeout=wait_ms(120)):
         page.analyse("levels", paths)
     x, fs = page.levels_view.plot.line.getData()
     assert len(fs) == 2 and x[1] > x[0] and fs[1] < fs[0]

@@ -19,6 +19,7 @@ from PySide6.QtCore import QByteArray, QSettings
 
 from app.settings import Settings
 from app.settings_ini import sanitized_ini
+from tests.pace import paced
 
 
 class _MakesMarker:
@@ -79,7 +80,7 @@ def test_the_risk_is_real_without_settings(tmp_path):
         q = QSettings({str(path)!r}, QSettings.IniFormat)
         [q.value(k) for k in q.allKeys()]
     """)
-    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, timeout=60)
+    subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, timeout=paced(60))
     assert marker.exists()
 
 

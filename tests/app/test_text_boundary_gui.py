@@ -6,6 +6,7 @@ from PySide6.QtCore import Qt
 
 from analysis.archive import open_archive
 from tests.app.conftest import open_and_wait
+from tests.pace import wait_ms
 from tests.production_helpers import LIMITS, small_measurement, unit
 
 # What a hostile name would draw if a label took it as rich text: a big green verdict and an image.
@@ -29,7 +30,7 @@ def test_a_limits_name_as_markup_is_shown_as_its_name(qtbot, window, archive_roo
     archive.store_limits({**LIMITS, "name": MARKUP})
     archive.store(path, unit(doc, fs=20.0), {"serial": "SN1", "station": "QA1", "driver": "W6"})
     page = window.production
-    with qtbot.waitSignal(page.computed, timeout=120_000):
+    with qtbot.waitSignal(page.computed, timeout=wait_ms(120)):
         window.pages.setCurrentWidget(page)
     assert MARKUP in page.summary.text()
     assert page.summary.textFormat() == Qt.PlainText

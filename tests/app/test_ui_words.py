@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (QAbstractButton, QAbstractItemView, QComboBox, QG
 
 from app.fit_quality import DETAILS
 
-from .conftest import ANALYSIS_TIMEOUT_MS, open_and_wait
+from .conftest import analysis_wait_ms, open_and_wait
 from tests.app.wizard.test_wizard_helpers import choose_simulator, run_job, to_hardware
 
 # A Python repr: Name(...) nested, Name(key=...), or <... object at 0x...>.
@@ -132,7 +132,7 @@ def test_no_page_shows_a_repr_an_internal_document_or_delta_bic(qtbot, window, r
     open_and_wait(qtbot, window, recordings["paper"])
     # The Model lab with a ranked diagnosis: its candidates table is where ΔBIC used to be.
     lab = window.model_lab
-    with qtbot.waitSignal(lab.diagnosis_shown, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(lab.diagnosis_shown, timeout=analysis_wait_ms()):
         lab.candidates.diagnose_button.click()
     assert lab.candidates.table.rowCount() > 0
     # The wizard's hardware test, whose answer used to be the simulator's repr.
@@ -225,7 +225,7 @@ def test_the_qa_and_production_pages_speak_in_names_and_units(qtbot, window, rec
         archive.store(path, unit(doc, RE=3.0 + 0.01 * i), {"station": "QA1", "serial": f"SN{i}", "driver": "W6",
                                                            "measured_at": f"2024-05-01T10:0{i}:00Z"})
     page = window.production
-    with qtbot.waitSignal(page.computed, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(page.computed, timeout=analysis_wait_ms()):
         window.pages.setCurrentWidget(page)
     names = [page.stats_table.item(r, 0).text() for r in range(page.stats_table.rowCount())]
     assert "Re" in names and "Le" in names and "RE" not in names

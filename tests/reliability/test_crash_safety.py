@@ -30,6 +30,7 @@ from instruments.measurement.analysis_step import analyse_measurement
 from instruments.measurement.recovery import RecoveryError, discard, find_unfinished, inspect, recover
 from instruments.measurement.runner import default_effects
 from tests.builders import PAPER, REPO_ROOT, TYPICAL_NOISE, recording
+from tests.pace import paced
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -48,7 +49,7 @@ def kill_when_periods_on_disk(out: Path, name: str, kind: str, periods_on_disk: 
         assert line.startswith("JOURNAL "), (line, proc.stderr.read() if proc.poll() is not None else "")
         journal = Path(line.split(" ", 1)[1].strip())
         assert find_unfinished(out) == []            # running: in use, not unfinished
-        deadline = time.monotonic() + 30
+        deadline = time.monotonic() + paced(30)
         while inspect(journal).periods < periods_on_disk:
             assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read()
             time.sleep(0.05)

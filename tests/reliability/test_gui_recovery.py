@@ -15,6 +15,7 @@ import pytest
 from PySide6.QtCore import QSettings
 
 from instruments.measurement.recovery import find_unfinished, run_journaled
+from tests.pace import wait_ms
 from tests.reliability.simulated_rig import Rig, plan
 
 pytestmark = pytest.mark.timeout(120)
@@ -54,7 +55,7 @@ def test_the_window_offers_the_unfinished_measurement_and_analyses_it(window, qt
     cut_short(tmp_path / "out", "crashed")
     asked = []
     window.ask_unfinished = lambda unfinished: asked.append(unfinished) or "analyse"
-    with qtbot.waitSignal(window.analysis_shown, timeout=60_000) as shown:
+    with qtbot.waitSignal(window.analysis_shown, timeout=wait_ms(60)) as shown:
         assert window.offer_unfinished() == ["analyse"]
     assert asked[0].name == "crashed" and asked[0].periods >= 3
     assert shown.args[0].path == tmp_path / "out" / "crashed.wav"

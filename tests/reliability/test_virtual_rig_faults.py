@@ -25,6 +25,7 @@ from instruments.measurement import MeasurementFailed, MeasurementPlan
 from instruments.measurement.recovery import find_unfinished, run_journaled
 from instruments.rig.workstation import rig_audio
 from tests.builders import PAPER, REPO_ROOT
+from tests.pace import paced
 
 pytestmark = [pytest.mark.rig, pytest.mark.timeout(120)]
 DEFAULT_LASER = {"clock_ppm": 37.0, "start_latency_s": 0.02}
@@ -95,7 +96,7 @@ def test_linpar_measure_with_the_jack_server_killed_says_so_in_one_line_and_keep
             if "averaging 2/" in line:
                 os.kill(handle.state.jackd_pid, signal.SIGKILL)
                 break
-        out, err = proc.communicate(timeout=30)
+        out, err = proc.communicate(timeout=paced(60))
         lines += err.splitlines(keepends=True)
     finally:
         if find_rig(name, runtime) is not None:

@@ -10,6 +10,7 @@ import pytest
 from analysis.archive.population import Population
 from analysis.production import capability, compare_stations, control_chart, production_stats
 from analysis.production.control_chart import D4_PAIRS
+from tests.pace import paced
 
 # pi to 60 digits, for a reference that owes nothing to floating point
 PI = Decimal("3.141592653589793238462643383279502884197169399375105820974944")
@@ -185,7 +186,7 @@ def test_the_statistics_import_no_scipy():
         assert parameter_units()["fs"][0] == "Hz"
         print(sorted(m for m in sys.modules if m.split(".")[0] == "scipy"))
     """
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(120))
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip() == "[]"
 
@@ -199,7 +200,7 @@ def test_qa_stats_with_stored_limits_imports_no_scipy(tmp_path):
     root = tmp_path / "archive"
     example = Path(__file__).resolve().parents[3] / "resources" / "limits" / "example.json"
     store = subprocess.run([sys.executable, "-m", "app.cli", "qa", "limits", "--store", str(example), "--root",
-                            str(root)], capture_output=True, text=True, timeout=120)
+                            str(root)], capture_output=True, text=True, timeout=paced(120))
     assert store.returncode == 0, store.stderr
     code = f"""if True:
         import sys
@@ -207,6 +208,6 @@ def test_qa_stats_with_stored_limits_imports_no_scipy(tmp_path):
         assert main(["qa", "stats", "--root", {str(root)!r}]) == 0
         print(sorted(m for m in sys.modules if m.split(".")[0] == "scipy"))
     """
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(120))
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.strip().splitlines()[-1] == "[]"

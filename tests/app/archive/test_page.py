@@ -20,8 +20,9 @@ from app.archive.page import ROOT_KEY
 from app.archive.table import FIRST_PARAMETER, HEADERS
 from tests.builders import DRIVERS, TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
 
-from tests.app.conftest import ANALYSIS_TIMEOUT_MS
-from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, skip_to_measure
+from tests.app.conftest import analysis_wait_ms
+from tests.app.wizard.test_wizard_helpers import job_wait_ms, skip_to_measure
+from tests.pace import wait_ms
 
 # key: (builders driver, driver name, serial, operator, measured_at)
 STORED = {
@@ -103,7 +104,7 @@ def test_the_filter_narrows_the_list_once_the_typing_stops(qtbot, window, archiv
     page = show_page(window)
     qtbot.keyClicks(page.filters.driver_edit, "w18")
     assert len(shown_ids(page)) == 4                      # not yet: the list waits for the typing to stop
-    with qtbot.waitSignal(page.listed, timeout=5000):
+    with qtbot.waitSignal(page.listed, timeout=wait_ms(30)):
         pass
     assert set(shown_ids(page)) == {ids["paper"], ids["red"]}
     page.filters.validity_combo.setCurrentIndex(page.filters.validity_combo.findData("red"))
@@ -130,7 +131,7 @@ def test_open_shows_the_stored_measurement_on_the_results_page(qtbot, window, ar
     page = show_page(window)
     row = shown_ids(page).index(ids["mid"])
     rect = page.table.visualRect(page.table.proxy.index(row, HEADERS.index("Driver")))
-    with qtbot.waitSignal(window.analysis_shown, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.analysis_shown, timeout=analysis_wait_ms()):
         qtbot.mouseClick(page.table.viewport(), Qt.LeftButton, pos=rect.center())
         qtbot.mouseDClick(page.table.viewport(), Qt.LeftButton, pos=rect.center())
     result = window.results.result
@@ -148,7 +149,7 @@ def test_compare_three_overlays_their_curves_and_tabulates_their_parameters(qtbo
     page = show_page(window)
     select(page, {ids["paper"], ids["mid"], ids["big"]})
     assert page.selection_label.text() == "3 selected"
-    with qtbot.waitSignal(page.comparison_shown, timeout=ANALYSIS_TIMEOUT_MS) as shown:
+    with qtbot.waitSignal(page.comparison_shown, timeout=analysis_wait_ms()) as shown:
         page.compare_button.click()
     order = ["big", "mid", "paper"]                        # as the list shows them: newest first
     assert list(shown.args[0].comparison.ids) == [ids[k] for k in order]
@@ -201,7 +202,7 @@ def test_a_corrupted_index_is_rebuilt_and_the_page_still_lists(qtbot, window, ar
     broken = archive_root / "measurements" / "not-a-measurement"
     broken.mkdir()
     (broken / "measurement.json").write_text("{", encoding="utf-8")
-    with qtbot.waitSignal(page.rebuilt, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(page.rebuilt, timeout=analysis_wait_ms()):
         page.rebuild_button.click()
     assert set(shown_ids(page)) == set(ids.values())
     assert "4 measurement(s); 1 folder(s) skipped" in page.message.text()
@@ -213,7 +214,7 @@ def test_archive_errors_are_messages_on_the_page(qtbot, window, archive, archive
     page = show_page(window)
     (Archive(archive_root).get(ids["mid"]).folder / "results.json").write_text("[1, 2", encoding="utf-8")
     select(page, {ids["mid"], ids["big"]})
-    with qtbot.waitSignal(page.worker.failed, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(page.worker.failed, timeout=analysis_wait_ms()):
         page.compare_button.click()
     assert "Cannot compare" in page.message.text() and "results.json" in page.message.text()
     (Archive(archive_root).get(ids["big"]).folder / "recording.wav").unlink()
@@ -243,7 +244,7 @@ def test_a_store_that_fails_keeps_the_recording_and_says_so(qtbot, window, measu
     path, _ = measured["paper"]
     archive_root.write_text("not a folder", encoding="utf-8")
     result = analyze_recording(read_recording(path))
-    with qtbot.waitSignal(window.archive.store_failed, timeout=ANALYSIS_TIMEOUT_MS):
+    with qtbot.waitSignal(window.archive.store_failed, timeout=analysis_wait_ms()):
         window.archive.store_measurement(path.with_suffix(".wav"), result, {"driver": "x"})
     assert "NOT stored in the archive" in window.status_label.text()
     assert path.with_suffix(".wav").is_file()
@@ -258,7 +259,7 @@ def test_a_wizard_measurement_ends_up_in_the_archive(qtbot, window, settings, tm
     wizard.driver_page.operator_edit.setText("ana")
     wizard.driver_page.station_edit.setText("bench 3")
     skip_to_measure(qtbot, wizard, realtime=False, template="midrange")
-    with qtbot.waitSignal(window.archive.stored, timeout=JOB_TIMEOUT_MS) as stored:
+    with qtbot.waitSignal(window.archive.stored, timeout=job_wait_ms()) as stored:
         wizard.measure_page.start_button.click()
     outcome = wizard.state.outcome
     mid, recording_path = stored.args
@@ -291,7 +292,7 @@ def test_a_narrow_window_puts_the_filters_on_two_rows(qtbot, window, archive):
     page = show_page(window)
     assert page.filters.rows == 1
     window.resize(700, 500)               # the page must not set the window's minimum width
-    qtbot.waitUntil(lambda: window.width() == 700)
-    qtbot.waitUntil(lambda: page.filters.rows == 2)
+    qtbot.waitUntil(lambda: window.width() == 700, timeout=wait_ms(5))
+    qtbot.waitUntil(lambda: page.filters.rows == 2, timeout=wait_ms(5))
     assert page.filters.driver_edit.isVisible() and page.filters.until_edit.isVisible()
     assert page.filters.until_edit.geometry().right() <= page.filters.width()

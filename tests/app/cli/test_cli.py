@@ -9,6 +9,7 @@ import pytest
 from analysis.recording.format import write_recording
 from app.cli import main
 from tests.builders import PAPER, TYPICAL_NOISE, recording
+from tests.pace import paced
 
 PARAMETER_NAMES = "RE LE L2 R2 CMES LCES RES fs Mms Rms Cms Kms Bl lambda Qes Qms Qts Vas".split()
 
@@ -102,7 +103,7 @@ def test_a_bad_recording_is_refused_with_exit_2(capsys, tmp_path, rec_path):
 
 def test_the_installed_command_runs_as_a_process(rec_path):
     proc = subprocess.run([sys.executable, "-m", "app.cli", "analyze", str(rec_path), "--json"],
-                          capture_output=True, text=True, timeout=120)
+                          capture_output=True, text=True, timeout=paced(120))
     assert proc.returncode == 0, proc.stderr
     assert json.loads(proc.stdout)["parameters"]["fs"]["value"] == pytest.approx(70.56, rel=1e-3)
 

@@ -15,9 +15,11 @@ import sys
 import pytest
 
 import app.cli.devices as cli_devices
+
 from analysis.recording.format import read_recording
 from app.cli import main
 from instruments.audio.simulated import SimulatedAudio
+from tests.pace import paced
 
 SHORT = ["--period", "16384", "--periods", "6", "--no-archive"]
 
@@ -123,5 +125,5 @@ def test_recover_of_a_folder_that_is_not_one(capsys, tmp_path):
 
 def test_recover_is_a_command_of_the_installed_program(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "app.cli", "recover", str(tmp_path)], capture_output=True,
-                          text=True, timeout=120)
+                          text=True, timeout=paced(120))
     assert proc.returncode == 0 and "no unfinished measurement" in proc.stdout

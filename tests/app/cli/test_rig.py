@@ -11,6 +11,7 @@ import pytest
 
 from app.cli import rig as cli_rig
 from app.cli import build_parser, main
+from tests.pace import paced
 
 REPO = Path(__file__).resolve().parents[3]
 
@@ -119,7 +120,7 @@ def test_a_nonlinear_rig_starts_and_says_so(virtual_rig, tmp_path):   # virtual_
 
     def linpar(*args):
         return subprocess.run([sys.executable, "-m", "app.cli", "rig", *args, *where], cwd=REPO,
-                              capture_output=True, text=True, timeout=60)
+                              capture_output=True, text=True, timeout=paced(60))
     try:
         started = linpar("start", "--model", "nonlinear", "--json")
         assert started.returncode == 0, started.stderr

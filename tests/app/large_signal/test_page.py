@@ -8,6 +8,7 @@ import pytest
 from analysis.large_signal import large_signal
 from app.large_signal.page import LargeSignalPage, summary_html
 from tests.large_signal_truth import write_steps
+from tests.pace import wait_ms
 
 
 @pytest.fixture(scope="module")
@@ -62,13 +63,13 @@ def test_the_summary_says_where_to_move_the_coil_and_what_to_read_with_care(resu
 
 
 def test_recordings_are_identified_off_the_gui_thread(qtbot, page, steps):
-    with qtbot.waitSignal(page.result_shown, timeout=180_000):
+    with qtbot.waitSignal(page.result_shown, timeout=wait_ms(180)):
         page.analyse(steps)
     assert "2 recording(s) identified" in page.status.text() and page.choose_button.isEnabled()
 
 
 def test_a_recording_without_the_laser_is_said_not_shown(qtbot, page, recordings):
-    with qtbot.waitSignal(page.worker.failed, timeout=60_000):
+    with qtbot.waitSignal(page.worker.failed, timeout=wait_ms(60)):
         page.analyse([recordings["no_laser"]])
     assert "no displacement" in page.status.text() and page.result is None
 

@@ -14,8 +14,8 @@ from app.model_lab.new_effect import NewEffectDialog
 from app.model_lab.page import ModelLab
 from tests.analysis.effects.test_user_effects import EXAMPLE
 
-from tests.app.conftest import ANALYSIS_TIMEOUT_MS
 from tests.app.model_lab.test_model_lab import CLOSE_WAIT_MS, _toggle
+from tests.pace import wait_ms
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +82,7 @@ def test_the_form_is_checked_as_one_types_with_the_files_one_line(qtbot, lab):
     # The typed text waits for a pause, then is checked: no check per keystroke.
     dialog.formula_edit.setText("r * (sqrt(w / ws) - 1) +")
     assert dialog.timer.isActive()
-    qtbot.waitUntil(lambda: "not a valid expression" in _status(dialog), timeout=5000)
+    qtbot.waitUntil(lambda: "not a valid expression" in _status(dialog), timeout=wait_ms(10))
 
 
 def test_the_preview_draws_the_effects_signature_over_the_misfit(qtbot, lab):

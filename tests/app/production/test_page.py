@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from analysis.archive import open_archive
+from tests.pace import wait_ms
 from tests.production_helpers import LIMITS, small_measurement, unit
 
-TIMEOUT_MS = 120_000
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +32,7 @@ def fill(spec, measured, n=120, drift_at=80):
 def show(qtbot, window):
     window.resize(1280, 720)                 # the smaller of the two screens the page is made for
     page = window.production
-    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as shown:
+    with qtbot.waitSignal(page.computed, timeout=wait_ms(120)) as shown:
         window.pages.setCurrentWidget(page)
     return page, shown.args[0]
 
@@ -60,7 +60,7 @@ def test_statistics_chart_alarms_and_stations_of_the_archive(qtbot, window, meas
     assert written and written.read_bytes().startswith(b"K0100 ")
     assert len(json.loads(page.export_to(tmp_path / "units.json").read_text())["measurements"]) == 120
     # One station only: the filter is the statistics' selection.
-    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as shown:
+    with qtbot.waitSignal(page.computed, timeout=wait_ms(120)) as shown:
         page.station_combo.setCurrentIndex(page.station_combo.findData("QA1"))
     assert len(shown.args[0].population) == 60 and set(shown.args[0].population.stations) == {"QA1"}
 
@@ -70,7 +70,7 @@ def test_an_empty_archive_and_a_lost_server_are_said_on_the_page(qtbot, window, 
     assert len(data.population) == 0 and "0 measurement(s)" in page.summary.text()
     assert not page.export_button.isEnabled()
     monkeypatch.setenv("LINPAR_ARCHIVE_URL", "postgresql://nobody@127.0.0.1:1/linpar?connect_timeout=2")
-    with qtbot.waitSignal(page.failed, timeout=TIMEOUT_MS) as failed:
+    with qtbot.waitSignal(page.failed, timeout=wait_ms(120)) as failed:
         page.refresh()
     assert "cannot reach the server" in failed.args[0]
     assert "Cannot compute the production statistics" in page.message.text() and page.message.isVisible()
@@ -80,7 +80,7 @@ def test_the_archive_page_lists_a_server_named_by_the_environment(qtbot, window,
     fill(pg_database.url("station_a"), measured, n=4)
     monkeypatch.setenv("LINPAR_ARCHIVE_URL", pg_database.url("audrey"))
     archive = window.archive
-    with qtbot.waitSignal(archive.listed, timeout=TIMEOUT_MS) as listed:
+    with qtbot.waitSignal(archive.listed, timeout=wait_ms(120)) as listed:
         window.pages.setCurrentWidget(archive)
     assert listed.args[0] == 4
     assert archive.root_label.text() == pg_database.url("audrey")

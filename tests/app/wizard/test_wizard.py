@@ -9,7 +9,8 @@ from app.wizard import MeasureWizard
 from app.wizard.calibration_page import settings_key
 
 from tests.app.wizard.test_wizard_helpers import (
-    JOB_TIMEOUT_MS, choose_simulator, fill_driver, parameter_errors, plain, run_job, skip_to_measure, to_hardware)
+    choose_simulator, fill_driver, job_wait_ms, parameter_errors, plain, run_job, skip_to_measure, to_hardware)
+from tests.pace import wait_ms
 
 
 @pytest.fixture
@@ -51,7 +52,7 @@ def test_a_whole_run_ends_in_the_simulated_drivers_parameters(qtbot, window, set
     wizard.next_button.click()
 
     measure = wizard.measure_page
-    with qtbot.waitSignal(window.measurement_shown, timeout=JOB_TIMEOUT_MS) as finished:
+    with qtbot.waitSignal(window.measurement_shown, timeout=job_wait_ms()) as finished:
         measure.start_button.click()
     outcome = finished.args[0]
     assert outcome.path.exists() and outcome.path.with_suffix(".json").exists()
@@ -111,12 +112,12 @@ def test_a_channel_map_with_two_signals_on_one_input_blocks_next(qtbot, wizard, 
 def test_cancel_stops_the_measurement_and_nothing_is_shown(qtbot, wizard):
     skip_to_measure(qtbot, wizard, realtime=True, template="midrange")     # short periods: a frame comes soon
     measure = wizard.measure_page
-    with qtbot.waitSignal(measure.panels.repainted, timeout=JOB_TIMEOUT_MS):
+    with qtbot.waitSignal(measure.panels.repainted, timeout=job_wait_ms()):
         measure.start_button.click()
     assert measure.jobs.cancel_button.isVisible() and not wizard.next_button.isEnabled()
     assert not wizard.back_button.isEnabled()
     assert "Wait for the measurement" in wizard.reason.text()
-    with qtbot.waitSignal(wizard.session.cancelled, timeout=10_000):
+    with qtbot.waitSignal(wizard.session.cancelled, timeout=wait_ms(10)):
         measure.jobs.cancel_button.click()
     assert "cancelled" in measure.result.text().lower()
     assert wizard.state.outcome is None
@@ -134,7 +135,7 @@ def test_the_measurement_runs_off_the_gui_thread(qtbot, wizard, monkeypatch):
         return real(*args, **kwargs)
     monkeypatch.setattr(tasks, "run_measurement", spy)
     skip_to_measure(qtbot, wizard, realtime=False)
-    with qtbot.waitSignal(wizard.measurement_finished, timeout=JOB_TIMEOUT_MS):
+    with qtbot.waitSignal(wizard.measurement_finished, timeout=job_wait_ms()):
         wizard.measure_page.start_button.click()
     assert threads and threads[0] is not threading.main_thread()
 
@@ -161,7 +162,7 @@ def test_the_large_signal_template_runs_the_plan_and_hands_the_curves_over(qtbot
     page = wizard.measure_page
     assert page.large_signal.isVisible() and "large-signal plan" in page.start_button.text()
     page.large_signal.excursion.setValue(1.0)
-    with qtbot.waitSignal(page.large_signal_measured, timeout=4 * JOB_TIMEOUT_MS) as handed:
+    with qtbot.waitSignal(page.large_signal_measured, timeout=job_wait_ms(4)) as handed:
         page.start_button.click()
     done = handed.args[0]
     assert done.plan.stopped_by == "excursion" and len(done.plan.steps) >= 2

@@ -6,6 +6,7 @@ import pytest
 from app.wizard import MeasureWizard, hardware, hardware_page
 
 from tests.app.wizard.test_wizard_helpers import plain, to_hardware
+from tests.pace import wait_ms
 
 
 @pytest.fixture
@@ -97,7 +98,7 @@ def test_a_device_stored_by_index_in_older_settings_is_asked_for_again(qtbot, se
     wizard = make_wizard(qtbot, settings, tmp_path, monkeypatch, '{"kind": "soundcard", "device": 3}')
     page = wizard.hardware_page
     assert "remembered by its number" in page.audio_result.text()
-    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=30_000)   # the list PortAudio gives here, if any
+    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=wait_ms(30))   # the list PortAudio gives here, if any
     page.on_devices(windows_cards())
     assert page.device_list.choice() is None and not wizard.next_button.isEnabled()
     assert "Choose a sound card" in wizard.reason.text()
@@ -108,7 +109,7 @@ def test_a_device_that_only_records_is_listed_but_not_taken(qtbot, settings, tmp
     from instruments.audio.interface import AudioDeviceInfo
     wizard = make_wizard(qtbot, settings, tmp_path, monkeypatch, '{"kind": "soundcard"}')
     page = wizard.hardware_page
-    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=30_000)
+    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=wait_ms(30))
     page.on_devices([AudioDeviceInfo(0, "Analogue 1 + 2 (Focusrite USB Audio)", "Windows WASAPI", 2, 0, 48000.0)])
     page.device_list.setCurrentItem(page.device_list.topLevelItem(0))
     assert page.device_list.choice() is None and not wizard.next_button.isEnabled()
@@ -122,7 +123,7 @@ def test_a_device_stored_with_its_old_index_beside_its_name_is_found_by_name(qtb
     wizard = make_wizard(qtbot, settings, tmp_path, monkeypatch, saved)
     page = wizard.hardware_page
     assert page.audio_result.text() == ""             # nothing to say: it is known by name
-    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=30_000)
+    qtbot.waitUntil(lambda: not page.audio_jobs.busy, timeout=wait_ms(30))
     page.on_devices(windows_cards())
     assert page.device_list.choice() == windows_cards()[0].choice
     wizard.shutdown(10_000)

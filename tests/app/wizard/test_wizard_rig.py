@@ -5,7 +5,7 @@ import pytest
 
 from app.wizard import MeasureWizard
 
-from tests.app.wizard.test_wizard_helpers import JOB_TIMEOUT_MS, fill_driver, parameter_errors, plain, run_job
+from tests.app.wizard.test_wizard_helpers import fill_driver, job_wait_ms, parameter_errors, plain, run_job
 
 pytestmark = pytest.mark.rig
 
@@ -33,7 +33,7 @@ def test_a_whole_run_on_the_virtual_rig(qtbot, settings, tmp_path, virtual_rig):
         assert level.decision.level is not None, level.decision.reason
         assert level.panels.frames_received >= 2
         wizard.next_button.click()
-        with qtbot.waitSignal(wizard.measurement_finished, timeout=JOB_TIMEOUT_MS) as finished:
+        with qtbot.waitSignal(wizard.measurement_finished, timeout=job_wait_ms()) as finished:
             wizard.measure_page.start_button.click()
         outcome = finished.args[0]
         assert outcome.path.exists()

@@ -11,6 +11,7 @@ import pytest
 
 from instruments.audio import AudioError, AudioInterface, AudioSpec, ChannelMap, audio_backends, factory, open_audio
 from instruments.rig.engine import RIG_CALIBRATION, RIG_CHANNEL_MAP
+from tests.pace import paced
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -44,7 +45,7 @@ def test_a_registered_back_end_is_opened_by_name(monkeypatch):
 def test_every_listed_back_end_has_its_opener():
     for backend, module in factory.BACKENDS.items():
         code = f"import {module} as m, sys; sys.exit(0 if callable(getattr(m, 'open_from_spec', None)) else 1)"
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=ROOT)
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(60), cwd=ROOT)
         assert done.returncode == 0, f"{backend}: {module} has no open_from_spec\n{done.stderr}"
 
 

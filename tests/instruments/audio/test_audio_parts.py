@@ -15,6 +15,7 @@ from instruments.audio.periods import PeriodCollector
 from instruments.audio.stream_core import (
     INPUT_OVERFLOW, OUTPUT_UNDERFLOW, DuplexCore, InputBlock, LoopedExcitation)
 from instruments.rig.engine import RIG_CALIBRATION, RigFaults, RigNoise
+from tests.pace import paced
 
 CAL = Calibration(volts_per_fs_out=10.0, volts_per_fs_voltage_sense=20.0, volts_per_fs_current_sense=1.0,
                   shunt_ohm=0.1, current_amp_gain=5.0, volts_per_fs_laser=5.0, laser_m_per_volt=1e-3)
@@ -204,7 +205,7 @@ def test_without_portaudio_the_error_is_clear_and_the_simulator_still_works(tmp_
         print("SIMULATED:", got.n_periods)
     """)
     # The project is installed (pip -e), so the stand-in only needs to come first on the path.
-    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=paced(120),
                             env={**os.environ, "PYTHONPATH": str(tmp_path)})
     assert result.returncode == 0, result.stderr
     assert "LIST: PortAudio is not available (PortAudio library not found): install the Debian package " \

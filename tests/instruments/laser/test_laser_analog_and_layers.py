@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from instruments.laser import AnalogLaserScale
+from tests.pace import paced
 
 
 def test_analog_scale_through_two_calibration_points():
@@ -26,6 +27,6 @@ def test_instruments_laser_imports_no_qt_no_app_no_analysis():
             "bad = sorted(m for m in sys.modules if m.split('.')[0] in {'PySide6', 'pyqtgraph', 'app', 'analysis'}"
             " and m not in shared)\n"
             "print(bad); sys.exit(1 if bad else 0)")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60,
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(60),
                           cwd=Path(__file__).resolve().parents[3])
     assert done.returncode == 0, done.stdout + done.stderr

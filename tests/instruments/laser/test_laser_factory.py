@@ -14,6 +14,7 @@ from instruments.laser import (
     DisplacementSensor, LaserBlock, LaserError, LaserModel, LaserSpec, concatenate_blocks, factory, laser_models,
     open_laser)
 from instruments.laser.factory import register_laser_model
+from tests.pace import paced
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -82,7 +83,7 @@ def test_a_new_model_is_one_registration_away_real_and_simulated(toy_model):
         sensor.configure(4000.0)
     sensor.configure(1000.0)
     sensor.start()
-    blocks, deadline = [], time.monotonic() + 5.0
+    blocks, deadline = [], time.monotonic() + paced(10.0)
     while sum(map(len, blocks)) < 20 and time.monotonic() < deadline:
         block = sensor.read_block(0.1)
         if block is not None:
@@ -106,7 +107,7 @@ def test_knowing_the_models_loads_nothing_posix_only_nor_pyserial():
             "laser.open_laser(laser.LaserSpec(simulated=True)).open()\n"
             "bad = sorted(m for m in ('pty', 'tty', 'termios', 'fcntl', 'serial') if m in sys.modules)\n"
             "print(bad); sys.exit(1 if bad else 0)")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, cwd=ROOT)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=paced(60), cwd=ROOT)
     assert done.returncode == 0, done.stdout + done.stderr
 
 

@@ -10,13 +10,16 @@ from pathlib import Path
 
 import pytest
 
+from tests.pace import paced
+
 REPO = Path(__file__).resolve().parents[3]
 pytestmark = pytest.mark.rig
 
 
-def linpar(*args: str, timeout: float = 30) -> subprocess.CompletedProcess:
+def linpar(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
+    """`linpar ARGS` in a process of its own; `timeout` (a hang's bound, for an idle machine) at the pace now."""
     return subprocess.run([sys.executable, "-m", "app.cli", *args], cwd=REPO, capture_output=True, text=True,
-                          timeout=timeout)
+                          timeout=paced(timeout))
 
 
 def processes_mentioning(word: str) -> list[str]:
@@ -64,7 +67,7 @@ def test_start_status_fault_stop_and_nothing_left_behind(rig_name):
 
     stopped = linpar("rig", "stop", *where)
     assert stopped.returncode == 0 and "stopped" in stopped.stdout
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + paced(10)
     while processes_mentioning(name) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert processes_mentioning(name) == []

@@ -20,6 +20,7 @@ import pytest
 from instruments.rig.jackd import registered_servers
 from instruments.rig.manager import find_rig, start_rig, stop_rig
 from instruments.rig.state import pid_alive
+from tests.pace import paced
 
 REPO = Path(__file__).resolve().parents[3]
 pytestmark = pytest.mark.rig
@@ -78,10 +79,10 @@ def own_rig(tmp_path, virtual_rig):   # virtual_rig: the same skip when jackd is
 
 def test_killing_the_rigs_jack_client_ends_the_capture_within_2_s_keeping_the_periods(own_rig, tmp_path):
     outcome, broken_at, child = run_child_and(lambda: own_rig.command("kill-client"), own_rig.name, tmp_path)
-    assert outcome["at"] - broken_at < 2.0
+    assert outcome["at"] - broken_at < paced(2.0)          # 2 s on an idle machine, at its pace now
     assert "exact zeros" in outcome["error"] and "JACK client" in outcome["error"]
     assert outcome["kept"] >= 2 and outcome["samples"] == outcome["kept"] * 8192
-    assert child.wait(10) == 0
+    assert child.wait(paced(30)) == 0
     status = own_rig.command("status")
     assert status["client_alive"] is False
 
@@ -89,13 +90,13 @@ def test_killing_the_rigs_jack_client_ends_the_capture_within_2_s_keeping_the_pe
 def test_killing_the_jack_server_ends_the_capture_within_2_s_and_the_rig_goes_too(own_rig, tmp_path):
     jackd = own_rig.state.jackd_pid
     outcome, broken_at, child = run_child_and(lambda: os.kill(jackd, signal.SIGKILL), own_rig.name, tmp_path)
-    assert outcome["at"] - broken_at < 2.0
+    assert outcome["at"] - broken_at < paced(2.0)          # 2 s on an idle machine, at its pace now
     assert "stopped by itself" in outcome["error"] or "no samples" in outcome["error"]
     assert outcome["kept"] >= 2
     # The child leaves its dead stream alone and exits normally (no hang, no abort in Pa_Terminate).
-    assert child.wait(10) == 0
+    assert child.wait(paced(30)) == 0
     # The rig notices its server is gone, cleans up and exits: nothing is left behind.
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + paced(10)
     while pid_alive(own_rig.pid) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert not pid_alive(own_rig.pid) and not pid_alive(jackd)
