@@ -2,8 +2,6 @@
 ±90°) or has no resonance (a resistor) is red with its likely cause, and its parameters are withheld, not
 reported as a driver's. Real drivers' curves (measured by others, when present) and catalogue drivers with
 odd physics and noise stay free of these findings."""
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -12,9 +10,8 @@ from analysis.curves.fitting import curve_json, fit_curves
 from analysis.importers import read_curve, read_uiv
 from analysis.spectra import TransferFunction
 from tests.analysis.curves.test_fitting import FREQS, curve
-from tests.builders import DRIVERS, electrical
+from tests.builders import DRIVERS, REAL_DATA, electrical
 
-REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "data" / "real"
 LOW_Q = electrical(5.7, 0.4e-3, 15e-3, 0.84e-3, 15.0, 7.0, L2=0.6e-3, R2=8.0, **{"lambda": 0.12})
 
 
@@ -37,9 +34,9 @@ def test_drivers_2_to_18_inch_and_a_low_q_one_are_passive_with_a_resonance(name)
                                    "dayton_ls10-44/test_impedance.txt",
                                    "woofer_uiv_laser/meas_data_UIV_spectra_1Hz-10kHz.csv"])
 def test_real_drivers_curves_are_passive_with_a_resonance(where):
-    path = REAL / where
+    path = REAL_DATA / where
     if not path.is_file():
-        pytest.skip(f"{where}: the real drivers' data (../shared/data/real) are not on this machine")
+        pytest.skip(f"{where}: the real data set (tests.builders.REAL_DATA) is not on this machine")
     z = read_uiv(path).impedance if path.suffix == ".csv" else read_curve(path, "impedance").transfer
     assert passivity.passivity_findings(z) == []
 
