@@ -36,7 +36,9 @@ class TcpProxy:
             listener, self._listener = self._listener, None
             sockets, self._open = self._open, set()
         if listener is not None:
-            listener.close()
+            with contextlib.suppress(OSError):
+                listener.shutdown(socket.SHUT_RDWR)     # wakes the accepting thread: close alone leaves the port
+            listener.close()                            # bound while it waits, and restore() finds it in use
         for s in sockets:
             try:
                 s.shutdown(socket.SHUT_RDWR)

@@ -139,13 +139,22 @@ def _jsonable(value):
     raise TypeError(f"{type(value).__name__} cannot be stored as JSON")
 
 
-def _iso(text: str | None, field_name: str) -> str | None:
+def _iso(text: str | None, field_name: str, naive_is_utc: bool = False) -> str | None:
+    """The date as the archive writes it (UTC, seconds, 'Z'); ArchiveError when it is none.
+
+    A time without its UTC offset is refused (naive_is_utc False): a measuring station's clock is local, and
+    reading 08:00 at a station on UTC+1 as UTC dates the measurement an hour late in a line's shared archive,
+    silently. The user adds the offset (or Z); linpar never guesses it."""
     if text is None:
         return None
     try:
         when = datetime.fromisoformat(str(text))
     except ValueError:
         raise ArchiveError(f"meta.{field_name}: {text!r} is not an ISO 8601 date or time") from None
+    if when.tzinfo is None and not naive_is_utc:
+        raise ArchiveError(f"meta.{field_name}: {text!r} has no UTC offset, and a time without one is hours off "
+                           f"at any station not on UTC: add it ({when:%Y-%m-%dT%H:%M:%S}+01:00 for UTC+1, or Z "
+                           "for UTC)")
     if when.tzinfo is None:
         when = when.replace(tzinfo=timezone.utc)
     YEAR.check(when.year, f"meta.{field_name} ({text})", ArchiveError)
@@ -153,10 +162,17 @@ def _iso(text: str | None, field_name: str) -> str | None:
     return when.astimezone(timezone.utc).isoformat(timespec="seconds").replace("+00:00", "Z")
 
 
+def checked_measured_at(text: str | None) -> str | None:
+    """A measurement time given by the user (--measured-at, meta.measured_at), checked: ArchiveError unless it
+    is an ISO 8601 time with its UTC offset."""
+    return _iso(text, "measured_at")
+
+
 def _sidecar_date(text: str | None) -> str | None:
-    """The sidecar's session date as the archive writes dates; None (the time of storing) when it is no date."""
+    """The sidecar's session date as the archive writes dates; None (the time of storing) when it is no date.
+    A sidecar date without an offset is read as UTC, as linpar read it before (its format asks for one)."""
     try:
-        return _iso(text, "measured_at")
+        return _iso(text, "measured_at", naive_is_utc=True)
     except ArchiveError:
         return None
 

@@ -42,6 +42,7 @@ from typing import Callable, Mapping, Sequence
 import numpy as np
 
 from analysis.curves.noise import describe_noise, with_estimated_noise
+from analysis.curves.passivity import judged_not_a_driver, passivity_findings
 from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
@@ -200,7 +201,11 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
     if f_range.z_f_max is None and f_range.z_max_over_fs is not None:
         other_bands = tuple(curve_data(impedance, hx, dataclasses.replace(f_range, z_max_over_fs=k))[0]
                             for k in OTHER_Z_BANDS_OVER_FS if k != f_range.z_max_over_fs)
-    return CurveAnalysis(fit=fit, parameters=parameter_table(fit, sd_m2), sd_m2=sd_m2, ranges=ranges,
+    parameters = parameter_table(fit, sd_m2)
+    found = passivity_findings(impedance)       # a curve no driver can give: red, its parameters withheld
+    if found:
+        validity, parameters = judged_not_a_driver(validity, parameters, found)
+    return CurveAnalysis(fit=fit, parameters=parameters, sd_m2=sd_m2, ranges=ranges,
                          validity=validity, notes=tuple(notes), data=data,
                          model_part_always=magnitude_only(impedance, hx), other_bands=other_bands)
 

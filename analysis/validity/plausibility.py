@@ -49,6 +49,7 @@ RATE_TOLERANCE = 0.005                      # relative: two sample rates that di
 MOTIONAL_OVER_RE = 2.0                      # lines where |Z| > 2 RE: the motion dominates the impedance
 SIGN_INVERTED_BELOW = -0.5                  # median cos(angle of Bl per line): +1 right, -1 inverted
 SIGN_MIN_LINES = 3
+PEAK_MARGIN = 1.02                           # a resonance's |Z| peak stands 2 % above both ends of its run
 
 _X_SCALE = "the displacement scale looks like mm, not m: set the displacement channel's scale in the sidecar " \
            "(mm -> m is x 0.001) and analyse again"
@@ -149,7 +150,12 @@ def rate_findings(sample_rate: float, extra: Mapping | None) -> list[Finding]:
 
 def _resonance_lines(z_abs: np.ndarray, freqs: np.ndarray, re_ohm: float) -> np.ndarray:
     """The lines of the first run where |Z| > 2 RE (the resonance), within two octaves of its start: above
-    it the voice coil's inductance lifts |Z| too, and there Ze is no longer ~ RE."""
+    it the voice coil's inductance lifts |Z| too, and there Ze is no longer ~ RE.
+
+    The run must hold a peak of |Z| (it rises, then falls by PEAK_MARGIN): a driver whose resonance stays
+    below 2 RE (Qms < Qes) has its first such run in the inductive rise, where Z - RE is the coil's j w Le,
+    not the motion, and Bl line by line comes out negative (-w^2 Le Mms / Bl) on a right laser. No lines
+    then: the sign is not judged, rather than judged wrong."""
     high = np.isfinite(z_abs) & (z_abs > MOTIONAL_OVER_RE * re_ohm)
     keep = np.zeros_like(high)
     if not high.any():
@@ -158,6 +164,10 @@ def _resonance_lines(z_abs: np.ndarray, freqs: np.ndarray, re_ohm: float) -> np.
     end = first
     while end < high.size and high[end] and freqs[end] <= 4 * freqs[first]:
         end += 1
+    run = z_abs[first:end]
+    peak = int(np.argmax(run))
+    if not (0 < peak < run.size - 1 and run[peak] > PEAK_MARGIN * max(run[0], run[-1])):
+        return keep
     keep[first:end] = True
     return keep
 

@@ -44,7 +44,8 @@ def register(sub) -> None:
     store.add_argument("path", help="recording: NAME, NAME.wav or NAME.json")
     for name in ("driver", "serial", "operator", "station", "notes"):
         store.add_argument(f"--{name}", metavar="TEXT", type=name_text, default="")
-    store.add_argument("--measured-at", metavar="DATE", help="when it was measured (ISO 8601; default: now)")
+    store.add_argument("--measured-at", metavar="DATE", help="when it was measured: ISO 8601 with its UTC offset "
+                       "(2026-05-04T09:30+02:00, or Z for UTC); default: now")
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
     add_sd_option(store)
     add_model_option(store)
@@ -133,8 +134,10 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _store(archive, args) -> int:
+    from analysis.archive.archive import checked_measured_at
     from analysis.fit.model_uncertainty import model_uncertainty
     from analysis.pipeline import analyze_path
+    checked_measured_at(args.measured_at)        # before the analysis: a wrong date is said at once
     # The record's uncertainties with their model part, as `linpar analyze` prints them.
     result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model)))
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,

@@ -11,11 +11,13 @@ from __future__ import annotations
 import os
 import shutil
 
+import numpy as np
 import pytest
 
 from analysis.recording.format import write_recording
+from app.cli import main
 from tests.builders import TYPICAL_NOISE, multitone, recording
-from tests.reliability.cli_outcome import outcome
+from tests.reliability.cli_outcome import OUTCOMES, outcome, strict_json
 
 pytestmark = [pytest.mark.timeout(300), pytest.mark.filterwarnings("error::RuntimeWarning")]
 
@@ -121,3 +123,49 @@ def test_no_traceback_ever(good, tmp_path, capsys, command, kind):
     if kind == "too-large":
         argv = ["--size-limit", f"{size_kind}=16", *argv]
     outcome(capsys, argv)
+
+
+# --- values, not files: what issue 31's last pass added (a time without its offset, curves no driver gives) ---
+
+def _zma(path, freqs, z) -> str:
+    path.write_text("\n".join(f"{f:.9e} {abs(v):.9e} {np.degrees(np.angle(v)):.9e}" for f, v in zip(freqs, z)))
+    return str(path)
+
+
+def _driver_z(freqs):
+    from analysis.effects import parse_effects
+    from analysis.model.composed import Model
+    from tests.builders import DRIVERS
+    return Model(parse_effects("lr2,creep-log")).impedance(2j * np.pi * freqs, DRIVERS["midwoofer-6in"])
+
+
+FREQS = np.logspace(1, np.log10(20e3), 300)
+# name -> (how to make the file in `work`, the argv; BAD is the file) and what the run must end in
+HOSTILE_VALUES = {
+    "measured-at without an offset": (None, ["archive", "store", "G/rec", "--root", "W/archive",
+                                             "--measured-at", "2026-05-04T09:30"], "refused"),
+    "impedance with the current reversed": (lambda p: _zma(p, FREQS, -_driver_z(FREQS)), None, "red"),
+    "impedance with a channel delay left in": (
+        lambda p: _zma(p, FREQS, _driver_z(FREQS) * np.exp(-2j * np.pi * FREQS * 100e-6)), None, "red"),
+    "a resistor given as a driver": (lambda p: _zma(p, FREQS, 8.0 + 2j * np.pi * FREQS * 0.3e-3), None, "red"),
+    # The start values find no resonance in Re(Z) here (4.4 fs and up): refused before any fit, as it was.
+    "an impedance starting above fs": (lambda p: _zma(p, FREQS[FREQS > 200], _driver_z(FREQS[FREQS > 200])), None,
+                                       "refused"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(HOSTILE_VALUES))
+def test_values_no_driver_or_clock_gives_end_in_one_line_or_red(good, tmp_path, capsys, name):
+    make, argv, expected = HOSTILE_VALUES[name]
+    if make is not None:
+        argv = ["analyze", "--impedance", make(tmp_path / "x.zma")] + (["--json"] if expected == "red" else [])
+    argv = [a.replace("W/", f"{tmp_path}/").replace("G/", f"{good}/") for a in argv]
+    if expected == "refused":
+        assert outcome(capsys, argv) == "refused"
+        return
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0 and "Traceback" not in err, err
+    doc = strict_json(out)
+    assert doc["validity"]["overall"] == "red" and doc["parameters"]["fs"]["value"] is None, doc["validity"]
+    OUTCOMES["exit 0, strict JSON, red: no driver's"] += 1

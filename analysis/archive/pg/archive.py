@@ -25,6 +25,7 @@ from analysis.archive.limits_store import LimitsVersion, checked_document, check
 from analysis.archive.names import ArchiveError, check_id, check_id_prefix, inside
 from analysis.archive.pg.files import fetch_file
 from analysis.archive.pg.outbox import Outbox, queue_folder
+from analysis.archive.pg.queue_identity import adopt, point, remembered, server_identity
 from analysis.archive.pg.server import ServerRefused, ServerUnreachable, connect, parse_url, server_errors
 from analysis.archive.record import RECORD_FILE, checked_parameter, entry_of, one_line_text, read_record
 from analysis.archive.sync_report import SyncReport
@@ -52,13 +53,37 @@ class PostgresArchive:
         self.server = parse_url(url)
         self.location = self.server.display
         self.notes: list[str] = []
-        self.outbox = Outbox(Path(queue_root) if queue_root else queue_folder(self.server.slug))
         self.cache = Path(cache_root) if cache_root else cache_folder(self.server.slug)
+        # The queue is the server's, not the URL spelling's (analysis.archive.pg.queue_identity): the URL's
+        # folder points to it once this URL has reached the server; until then the URL's folder is the queue.
+        self._url_queue = None if queue_root else queue_folder(self.server.slug)
+        self._identity_checked = queue_root is not None
+        if queue_root:
+            self.outbox = Outbox(Path(queue_root))
+        else:
+            known = remembered(self._url_queue)
+            self.outbox = Outbox(known or self._url_queue)
+            if known is not None:
+                adopt(self._url_queue, known)        # queued there by a linpar that kept queues per URL
+
+    def _connect(self, doing: str):
+        """A connection to the server; the first one also tells which queue is this server's."""
+        conn = connect(self.server, doing)
+        if not self._identity_checked:
+            self._identity_checked = True
+            name = server_identity(conn)
+            if name is not None:
+                target = self._url_queue.parent / name
+                point(self._url_queue, target)
+                for source in {self._url_queue, self.outbox.root}:
+                    adopt(source, target)
+                self.outbox = Outbox(target)
+        return conn
 
     @contextlib.contextmanager
     def _session(self, doing: str, needs: str = "") -> Iterator:
         try:
-            conn = connect(self.server, doing)
+            conn = self._connect(doing)
         except ServerUnreachable as exc:
             waiting = self.pending
             if not waiting:
@@ -105,15 +130,16 @@ class PostgresArchive:
 
     def sync(self) -> SyncReport:
         """Send this station's local queue to the server."""
-        waiting = len(self.outbox.waiting())
-        if not waiting:
-            return SyncReport()
+        if self._identity_checked and not self.pending:
+            return SyncReport()         # (unchecked, this URL's spelling may not be where its server's queue is)
         try:
-            conn = connect(self.server, "sending the local queue")
+            conn = self._connect("sending the local queue")
         except (ServerUnreachable, ServerRefused) as exc:
-            return SyncReport(waiting=waiting, problem=str(exc), refused=isinstance(exc, ServerRefused))
+            waiting = self.pending
+            return SyncReport(waiting=waiting, problem=str(exc) if waiting else "",
+                              refused=bool(waiting) and isinstance(exc, ServerRefused))
         try:
-            return self.outbox.send(conn, self.server)
+            return self.outbox.send(conn, self.server) if self.pending else SyncReport()
         finally:
             conn.close()
 

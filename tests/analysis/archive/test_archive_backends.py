@@ -113,7 +113,8 @@ def test_population_selects_exactly_and_keeps_time_order(opener, measured):
     path, doc = measured
     station = opener()
     plan = [("QA1", "W6", 70.1), ("QA10", "W6", 70.2), ("QA1", "W8", 70.3), ("QA1", "W6", 70.4)]
-    ids = [station.store(path, unit(doc, fs=fs), {"station": s, "driver": d, "measured_at": f"2024-06-0{i + 1}"})
+    ids = [station.store(path, unit(doc, fs=fs), {"station": s, "driver": d,
+                                                  "measured_at": f"2024-06-0{i + 1}T00:00Z"})
            for i, (s, d, fs) in enumerate(plan)]
     everything = opener().population()
     assert list(everything.ids) == ids and everything.values["fs"].tolist() == [70.1, 70.2, 70.3, 70.4]

@@ -125,3 +125,16 @@ def test_an_inverted_laser_is_red_with_the_sign_named_not_the_model_lab(written,
     from analysis.validity.fit import qa_blocker
     verdict, why = qa_blocker(result.validity)
     assert "sign is inverted" in why
+
+
+def test_a_low_q_driver_with_a_right_laser_is_not_judged_inverted():
+    """A 6-inch driver damped hard (Rms 15 kg/s, Qms 0.28 < Qes 0.50): its resonance peak stays below 2 RE, so
+    the first lines with |Z| > 2 RE are the coil's inductive rise, where Z - RE is j w Le and Bl line by line
+    reads -w^2 Le Mms / Bl: the old check called the right laser inverted (152 degrees, red)."""
+    from tests.builders import electrical
+    values = electrical(5.7, 0.4e-3, 15e-3, 0.84e-3, 15.0, 7.0, L2=0.6e-3, R2=8.0, **{"lambda": 0.12})
+    assert values["RES"] < values["RE"]                 # peak |Z| = RE + RES < 2 RE
+    result = analyze_recording(_odd_recording(values), sd_m2=0.0104)
+    assert result.parameters["Qms"].value < result.parameters["Qes"].value
+    assert pl.LASER_SIGN not in _plausibility(result), result.validity
+    assert result.validity["overall"] != "red", result.validity

@@ -91,6 +91,22 @@ def test_a_date_beyond_9998_is_one_line(capsys, rec, tmp_path):
     assert code == 2 and "meta.measured_at" in error_line(err) and "a year" in err
 
 
+@pytest.mark.parametrize("when", ["2026-05-04T09:30:00", "2026-05-04 09:30", "2026-05-04"])
+def test_a_measurement_time_without_its_utc_offset_is_one_line_and_nothing_stored(capsys, rec, tmp_path, when):
+    """Taken as UTC, 09:30 typed at a station on UTC+2 would date the unit two hours late in the line's archive:
+    the offset is asked for, before the analysis runs, and nothing is stored."""
+    root = tmp_path / "a"
+    code, out, err = run(capsys, "archive", "store", rec, "--root", root, "--measured-at", when)
+    line = error_line(err)
+    assert code == 2 and "has no UTC offset" in line and "+01:00" in line and "or Z for UTC" in line
+    assert Archive(root).list() == []
+    code, out, err = run(capsys, "archive", "store", rec, "--root", root, "--measured-at", when + "+02:00"
+                         if "T" in when or " " in when else when + "T00:00+02:00", "--json")
+    assert code == 0
+    stored = Archive(root).list()
+    assert len(stored) == 1 and stored[0].measured_at.endswith("Z") and stored[0].measured_at[11:13] in ("07", "22")
+
+
 @pytest.mark.parametrize("field, value, words", [
     (("key_parameters", "RE", "value"), float("inf"), "key_parameters.RE.value: found inf"),
     (("driver",), "two\nlines", "driver held characters that are not text"),
