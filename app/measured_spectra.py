@@ -59,6 +59,7 @@ class MeasuredSpectraView(pg.GraphicsLayoutWidget):
         for row, (name, label, scale, amplitude, noise) in enumerate(rows):
             plot = self.addPlot(row=row, col=0, axisItems={"bottom": LogFrequencyAxis("bottom")})
             style_plot(plot, label, log_y=True, bottom="frequency (Hz)" if row == len(rows) - 1 else None)
+            plot.getAxis("left").enableAutoSIPrefix(False)      # "voltage (V) (x0.001)" over 10¹ read as 10 V
             x = hx_freqs if name == "Hx" else freqs
             positive = amplitude > 0
             plot.plot(x[positive], amplitude[positive] * scale, pen=None, symbol="o",

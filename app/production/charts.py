@@ -176,11 +176,10 @@ class ControlChartView(pg.GraphicsLayoutWidget):
             k = np.array(jumps)
             self.ranges.plot(x[k], chart.moving_ranges[k - 1] * abs(scale), pen=None, symbol="o", symbolSize=7,
                              symbolBrush=ALARM, symbolPen=None)
-        # Short, and free to be cut: a title wider than the pane set the chart's minimum width, and at 1280 px
-        # the chart ran past the window's edge with its limits' labels.
-        self.individuals.setTitle(f"{display_name(p.name)}: {chart.values.size} units, centre and σ from the first "
-                                  f"{chart.baseline}; {len(chart.alarms)} alarm(s)")
-        self.individuals.titleLabel.setMinimumWidth(0)
+        # A short title: pyqtgraph makes a title's width the chart's minimum width, and at 1280 px a long one ran
+        # the chart, with its limits' labels, past the window's edge.
+        self.individuals.setTitle(f"{display_name(p.name)}: {len(chart.alarms)} alarm(s); centre, σ of units "
+                                  f"1–{chart.baseline}")
 
 
 class HistogramView(pg.PlotWidget):

@@ -4,6 +4,7 @@ and limits stored from the page itself (a server refuses a login whose role may 
 import json
 
 import pytest
+from PySide6.QtCore import Qt
 
 from analysis.archive import open_archive
 from tests.app.production.test_page import TIMEOUT_MS, fill, show
@@ -31,6 +32,9 @@ def test_the_statistics_table_fits_without_sideways_scrolling(qtbot, window, mea
         widths = [header.sectionSize(i) for i in range(header.count())]
         assert header.length() <= table.viewport().width(), f"columns {widths} in {table.viewport().width()} px"
         assert table.horizontalScrollBar().maximum() == 0
+        # The control chart inside its pane: a long title had made the chart's layout wider than the window.
+        chart_min = page.chart.ci.effectiveSizeHint(Qt.SizeHint.MinimumSize).width()
+        assert chart_min <= page.chart.viewport().width(), (chart_min, page.chart.viewport().width())
     qtbot.waitUntil(fits, timeout=10_000)
     fs = [r for r in range(table.rowCount()) if table.item(r, 0).text() == "fs"][0]
     cpk = table.item(fs, 6).text()
