@@ -7,7 +7,8 @@ import pytest
 from PySide6.QtCore import Qt
 
 from analysis.archive import open_archive
-from tests.app.production.test_page import TIMEOUT_MS, fill, show
+from tests.app.production.test_page import fill, show
+from tests.pace import wait_ms
 from tests.production_helpers import LIMITS, small_measurement
 
 
@@ -23,7 +24,7 @@ def test_the_statistics_table_fits_without_sideways_scrolling(qtbot, window, mea
     fill(str(archive_root), measured, n=units, drift_at=99)
     page, data = show(qtbot, window)
     window.resize(*size)
-    qtbot.waitUntil(lambda: window.width() == size[0], timeout=TIMEOUT_MS)
+    qtbot.waitUntil(lambda: window.width() == size[0], timeout=wait_ms(120))
     table = page.stats_table
     # The layout settles on the event loop: wait for it, then ask whether any column lies past the edge.
     header = table.horizontalHeader()
@@ -35,7 +36,7 @@ def test_the_statistics_table_fits_without_sideways_scrolling(qtbot, window, mea
         # The control chart inside its pane: a long title had made the chart's layout wider than the window.
         chart_min = page.chart.ci.effectiveSizeHint(Qt.SizeHint.MinimumSize).width()
         assert chart_min <= page.chart.viewport().width(), (chart_min, page.chart.viewport().width())
-    qtbot.waitUntil(fits, timeout=10_000)
+    qtbot.waitUntil(fits, timeout=wait_ms(10))
     fs = [r for r in range(table.rowCount()) if table.item(r, 0).text() == "fs"][0]
     cpk = table.item(fs, 6).text()
     assert "\n" in cpk and "–" in cpk.split("\n")[1]                                         # the interval on the cell's second line
@@ -49,8 +50,8 @@ def test_limits_stored_from_the_page_reach_the_statistics(qtbot, window, measure
     assert data.stats.limits is None and "Store limits…" in page.summary.text()
     limits = tmp_path / "limits.json"
     limits.write_text(json.dumps(LIMITS))
-    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as computed:
-        with qtbot.waitSignal(page.limits_stored, timeout=TIMEOUT_MS) as stored:
+    with qtbot.waitSignal(page.computed, timeout=wait_ms(120)) as computed:
+        with qtbot.waitSignal(page.limits_stored, timeout=wait_ms(120)) as stored:
             page.store_limits(limits)
     assert "limits version 1 (6-inch woofer)" in stored.args[0]
     assert computed.args[0].stats.limits.version == 1
@@ -64,7 +65,7 @@ def test_a_bad_limits_file_is_said_and_nothing_is_stored(qtbot, window, measured
     page, _ = show(qtbot, window)
     bad = tmp_path / "limits.json"
     bad.write_text('{"format": "linpar-limits/1", "name": "x", "parameters": {"fs": {"min": 80, "max": 60}}}')
-    with qtbot.waitSignal(page.failed, timeout=TIMEOUT_MS) as failed:
+    with qtbot.waitSignal(page.failed, timeout=wait_ms(120)) as failed:
         page.store_limits(bad)
     assert "The limits were not stored" in page.message.text() and failed.args[0]
     assert open_archive(str(archive_root)).limits() is None
@@ -77,10 +78,10 @@ def test_a_server_refuses_limits_from_an_operator_and_takes_them_from_an_enginee
     limits.write_text(json.dumps(LIMITS))
     monkeypatch.setenv("LINPAR_ARCHIVE_URL", pg_database.url("station_a"))
     page, _ = show(qtbot, window)
-    with qtbot.waitSignal(page.failed, timeout=TIMEOUT_MS) as failed:
+    with qtbot.waitSignal(page.failed, timeout=wait_ms(120)) as failed:
         page.store_limits(limits)
     assert "engineer" in failed.args[0], failed.args[0]
     monkeypatch.setenv("LINPAR_ARCHIVE_URL", pg_database.url("eva"))
-    with qtbot.waitSignal(page.computed, timeout=TIMEOUT_MS) as computed:
+    with qtbot.waitSignal(page.computed, timeout=wait_ms(120)) as computed:
         page.store_limits(limits)
     assert computed.args[0].stats.limits.version == 1
