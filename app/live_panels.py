@@ -49,7 +49,9 @@ DISPLAY_BUCKETS = 300
 LEGEND = (f"<span style='color:{SIGNAL_COLOUR}'>●</span> signal lines &nbsp; "
           f"<span style='color:{DISTORTION_COLOUR}'>●</span> noise + distortion (lines not excited) &nbsp; "
           f"<span style='color:{NOISE_COLOUR}'>—</span> noise floor")
-UNIT_WORDS = {"V": "dB re 1 V", "A": "dB re 1 A", "m": "dB re 1 m"}
+UNIT_WORDS = {"V": "dB re 1 V", "A": "dB re 1 A", "m": "dB re 1 mm"}
+# dB added to a channel's levels (dB re 1 of its SI unit) for its panel: displacement is read in mm, not m.
+UNIT_OFFSET_DB = {"m": 60.0}
 
 
 class SparseFrequencyAxis(LogFrequencyAxis):
@@ -167,6 +169,9 @@ class LiveChannelPanel(QWidget):
         noise = np.concatenate([_visible(ch.line_noise_db), _visible(ch.other_noise_db)])[self._order]
         other_db = self._others.power_mean_db(other_db)
         noise = self._merged.power_mean_db(noise)
+        offset = UNIT_OFFSET_DB.get(ch.unit, 0.0)
+        if offset:
+            line_db, other_db, noise = line_db + offset, other_db + offset, noise + offset
         self._set_y_range(line_db, other_db, noise)
         self._dots(self.lines, frame.line_freqs, line_db, DOT_HEIGHT)
         self._dots(self.distortion, self._others.freqs, other_db, DOT_HEIGHT * 0.5)

@@ -132,6 +132,14 @@ def short_value(p: ParameterValue) -> tuple[str, str]:
     return f"{round(value, decimals):.{max(0, decimals)}f}", std_text
 
 
+def shared_reason(rows) -> str:
+    """The one reason every parameter row went unmeasured for (a broken lead: nothing fitted), or "": the table
+    says it once instead of in each row's cell, truncated."""
+    reasons = {p.reason or "" for p in rows if not isinstance(p, str) and p.name != "Sd"}
+    unmeasured = all(p.value is None for p in rows if not isinstance(p, str) and p.name != "Sd")
+    return reasons.pop() if unmeasured and len(reasons) == 1 else ""
+
+
 class ParameterModel(QAbstractTableModel):
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -141,6 +149,7 @@ class ParameterModel(QAbstractTableModel):
         self._parameters: Mapping[str, ParameterValue] = {}
         self._sd_m2: float | None = None
         self.all_digits = False
+        self.common_reason = ""         # every row unmeasured for one reason: said once above the table
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
                        descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
@@ -151,6 +160,7 @@ class ParameterModel(QAbstractTableModel):
         # Every role of every cell, worked out once: a view asks for each of them on every repaint
         # (some 1,700 calls to show the table), and formatting them each time made up half of the
         # Results page's repaint.
+        self.common_reason = shared_reason(self._rows)
         self._cells = [self._row_roles(p) for p in self._rows]
         self.endResetModel()
 
@@ -217,7 +227,9 @@ class ParameterModel(QAbstractTableModel):
         if col == UNIT:
             return pretty_unit(p.display_unit)
         if p.value is None:
-            return f"n/a: {p.reason}" if col == VALUE else ""
+            if col != VALUE:
+                return ""
+            return "not measured" if self.common_reason else f"n/a: {p.reason}"
         value, std = format_value(p, self.all_digits)
         return value if col == VALUE else std
 
@@ -311,10 +323,22 @@ def titled_parameter_table(title_html: str) -> tuple[QWidget, "ParameterTable"]:
                           f"{DEFAULT_DIGITS} significant digits")
     all_digits.toggled.connect(table.set_all_digits)
     table.all_digits_box = all_digits
+    note = QLabel()                     # the one reason nothing was measured, when that is so
+    note.setWordWrap(True)
+    note.setTextFormat(Qt.PlainText)
+    note.hide()
+    table.note = note
+
+    def show_note():
+        reason = table.parameter_model.common_reason
+        note.setText(f"Not measured: {reason}" if reason else "")
+        note.setVisible(bool(reason))
+    table.parameter_model.modelReset.connect(show_note)
     top = QHBoxLayout()
     top.addWidget(title, 1)
     top.addWidget(all_digits)
     layout.addLayout(top)
+    layout.addWidget(note)
     layout.addWidget(table, 1)
     parts = QLabel()
     parts.setWordWrap(True)

@@ -11,6 +11,7 @@ from analysis.derived import parameter_table
 from analysis.pipeline import AnalysisResult
 from app import style
 from app.fit_quality import FitQualityBox
+from app.measured_spectra import MeasuredSpectraView
 from app.parameter_table import titled_parameter_table
 from app.plots import TransferPlot
 from app.spl_panel import SplPanel
@@ -70,6 +71,10 @@ class ResultsView(QWidget):
         self.fit_quality = FitQualityBox()
 
         self.impedance_plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
+        self.measured_spectra = MeasuredSpectraView()       # a broken measurement: what it still measured
+        self.impedance_stack = QStackedWidget()
+        self.impedance_stack.addWidget(self.impedance_plot)
+        self.impedance_stack.addWidget(self.measured_spectra)
         self.displacement_plot = TransferPlot("|Hx| (mm/V)", 1e3, log_y=True)
         self.no_displacement = QLabel("This recording has no displacement channel: Hx, and with it Bl, Mms, "
                                       "Cms and the SPL prediction, need the laser.")
@@ -81,7 +86,7 @@ class ResultsView(QWidget):
         self.spl_panel = SplPanel()
 
         self.plot_tabs = QTabWidget()
-        self.plot_tabs.addTab(self.impedance_plot, "Impedance Z")
+        self.plot_tabs.addTab(self.impedance_stack, "Impedance Z")
         self.plot_tabs.addTab(self.displacement_stack, "Displacement Hx")
         self.plot_tabs.addTab(self.spl_panel, "Predicted SPL")
 
@@ -135,18 +140,23 @@ class ResultsView(QWidget):
     def show_outcome(self, outcome: AnalysisOutcome) -> None:
         result, curves = outcome.result, outcome.curves
         self.result, self.curves = result, curves
-        self.source_label.setText(source_text(result))
+        self.source_label.setText(source_text(result) + self._re_remark(result, outcome.nominal_ohm))
         self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
         self.fit_quality.set_result(result)
         self._show_parameters(result)
-        if curves is None:          # a broken measurement: judged (validity, reasons), nothing to draw
+        if curves is None:          # a broken measurement: judged (validity, reasons), nothing fitted
             self.impedance_plot.clear_curves()
             self.displacement_plot.clear_curves()
+            self.measured_spectra.show_result(result)
+            self.impedance_stack.setCurrentWidget(self.measured_spectra)
+            self.plot_tabs.setTabText(0, "Measured")
             self.displacement_stack.setCurrentWidget(self.displacement_plot)
             self.spl_panel.clear()
             self.stack.setCurrentWidget(self.content)
             self.result_changed.emit(result)
             return
+        self.impedance_stack.setCurrentWidget(self.impedance_plot)
+        self.plot_tabs.setTabText(0, "Impedance Z")
         self.impedance_plot.set_curves(curves.impedance, "Impedance Z = U / I")
         if curves.displacement is not None:
             self.displacement_plot.set_curves(curves.displacement, "Displacement per volt Hx = X / U")
@@ -174,6 +184,14 @@ class ResultsView(QWidget):
         self._show_parameters(result)
         self.result_changed.emit(result)
         return True
+
+    @staticmethod
+    def _re_remark(result: AnalysisResult, nominal_ohm: float | None) -> str:
+        """Re against the nominal impedance entered, on a line of its own when it is unusual (not a verdict)."""
+        from analysis.validity.nominal_remark import re_nominal_remark
+        re = result.parameters.get("RE")
+        remark = re_nominal_remark(None if re is None else re.value, nominal_ohm)
+        return f"<br><span style='color:{style.VALIDITY_COLOURS['yellow'][1]}'>{html.escape(remark)}</span>" if remark else ""
 
     def clear(self) -> None:
         self.result = self.curves = None

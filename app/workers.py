@@ -19,6 +19,7 @@ class AnalysisOutcome:
     path: Path
     result: AnalysisResult
     curves: ResultCurves | None         # None: nothing was fitted (result.not_fitted says why)
+    nominal_ohm: float | None = None    # the nominal impedance the sidecar's driver entry gives, for a remark
 
 
 class AnalysisWorker(JobRunner):
@@ -33,7 +34,9 @@ class AnalysisWorker(JobRunner):
             job.check()
             job.say(f"estimating spectra and fitting {path.name}")
             result = analyze_recording(recording, sd_m2, cancel=job.cancel_event)
-            return AnalysisOutcome(job.id, path, result, result_curves(result))
+            nominal = (recording.driver or {}).get("nominal_impedance_ohm")
+            nominal = float(nominal) if isinstance(nominal, (int, float)) and not isinstance(nominal, bool) else None
+            return AnalysisOutcome(job.id, path, result, result_curves(result), nominal)
         return self.run("analysis", work, f"analysing {path.name}")
 
     def start_model_part(self, outcome: AnalysisOutcome) -> Job:
@@ -43,5 +46,5 @@ class AnalysisWorker(JobRunner):
         def work(job: Job) -> AnalysisOutcome:
             job.say(f"the model part of the uncertainties of {outcome.path.name}")
             result = model_uncertainty(outcome.result, cancel=job.cancel_event)
-            return AnalysisOutcome(job.id, outcome.path, result, outcome.curves)
+            return AnalysisOutcome(job.id, outcome.path, result, outcome.curves, outcome.nominal_ohm)
         return self.run("model part", work, f"estimating the model part of {outcome.path.name}'s uncertainties")

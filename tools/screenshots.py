@@ -41,7 +41,8 @@ with residuals beyond the strip's range (tools/screenshots_window.py).
 --only hardware: the Hardware page's sound-card and serial-port lists at both sizes, this machine's and a
 Windows PC's as an example (tools/screenshots_hardware.py).
 qa-current-zeroed-1280x720.png and -1920x1080.png: the QA page judging a recording
-whose current lead is broken against limits; help-guide.png and help-about.png:
+whose current lead is broken against limits, results-current-zeroed-*.png: the Results page of it (what the
+valid channels measured); help-guide.png and help-about.png:
 Help's user guide and About (--only qa: just these).
 Nothing of the user's settings or archive is touched: the window gets
 a QSettings file and an archive in the temporary folder.
@@ -500,14 +501,15 @@ def qa_broken_screenshots(app: QApplication, window, folder: Path, out: Path) ->
     window.open_path(broken)
     if not wait_for(window.analysis_shown, ANALYSIS_TIMEOUT_S):
         return []
-    window.pages.setCurrentWidget(window.qa)
     written = []
-    for size in SMALL_AND_LARGE:
-        window.resize(*size)
-        settle(app)
-        path = out / f"qa-current-zeroed-{size[0]}x{size[1]}.png"
-        window.grab().save(str(path))
-        written.append(path)
+    for page, stem in ((window.qa, "qa-current-zeroed"), (window.results, "results-current-zeroed")):
+        window.pages.setCurrentWidget(page)
+        for size in SMALL_AND_LARGE:
+            window.resize(*size)
+            settle(app)
+            path = out / f"{stem}-{size[0]}x{size[1]}.png"
+            window.grab().save(str(path))
+            written.append(path)
     for name, show in (("help-guide", window.menus.show_guide), ("help-about", window.menus.show_about)):
         dialog = show()
         settle(app)

@@ -1,7 +1,7 @@
 """`linpar measure`: play, record, write the recording, then analyse it.
 
     linpar measure --out DIR [--rig virtual|soundcard] [--device NAME] [--calibration FILE]
-                   [--laser URL|analog|none] [--template woofer|midrange|tweeter|microspeaker]
+                   [--laser URL|analog|none] [--template woofer|woofer-line|midrange|tweeter|microspeaker]
                    [--level VOLT] [--periods N] [--period SAMPLES] [--name NAME] [--model EFFECTS] [--sd M2]
                    [--on-xrun end|restart] [--serial TEXT] [--operator TEXT] [--station TEXT]
                    [--archive URL|DIR | --archive-root DIR | --no-archive] [--json]

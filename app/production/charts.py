@@ -37,11 +37,56 @@ RIGHT_MARGIN = 0.14          # room right of the last unit for the lines' labels
 
 
 def _hline(plot, y, colour, dashed=True, label=""):
+    """A horizontal line; its name goes to the plot's MarginLabels (InfiniteLine's own labels overlapped
+    where two lines were close, and the top line's was cut at the plot's edge)."""
     pen = pg.mkPen(colour, width=1.5, style=Qt.DashLine if dashed else Qt.SolidLine)
-    line = pg.InfiniteLine(pos=y, angle=0, pen=pen, label=label,
-                           labelOpts={"position": 0.995, "color": colour, "anchors": [(1, 1), (1, 1)]})
+    line = pg.InfiniteLine(pos=y, angle=0, pen=pen)
     plot.addItem(line)
+    if label:
+        plot.margin_labels.add(label, y, colour)
     return line
+
+
+class MarginLabels:
+    """The horizontal lines' names at the plot's right edge, each beside its line where there is room, pushed
+    apart (and inside the plot) where lines lie closer than a line of text; placed again on every resize."""
+
+    def __init__(self, plot):
+        self.plot = plot
+        self.items: list[tuple[pg.TextItem, float]] = []
+        plot.getViewBox().sigResized.connect(self.place)
+        plot.getViewBox().sigRangeChanged.connect(self.place)
+
+    def clear(self) -> None:
+        self.items = []             # plot.clear() removed the text items themselves
+
+    def add(self, text: str, y: float, colour: str) -> None:
+        item = pg.TextItem(text, color=colour, anchor=(1, 0.5), fill=pg.mkBrush(255, 255, 255, 210))
+        item.setZValue(10)
+        self.plot.addItem(item)
+        self.items.append((item, float(y)))
+        self.place()
+
+    def place(self, *_) -> None:
+        if not self.items:
+            return
+        box = self.plot.getViewBox()
+        (x0, x1), (y0, y1) = box.viewRange()
+        pixels = box.height()
+        if pixels <= 0 or y1 <= y0:
+            return
+        per_pixel = (y1 - y0) / pixels
+        order = sorted(self.items, key=lambda pair: -pair[1])            # top first, in pixels from the top
+        heights = [item.boundingRect().height() for item, _ in order]
+        at = [(y1 - y) / per_pixel - h / 2 for (_, y), h in zip(order, heights)]     # just above its line
+        for i in range(len(at)):                                         # down from the top, no overlap
+            low = heights[i] / 2 if i == 0 else at[i - 1] + (heights[i - 1] + heights[i]) / 2
+            at[i] = max(at[i], low)
+        for i in reversed(range(len(at))):                               # up from the bottom edge
+            high = pixels - heights[i] / 2 if i == len(at) - 1 else at[i + 1] - (heights[i + 1] + heights[i]) / 2
+            at[i] = min(at[i], high)
+        for (item, _), pixel in zip(order, at):
+            item.setPos(x1, y1 - pixel * per_pixel)
 
 
 def display_unit(unit: str) -> str:
@@ -62,6 +107,7 @@ class ControlChartView(pg.GraphicsLayoutWidget):
         for plot in (self.individuals, self.ranges):
             show_grid(plot)
             plot.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
+            plot.margin_labels = MarginLabels(plot)
         self.ranges.setXLink(self.individuals)
         self.ranges.setLabel("bottom", "unit (in the order measured)")
         self.ranges.setLabel("left", "moving range")
@@ -70,6 +116,7 @@ class ControlChartView(pg.GraphicsLayoutWidget):
     def clear_chart(self, why: str = "") -> None:
         for plot in (self.individuals, self.ranges):
             plot.clear()
+            plot.margin_labels.clear()
         self.individuals.setTitle(why)
         self.alarm_points = np.array([], dtype=int)
 
@@ -90,14 +137,21 @@ class ControlChartView(pg.GraphicsLayoutWidget):
         _hline(self.individuals, chart.centre * scale, style.GUIDE, dashed=False, label="centre")
         _hline(self.individuals, chart.ucl * scale, CONTROL, label="UCL +3σ")
         _hline(self.individuals, chart.lcl * scale, CONTROL, label="LCL −3σ")
+        lines = [chart.centre, chart.ucl, chart.lcl]
         for value, name in ((p.capability.low, "LSL"), (p.capability.high, "USL")):
             if value is not None:
                 _hline(self.individuals, value * scale, SPEC, label=name)
+                lines.append(value)
         self.individuals.setXRange(0, x[-1] * (1 + RIGHT_MARGIN), padding=0)
-        self.individuals.addItem(pg.InfiniteLine(pos=chart.baseline + 0.5, angle=90,
-                                                 pen=pg.mkPen(style.GUIDE, width=1, style=Qt.DotLine),
-                                                 label="baseline", labelOpts={"position": 0.97, "color": style.GUIDE,
-                                                                               "anchors": [(1, 0), (1, 0)]}))
+        # Every line and point in view, the outermost line's label inside the plot.
+        shown = np.concatenate([y, np.array(lines) * scale])
+        self.individuals.setYRange(float(shown.min()), float(shown.max()), padding=0.06)
+        if chart.baseline < x[-1]:
+            # Where the baseline ends (every unit is in it: no line, the title says so), labelled at the top
+            # left of its line, away from the limits' labels at the right edge.
+            self.individuals.addItem(pg.InfiniteLine(
+                pos=chart.baseline + 0.5, angle=90, pen=pg.mkPen(style.GUIDE, width=1, style=Qt.DotLine),
+                label="baseline", labelOpts={"position": 0.97, "color": style.GUIDE, "anchors": [(1, 0), (1, 0)]}))
         flagged = chart.flagged()
         self.alarm_points = flagged
         if flagged.size:
@@ -122,8 +176,10 @@ class ControlChartView(pg.GraphicsLayoutWidget):
             k = np.array(jumps)
             self.ranges.plot(x[k], chart.moving_ranges[k - 1] * abs(scale), pen=None, symbol="o", symbolSize=7,
                              symbolBrush=ALARM, symbolPen=None)
-        self.individuals.setTitle(f"{display_name(p.name)}: individuals, centre and σ from the first "
-                                  f"{chart.baseline} units; {len(chart.alarms)} alarm(s)")
+        # A short title: pyqtgraph makes a title's width the chart's minimum width, and at 1280 px a long one ran
+        # the chart, with its limits' labels, past the window's edge.
+        self.individuals.setTitle(f"{display_name(p.name)}: {len(chart.alarms)} alarm(s); centre, σ of units "
+                                  f"1–{chart.baseline}")
 
 
 class HistogramView(pg.PlotWidget):

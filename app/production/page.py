@@ -37,6 +37,7 @@ STATION_COLUMNS = ("Station", "n", "Mean", "Offset from the stations' mean", "Re
 EXPORTS = {"CSV, one row per measurement and parameter (*.csv)": ".csv", "JSON (*.json)": ".json",
            "Q-DAS AQDEF for qs-STAT (*.dfq)": ".dfq"}
 LOW_CPK = 1.33          # below it a capability index is shown in red: the customary minimum for a process
+NAME_WIDTH = 104        # px of the Parameter column: a long name ("Sensitivity (1 W into Re, 1 m)") is elided
 
 
 def _number(value, scale: float = 1.0, digits: int = 4) -> str:
@@ -54,14 +55,14 @@ def _item(text: str, tooltip: str = "", colour: str | None = None) -> QTableWidg
 
 
 def _index_item(value: float | None, interval: tuple[float, float] | None, n: int) -> QTableWidgetItem:
-    """A capability index as an estimate: its value, its 95 % interval below it in the tooltip and after
-    it in the cell; green only when the whole interval clears LOW_CPK, red when the value is below it,
-    grey (no verdict) below MIN_UNITS units."""
+    """A capability index as an estimate: its value, its 95 % interval on the cell's second line and in the
+    tooltip (on one line the four intervals widened the table past a 1280 px screen); green only when the
+    whole interval clears LOW_CPK, red when the value is below it, grey (no verdict) below MIN_UNITS units."""
     if value is None:
         return _item("–")
     text = f"{value:.2f}"
     if interval is not None:
-        text += f" ({interval[0]:.2f}–{interval[1]:.2f})"
+        text += f"\n{interval[0]:.2f}–{interval[1]:.2f}"
     why = too_few(n)
     tip = (f"95 % confidence interval {interval[0]:.2f} to {interval[1]:.2f} from {n} units"
            if interval is not None else "")
@@ -87,6 +88,7 @@ def _table(columns) -> QTableWidget:
 class ProductionPage(QWidget):
     computed = Signal(object)           # app.production.worker.ProductionData, once shown
     failed = Signal(str)
+    limits_stored = Signal(str)         # the line that says which version was stored
 
     def __init__(self, settings, parent=None):
         super().__init__(parent)
@@ -95,6 +97,7 @@ class ProductionPage(QWidget):
         self.jobs = JobControls(self.worker, cancel_tip="Stop computing; the statistics shown stay", bar_width=120)
         self.data = None
         self.parameter: str | None = None
+        self.stored_line = ""                   # what Store limits… stored, until the statistics show it
 
         self.source_label = QLabel()
         self.source_label.setTextFormat(Qt.PlainText)       # an archive's path or URL is never markup
@@ -112,6 +115,10 @@ class ProductionPage(QWidget):
         self.refresh_button = QPushButton("Refresh")
         self.export_button = QPushButton("Export…")
         self.export_button.setToolTip("The selected units as CSV, JSON or Q-DAS AQDEF (.dfq)")
+        self.store_limits_button = QPushButton("Store limits…")
+        self.store_limits_button.setToolTip("Store a reviewed limits file (linpar-limits/1) as the archive's next "
+                                            "limits version, which the statistics then use. On a server only an "
+                                            "engineer's login may.")
         self.message = QLabel()
         self.message.setWordWrap(True)
         self.message.setTextFormat(Qt.RichText)
@@ -119,6 +126,10 @@ class ProductionPage(QWidget):
         self.summary.setTextFormat(Qt.PlainText)            # it quotes the limits' name and the filters typed
         self.summary.setWordWrap(True)
         self.stats_table = _table(STATS_COLUMNS)
+        self.stats_table.horizontalHeader().setSectionResizeMode(0, QHeaderView.Fixed)
+        self.stats_table.setColumnWidth(0, NAME_WIDTH)
+        # No stretched last column: it kept at least Qt's default 100 px, which cost the table its fit at 1280.
+        self.stats_table.horizontalHeader().setStretchLastSection(False)
         self.alarms_table = _table(ALARM_COLUMNS)
         self.stations_table = _table(STATION_COLUMNS)
         self.chart = ControlChartView()
@@ -135,6 +146,7 @@ class ProductionPage(QWidget):
             signal.connect(lambda *_: self.filter_timer.start())
         self.refresh_button.clicked.connect(self.refresh)
         self.export_button.clicked.connect(self.on_export)
+        self.store_limits_button.clicked.connect(self.on_store_limits)
         self.stats_table.itemSelectionChanged.connect(self.on_parameter_chosen)
         self.export_button.setEnabled(False)
 
@@ -151,6 +163,7 @@ class ProductionPage(QWidget):
         top.addWidget(QLabel("Baseline"))
         top.addWidget(self.baseline_spin)
         top.addWidget(self.refresh_button)
+        top.addWidget(self.store_limits_button)
         top.addWidget(self.export_button)
         filters = QHBoxLayout()
         for label, widget in (("Measured from", self.since_edit), ("to", self.until_edit), ("", self.station_combo),
@@ -172,7 +185,9 @@ class ProductionPage(QWidget):
         body = QSplitter(Qt.Horizontal)
         body.addWidget(left)
         body.addWidget(right)
-        body.setSizes([680, 600])
+        body.setStretchFactor(0, 3)             # the table's eleven columns first: no sideways scrolling at 1280 px
+        body.setStretchFactor(1, 2)
+        body.setSizes([780, 500])
         layout = QVBoxLayout(self)
         layout.addLayout(top)
         layout.addLayout(filters)
@@ -215,7 +230,9 @@ class ProductionPage(QWidget):
 
     def on_computed(self, data) -> None:
         self.data = data
-        self._say("; ".join(data.notes), "note") if data.notes else self.message.hide()
+        notes = [*data.notes, *([self.stored_line] if self.stored_line else [])]
+        self.stored_line = ""                   # said once, above the statistics of the new version
+        self._say("; ".join(notes), "note") if notes else self.message.hide()
         self._offer(self.station_combo, data.population.stations)
         self._offer(self.driver_combo, data.population.drivers)
         self.summary.setText(self._summary_text(data.stats, self._loaded_limits_file()))
@@ -244,11 +261,11 @@ class ProductionPage(QWidget):
         store = f"linpar qa limits --store {shlex.quote(loaded_limits or 'FILE')}"
         parts.append(f"limits version {stats.limits.version} ({stats.limits.name})" if stats.limits is not None
                      else f"no limits stored: Cp, Cpk, Pp, Ppk and yield need the archive's limits; an engineer "
-                          f"stores them with: {store}")
+                          f"stores them with Store limits… or: {store}")
         few = [p.capability.n for p in stats.parameters.values() if p.capability.n < MIN_UNITS]
         if stats.limits is not None and few:
             parts.append(f"capability indices greyed: {max(few)} unit(s) or fewer, at least {MIN_UNITS} needed; "
-                         "the brackets are 95 % confidence intervals")
+                         "below each index its 95 % confidence interval")
         if stats.first_pass_yield is not None:
             parts.append(f"first-pass yield {100 * stats.first_pass_yield:.1f} % as the stations judged")
         return "; ".join(parts) + "."
@@ -262,11 +279,11 @@ class ProductionPage(QWidget):
             c, s = p.capability, p.display_scale
             unit = f" {display_unit(p.display_unit)}".rstrip()
             alarms = 0 if p.chart is None else len(p.chart.alarms)
-            name = _item(display_name(p.name))
+            name = _item(display_name(p.name), display_name(p.name))
             name.setData(Qt.ItemDataRole.UserRole, p.name)         # the statistics' key, for on_parameter_chosen
             cells = [name, _item(str(c.n)), _item(_number(c.mean, s) + unit,
                                                            f"min {_number(c.minimum, s)}, max {_number(c.maximum, s)}"),
-                     _item(_number(c.sigma_overall, s), f"within (moving range): {_number(c.sigma_within, s)}"),
+                     _item(_number(c.sigma_overall, s, 3), f"within (moving range): {_number(c.sigma_within, s)}"),
                      _item(p.limit_text or "–")]
             for value, interval in ((c.cp, spread_interval), (c.cpk, centred_interval), (c.pp, spread_interval),
                                     (c.ppk, centred_interval)):
@@ -277,6 +294,7 @@ class ProductionPage(QWidget):
                 table.setItem(row, col, item)
             if p.name == self.parameter:
                 chosen_row = row
+        table.resizeRowsToContents()            # the indices' intervals are their cells' second line
         table.blockSignals(False)
         if stats.parameters:
             table.selectRow(chosen_row)
@@ -329,6 +347,30 @@ class ProductionPage(QWidget):
                 self.stations_table.setItem(row, col, item)
         self.details.setTabText(1, f"{display_name(p.name)}: stations" + (f" ({sum(1 for s in rows if s.reads)} differ)"
                                                             if any(s.reads for s in rows) else ""))
+
+    # -- limits ------------------------------------------------------------------------------
+    def on_store_limits(self) -> None:
+        path, _ = QFileDialog.getOpenFileName(self, "Store a limits file as the next limits version",
+                                              self._loaded_limits_file(), "Limits (*.json);;All files (*)")
+        if path:
+            self.store_limits(path)
+
+    def store_limits(self, path: str | Path, note: str = "") -> int:
+        """Store the limits file at `path` in the archive (off the GUI thread); the page says what came of it
+        and shows the statistics against the new version. The job's id."""
+        job = self.worker.store(self.request().source, str(path), note)
+        self.jobs.run(job, "Storing the limits…", self.on_limits_stored, self.on_store_failed)
+        return job.id
+
+    def on_limits_stored(self, line: str) -> None:
+        self.stored_line = line
+        self._say(line, "note")
+        self.limits_stored.emit(line)
+        self.refresh()
+
+    def on_store_failed(self, message: str) -> None:
+        self._say(f"The limits were not stored: {message}")
+        self.failed.emit(message)
 
     # -- export ------------------------------------------------------------------------------
     def on_export(self) -> None:

@@ -50,6 +50,21 @@ def compute(request: ProductionRequest) -> ProductionData:
     return ProductionData(request, archive.location, population, stats, excluded, tuple(archive.notes))
 
 
+def store_limits(source: str, path: str, note: str = "") -> str:
+    """Store a limits file as the archive's next limits version (every check of `linpar qa limits --store`);
+    the line that says what was stored. A server refuses a user whose role may not (ServerRefused)."""
+    import json
+
+    from analysis.archive import open_archive
+    from analysis.files import read_text
+    from analysis.limits import LimitsError, load_limits
+    load_limits(path)                                       # every check of a limits file, with its lines
+    document = json.loads(read_text(path, "config", "a JSON limits file", LimitsError))
+    archive = open_archive(source)
+    version = archive.store_limits(document, note)
+    return f"Stored {path} as limits version {version.version} ({version.name}) in {archive.location}."
+
+
 class ProductionWorker(JobRunner):
     def __init__(self, parent: QObject | None = None):
         super().__init__(parent, max_threads=1)
@@ -57,3 +72,6 @@ class ProductionWorker(JobRunner):
     def start(self, request: ProductionRequest) -> Job:
         self.cancel_all()               # only the newest request's result is shown
         return self.run("statistics", lambda job: compute(request), "computing the production statistics")
+
+    def store(self, source: str, path: str, note: str = "") -> Job:
+        return self.run("limits", lambda job: store_limits(source, path, note), f"storing the limits {path}")

@@ -43,7 +43,18 @@ class MeasurementTemplate:
     level_v_rms: float
     n_periods: int
     lines_per_octave: float = 12.0
+    settle_periods: int | None = None       # None: SETTLE_SAMPLES in whole periods
 
+
+# A line's woofer in under 3 s (the end-of-line target): 4 periods of 16,384 samples (2.9 Hz between
+# bins, 0.34 s each) after 4 settling ones (65,536 samples: the virtual rig's FIR; a real woofer's decay is far
+# shorter), 2.7 s of sound, at a level given once (`--level`, the first unit's level check) instead of a
+# level check per unit. Repeatability (tools/line_repeatability.py, 10 repeats on the in-process rig):
+# docs/production.md.
+LINE_WOOFER = ("woofer-line", "woofers on a production line, fs 25 - 100 Hz: 2.7 s of sound a unit at a level given "
+               "once (no level check). 10 repeats on the in-process rig with a line's noise: 1 σ of Re 0.001 %, fs "
+               "0.001 %, Qts 0.004 %, Bl 0.003 %, Mms 0.005 % (the full woofer template, 13.7 s: 0.000-0.002 %); "
+               "that is the noise alone: a line's fixture, temperature and creep add theirs (docs/production.md)")
 
 TEMPLATES: Mapping[str, MeasurementTemplate] = {t.name: t for t in (
     MeasurementTemplate("woofer", "bass and bass-midrange drivers, fs 15 - 100 Hz", 2.0, 10000.0, 65536, 1.0, 8),
@@ -55,6 +66,7 @@ TEMPLATES: Mapping[str, MeasurementTemplate] = {t.name: t for t in (
     # The large-signal plan's steps (large_signal_plan.py): short periods, few of them, from a small-signal level.
     MeasurementTemplate("large-signal", "large-signal steps of woofers and midranges, fs 20 - 200 Hz", 5.0, 10000.0,
                         16384, 0.5, 4),
+    MeasurementTemplate(*LINE_WOOFER, 5.0, 10000.0, 16384, 1.0, 4, settle_periods=4),
 )}
 
 
@@ -111,7 +123,8 @@ class MeasurementPlan:
         except KeyError:
             raise PlanError(f"unknown template {name!r}; known: {', '.join(TEMPLATES)}") from None
         base = cls(template=t.name, f_min_hz=t.f_min_hz, f_max_hz=t.f_max_hz, period_samples=t.period_samples,
-                   level_v_rms=t.level_v_rms, n_periods=t.n_periods, lines_per_octave=t.lines_per_octave)
+                   level_v_rms=t.level_v_rms, n_periods=t.n_periods, lines_per_octave=t.lines_per_octave,
+                   settle_periods=t.settle_periods)
         return replace(base, **{k: v for k, v in changes.items() if v is not None})
 
     @property

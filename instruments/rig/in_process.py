@@ -47,6 +47,8 @@ class InProcessRig:
     ``calibration``: the chain's (instruments.audio.Calibration); the rig's own by default, whose amplifier
     gives 10 V at full scale (a multitone of ~7 V RMS at most).
 
+    ``noise``: the sensors' instruments.rig.engine.RigNoise (the rig's default when None).
+
     ``laser``: one of KINDS. The laser's ``ppm``, ``start_latency_s`` (switch-on
     to first measurement), ``link_latency_s`` (measurement to arrival, which no
     host time shows), ``link_jitter_s`` (with it the samples arrive in a USB
@@ -58,7 +60,7 @@ class InProcessRig:
     def __init__(self, driver: BlockDriver, laser: str = "simulated", *, ppm: float = 25.0,
                  start_latency_s: float = 0.0, link_latency_s: float = 0.0, link_jitter_s: float = 0.0,
                  error_plan=None, seed: int = 2,
-                 blocksize: int = 2048, realtime: bool | None = None, calibration=RIG_CALIBRATION):
+                 blocksize: int = 2048, realtime: bool | None = None, calibration=RIG_CALIBRATION, noise=None):
         if laser not in KINDS:
             raise ValueError(f"laser: {laser!r}, expected one of {', '.join(KINDS)}")
         self.kind = laser
@@ -67,7 +69,8 @@ class InProcessRig:
             "simulated", calibration=calibration, sample_rate=driver.sample_rate,
             channel_map=RIG_CHANNEL_MAP if laser in ("analog", "none") else SERIAL_CHANNEL_MAP,
             options=dict(driver=driver, blocksize=blocksize, seed=seed, feed=self.feed,
-                         realtime=laser in ("simulated", "serial") if realtime is None else realtime)))
+                         realtime=laser in ("simulated", "serial") if realtime is None else realtime,
+                         **({} if noise is None else {"noise": noise}))))
         self.laser_settings = {"clock_ppm": float(ppm), "start_latency_s": float(start_latency_s),
                                "link_latency_s": float(link_latency_s), "link_jitter_s": float(link_jitter_s)}
         self.error_plan = error_plan

@@ -105,7 +105,7 @@ def test_four_units_grey_the_capability_indices_and_say_why(qtbot, window, measu
     for item in _index_cells(page, "fs"):
         if item.text() != "–":
             assert item.foreground().color() == Qt.GlobalColor.gray
-            assert "only 4 units" in item.toolTip() and "(" in item.text()      # the interval in the cell
+            assert "only 4 units" in item.toolTip() and "–" in item.text()      # the interval in the cell
 
 
 def test_forty_units_show_intervals_and_a_verdict(qtbot, window, measured, archive_root):
@@ -118,7 +118,7 @@ def test_forty_units_show_intervals_and_a_verdict(qtbot, window, measured, archi
     c = data.stats.parameters["fs"].capability
     lo, hi = centred_interval(c.cpk, c.n)
     cpk = _index_cells(page, "fs")[1]
-    assert cpk.text() == f"{c.cpk:.2f} ({lo:.2f}–{hi:.2f})"
+    assert cpk.text() == f"{c.cpk:.2f}\n{lo:.2f}–{hi:.2f}"                 # the interval on the second line
     colour = cpk.foreground().color()
     assert colour != Qt.GlobalColor.gray
     assert (colour == Qt.GlobalColor.darkGreen) == (lo >= 1.33)       # green only when the interval clears 1.33
