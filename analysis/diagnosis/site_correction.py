@@ -5,7 +5,11 @@ The correction is a complex function of frequency,
     h(f) = sum_k (a_k + j*b_k) * B_k(ln f)
 
 with cubic B-splines B_k on knots evenly spaced in ln f over the measured
-band (KNOTS_PER_DECADE). It enters the model the way an effect at that site
+band (KNOTS_PER_DECADE), and denser (DENSE_KNOTS_PER_DECADE) where the current
+fit's residual is concentrated: there the correction can follow a resonance
+and an antiresonance (a cone mode of Q 5-10 spans a tenth of a decade), which
+six knots a decade smooth away. The extra knots are paid for: the ranking
+counts the correction's effective number of parameters. It enters the model the way an effect at that site
 does (docs/physics.md section 8), in a form that is smooth for the physics
 expected there:
 
@@ -29,16 +33,35 @@ from scipy.interpolate import BSpline
 from analysis.effects.base import Effect, ParamSpec, Site
 
 KNOTS_PER_DECADE = 6.0
+DENSE_KNOTS_PER_DECADE = 30.0
 SPLINE_DEGREE = 3
 CATEGORY = "site-correction"
 COEFFICIENT_BOUND = 1e3
 
 
-def spline_knots(f_lo: float, f_hi: float, per_decade: float = KNOTS_PER_DECADE) -> np.ndarray:
-    """Clamped cubic B-spline knots in ln f, evenly spaced from f_lo to f_hi."""
+def spline_knots(f_lo: float, f_hi: float, per_decade: float = KNOTS_PER_DECADE,
+                 dense: tuple[tuple[float, float], ...] = ()) -> np.ndarray:
+    """Clamped cubic B-spline knots in ln f, evenly spaced from f_lo to f_hi, and DENSE_KNOTS_PER_DECADE
+    inside each of the `dense` spans (f_a, f_b)."""
     lo, hi = np.log(f_lo), np.log(f_hi)
     intervals = max(2, int(np.ceil((hi - lo) / np.log(10.0) * per_decade)))
     inner = np.linspace(lo, hi, intervals + 1)
+    extra = []
+    for f_a, f_b in dense:
+        a, b = max(np.log(f_a), lo), min(np.log(f_b), hi)
+        if b > a:
+            n = max(2, int(np.ceil((b - a) / np.log(10.0) * DENSE_KNOTS_PER_DECADE)))
+            extra.append(np.linspace(a, b, n + 1))
+    if extra:
+        inner = np.concatenate([inner] + extra)
+        inner.sort()
+        # Knots closer than a third of the dense spacing add nothing but ill-conditioning.
+        gap = np.log(10.0) / DENSE_KNOTS_PER_DECADE / 3.0
+        keep = np.concatenate([[True], np.diff(inner) > gap])
+        keep[-1] = True
+        inner = inner[keep]
+        if len(inner) > 2 and inner[-1] - inner[-2] <= gap:
+            inner = np.delete(inner, -2)
     return np.concatenate([[lo] * SPLINE_DEGREE, inner, [hi] * SPLINE_DEGREE])
 
 
@@ -119,8 +142,9 @@ FACTOR_WORDS = {Site.FORCE_FACTOR: "factor on Bl", Site.COMPLIANCE: "factor on t
                 Site.CURRENT: "factor on the measured current", Site.DISPLACEMENT: "factor on the measured displacement"}
 
 
-def site_correction(site: Site, f_lo: float, f_hi: float, scale: float = 1.0) -> SiteCorrection:
-    knots = spline_knots(f_lo, f_hi)
+def site_correction(site: Site, f_lo: float, f_hi: float, scale: float = 1.0,
+                    dense: tuple[tuple[float, float], ...] = ()) -> SiteCorrection:
+    knots = spline_knots(f_lo, f_hi, dense=dense)
     n = len(knots) - SPLINE_DEGREE - 1
     params = tuple(ParamSpec(name, "1", "-", 1.0, -COEFFICIENT_BOUND, COEFFICIENT_BOUND, 0.0,
                              f"spline coefficient of the {site.key} correction")

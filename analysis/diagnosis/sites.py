@@ -2,11 +2,27 @@
 
 For each of the six sites of docs/physics.md section 8, the current model gets a
 smooth, flexible complex correction there (analysis.diagnosis.site_correction) and is
-refitted with it, its own parameters free. The sites are ranked by how much
-misfit their correction removes, paid for by its effective number of
-parameters:
+refitted with it, its own parameters free. A site's correction is judged by
+how much misfit it removes, paid for by its effective number of parameters:
 
     delta_bic = chi^2(with the correction) - chi^2(current) + edf * ln n
+
+and the sites are ranked by the same criterion with each channel's misfit at
+its own scale, the BIC of a model whose noise level per channel is unknown
+(the profile likelihood, -2 ln L = m_c ln(chi^2_c / m_c) for the m_c values of
+channel c):
+
+    score = sum over Z, Hx of m_c * ln(chi^2_c(with) / chi^2_c(current)) + edf * ln n
+
+At the noise floor (chi^2_c near m_c) this is delta_bic; far from it a
+channel counts by the share of its misfit removed, not by its size. Z
+carries far the larger chi^2 (its noise is smaller against its size), and a
+factor on the measured current can reshape any Z: ranked by delta_bic, a
+site that cured Z alone outranked one that cures both channels.
+
+Where the current fit's residual is concentrated (a mode, a dip), the
+correction gets dense knots there (analysis.diagnosis.site_correction), so
+it can follow a resonance; edf counts them.
 
 edf is the trace of the correction's hat matrix: a roughness penalty
 (second differences of the spline coefficients) and a small ridge keep the
@@ -45,6 +61,12 @@ CORRECTION_POINTS = 120      # where the correction is reported
 DERIVATIVE_STEP = 1e-7       # the shift of h (and the relative step of the model's parameters)
 COMPLIANCE_TOP_OVER_FS = 2.0
 DETERMINED_RATIO = 3.0
+# Dense knots (analysis.diagnosis.site_correction) where the residual is concentrated: lines above this many
+# times their channel's mean chi^2 share, spans widened by this factor either side, at most this much of the band.
+CONCENTRATED = 3.0
+MAX_HOT_SHARE = 0.4
+SPAN_MARGIN = 1.15
+MAX_DENSE_DECADES = 1.0
 TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a ranking needs no more
 # The correction replaces what the model already has at its site: the base elements there and the
 # effects there are held at the current fit (the correction can take on any change of theirs, and
@@ -70,6 +92,11 @@ class SiteResult:
     # The standard error of the correction at each of `freqs` (of its real and of its imaginary part):
     # where it is large, the data do not see the correction and its shape there means nothing.
     correction_std: np.ndarray | None = None
+    score: float | None = None    # the ranking's: delta_bic with each channel at its own misfit's scale
+
+    @property
+    def rank_key(self) -> float:
+        return self.delta_bic if self.score is None else self.score
 
     @property
     def determined(self) -> np.ndarray:
@@ -84,7 +111,8 @@ class SiteResult:
         return self.site.key
 
     def as_json(self) -> dict:
-        return {"site": self.key, "delta_bic": float(self.delta_bic), "edf": float(self.edf),
+        return {"site": self.key, "delta_bic": float(self.delta_bic), "score": float(self.rank_key),
+                "edf": float(self.edf),
                 "chi2_red": {k: float(v) for k, v in self.chi2_red.items()},
                 "correction": {"f": self.freqs.tolist(), "magnitude": np.abs(self.correction).tolist(),
                                "phase_deg": np.degrees(np.angle(self.correction)).tolist(),
@@ -206,7 +234,8 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
         # Above a few fs the stiffness is spent (at 2 fs it is a quarter of the mass's reactance): a
         # compliance that changes there cannot show, so its correction is held constant above.
         f_hi = float(np.clip(COMPLIANCE_TOP_OVER_FS * resonance_frequency(values), 2.0 * f_lo, f_hi))
-    problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale))
+    dense = misfit_spans(current, f_lo, f_hi)
+    problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale, dense))
     x0 = np.zeros(problem.k + 2 * problem.n_basis)
     # MINPACK's Levenberg-Marquardt: its own QR, no threaded LAPACK call per step (on a busy machine
     # OpenBLAS threads made 'trf' 15x slower), and like lmfit's fits it starts from the current fit.
@@ -227,9 +256,46 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
     freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
     shown, unit, acts_as, scale = problem.correction.shown(freqs, p)
     std = scale * _h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
+    score = edf * np.log(n) + sum(m * np.log(max(c, 1e-300) / max(current.channels[name].chi2, 1e-300))
+                                  for name, (c, m) in chi2_by_channel.items())
     return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
                       chi2 - current.chi2 + edf * np.log(n), edf, freqs, shown, unit, acts_as, bool(result.status > 0),
-                      std)
+                      std, float(score))
+
+
+def misfit_spans(current: FitResult, f_lo: float, f_hi: float) -> tuple[tuple[float, float], ...]:
+    """Where the current fit's residual is concentrated: the spans (f_a, f_b) that get dense knots.
+
+    A line counts when it carries more than CONCENTRATED times its channel's mean share of that channel's
+    chi^2 and stands above the noise (|r| > 3 sigma); neighbouring lines form a span, widened by
+    SPAN_MARGIN either side. A misfit spread over most of the band is no resonance: no spans then.
+    """
+    flagged = []
+    for ch in current.channels.values():
+        r2 = np.abs(ch.normalized_residual) ** 2
+        if not np.any(r2 > 0):
+            continue
+        hot = (r2 > CONCENTRATED * np.mean(r2)) & (r2 > 9.0)
+        if hot.mean() > MAX_HOT_SHARE:
+            continue
+        flagged += [float(f) for f in ch.freqs[hot]]
+    if not flagged:
+        return ()
+    spans: list[list[float]] = []
+    for f in sorted(flagged):
+        if spans and f <= spans[-1][1] * SPAN_MARGIN ** 2:
+            spans[-1][1] = f
+        else:
+            spans.append([f, f])
+    widened = [(max(a / SPAN_MARGIN, f_lo), min(b * SPAN_MARGIN, f_hi)) for a, b in spans]
+    # The widest spans first, up to MAX_DENSE_DECADES in all: dense knots everywhere would be a finer spline.
+    kept, total = [], 0.0
+    for a, b in sorted(widened, key=lambda ab: -np.log10(ab[1] / ab[0])):
+        width = np.log10(b / a)
+        if total + width <= MAX_DENSE_DECADES:
+            kept.append((a, b))
+            total += width
+    return tuple(sorted(kept))
 
 
 def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:
@@ -280,7 +346,7 @@ def _inverse(A: np.ndarray) -> np.ndarray:
 def localise(data: FitData, current: FitResult, executor: Executor | None = None,
              sites: tuple[Site, ...] | None = None, known: dict[Site, SiteResult] | None = None,
              cancel: threading.Event | None = None) -> tuple[SiteResult, ...]:
-    """The sites' corrections (every usable site by default), best (lowest delta BIC) first.
+    """The sites' corrections (every usable site by default), best (lowest score) first.
 
     `known`: results already computed for `current` (the diagnosis computes some on its way).
     """
@@ -295,4 +361,4 @@ def localise(data: FitData, current: FitResult, executor: Executor | None = None
             if cancel is not None and cancel.is_set():
                 raise FitCancelled("site localisation cancelled")
             fitted.append(fit_site(data, current, site))
-    return tuple(sorted(list(known.values()) + fitted, key=lambda r: r.delta_bic))
+    return tuple(sorted(list(known.values()) + fitted, key=lambda r: r.rank_key))

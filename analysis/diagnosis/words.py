@@ -104,10 +104,20 @@ def _flag_sentence(flags: Iterable[acceptance.Flag]) -> str:
     return ("Flags: " + "; ".join(messages) + ".") if messages else ""
 
 
+def first_site(result: Diagnosis) -> Site | None:
+    """The site the verdict points the user at first: where the misfit left belongs when some is left (and a
+    site's correction explains it), else the site of the first effect the path took; None when neither."""
+    if result.verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED) and result.sites \
+            and result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
+        return result.sites[0].site
+    taken = next((step.chosen for step in result.steps if step.chosen is not None), None)
+    return taken.effect.site if taken is not None else None
+
+
 def verdict_headline(result: Diagnosis) -> str:
     """The verdict in one short sentence (verdict_text says it all)."""
     verdict = result.verdict
-    moves = ", ".join(c.effect.id for c in (step.chosen for step in result.steps) if c is not None)
+    moves = ", ".join(c.label for c in (step.chosen for step in result.steps) if c is not None)
     site = ""
     if result.sites and result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
         site = SITE_WORDS[result.sites[0].site][0]
@@ -132,7 +142,7 @@ def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
     verdict = result.verdict
     start, final = result.start, result.final
     taken = [step.chosen for step in result.steps if step.chosen is not None]
-    moves = ", ".join(("replacing " + c.replaces.id + " by " if c.replaces else "adding ") + c.effect.id
+    moves = ", ".join(("replacing " + c.replaces.id + " by " if c.replaces else "adding ") + c.label
                       for c in taken)
     parts = []
     if verdict == acceptance.NOTHING_MISSING:

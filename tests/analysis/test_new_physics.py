@@ -31,6 +31,9 @@ CASES = [
     ("closed-box", "lr2,creep-log,closed-box", {"alpha_b": 0.7}, 22),
     ("vented-box", "lr2,creep-log,vented-box", {"alpha_b": 1.5, "fb": 50.0, "QL": 7.0}, 21),
     ("vented-box", "lr2,creep-log,vented-box", {"alpha_b": 3.0, "fb": 35.0, "QL": 12.0}, 22),
+    # The vented box's loss family (issue 30): Vb with alpha_b 1.5, fb 45 Hz, the losses in the port or the filling.
+    ("vented-box-port", "lr2,creep-log,vented-box-port", {"alpha_b": 1.5, "fb": 45.0, "QP": 8.0}, 21),
+    ("vented-box-absorption", "lr2,creep-log,vented-box-absorption", {"alpha_b": 2.0, "fb": 40.0, "QA": 10.0}, 22),
     ("creep-kv", "lr2,creep-kv", {"kappa": 1.0, "beta": 0.4}, 21),
     ("creep-kv", "lr2,creep-kv", {"kappa": 0.4, "beta": 0.25}, 22),
     ("creep-zener", "lr2,creep-zener", {"kappa": 0.5, "tau_r": 1 / (2 * math.pi * 10.0), "beta": 0.5}, 21),
@@ -60,5 +63,26 @@ def test_the_diagnosis_names_the_missing_physics_and_explains_the_recording(pool
     for channel, chi2_red in final.chi2_red_by_channel().items():
         assert chi2_red <= 2.0, (channel, chi2_red)
     fitted, true = _mechanical(final.values), _mechanical(truth)
+    for name, value in true.items():
+        assert fitted[name] == pytest.approx(value, rel=0.01), name
+
+
+def test_a_cone_mode_in_the_impedance_and_at_the_spot_is_taken_as_a_pair(pool, mt):
+    """breakup alone makes Hx worse (the spot sees more of the mode than the coil), breakup-spot alone leaves Z:
+    the pair explains both channels (issue 30)."""
+    values = {"f2": 1500.0, "Q2": 6.0, "mu2": 0.05, "f2x": 1500.0, "Q2x": 4.0}
+    truth = {**PAPER.parameters, **values}
+    rec = recording(truth, "lr2,creep-log,breakup,breakup-spot", noise=TYPICAL_NOISE, n_periods=8, seed=23, mt=mt)
+    data = FitData.from_spectra(estimate_spectra(rec))
+    result = diagnose(data, Model(parse_effects(START)), executor=pool)
+
+    singles = {c.effect.id: c for c in result.first_candidates if c.partner is None}
+    assert not singles["breakup"].accepted and not singles["breakup-spot"].accepted
+    taken = [step.chosen for step in result.steps if step.chosen is not None]
+    assert [(c.effect.id, c.partner.id if c.partner else None) for c in taken] == [("breakup", "breakup-spot")]
+    assert result.verdict == acceptance.EXPLAINED
+    for channel, chi2_red in result.final.chi2_red_by_channel().items():
+        assert chi2_red <= 2.0, (channel, chi2_red)
+    fitted, true = _mechanical(result.final.values), _mechanical(truth)
     for name, value in true.items():
         assert fitted[name] == pytest.approx(value, rel=0.01), name
