@@ -28,7 +28,7 @@ import numpy as np
 
 from analysis.diagnosis import acceptance, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
-from analysis.diagnosis.sites import SiteResult, localise
+from analysis.diagnosis.sites import SiteResult, first_among_tied, localise
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
@@ -374,7 +374,13 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
         progress("looking for the site of the misfit left")
     final = result.final
     known = sites.done if final is sites.fit else None
-    return dataclasses.replace(result, sites=localise(data, final, executor, known=known, cancel=cancel))
+    located = localise(data, final, executor, known=known, cancel=cancel)
+    taken = {site for step in result.steps if step.chosen is not None for site in _sites_of(step.chosen)}
+    return dataclasses.replace(result, sites=first_among_tied(located, taken))
+
+
+def _sites_of(candidate: Candidate) -> tuple[Site, ...]:
+    return (candidate.effect.site,) + ((candidate.partner.site,) if candidate.partner is not None else ())
 
 
 def _model_flags(fit: FitResult) -> tuple[Flag, ...]:

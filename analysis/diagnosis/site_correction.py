@@ -31,12 +31,19 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from analysis.effects.base import Effect, ParamSpec, Site
+from analysis.fit.least_squares import FitResult
 
 KNOTS_PER_DECADE = 6.0
 DENSE_KNOTS_PER_DECADE = 30.0
 SPLINE_DEGREE = 3
 CATEGORY = "site-correction"
 COEFFICIENT_BOUND = 1e3
+# Dense knots where the residual is concentrated: lines above this many
+# times their channel's mean chi^2 share, spans widened by this factor either side, at most this much of the band.
+CONCENTRATED = 3.0
+MAX_HOT_SHARE = 0.4
+SPAN_MARGIN = 1.15
+MAX_DENSE_DECADES = 1.0
 
 
 def spline_knots(f_lo: float, f_hi: float, per_decade: float = KNOTS_PER_DECADE,
@@ -153,3 +160,38 @@ def site_correction(site: Site, f_lo: float, f_hi: float, scale: float = 1.0,
         id=f"correction-{site.key}", category=CATEGORY, title=f"Smooth correction at the {site.key} site",
         site=site, params=params, physics="", signature="", typical="", reference="",
         knots=knots, scale=scale)
+
+
+def misfit_spans(current: FitResult, f_lo: float, f_hi: float) -> tuple[tuple[float, float], ...]:
+    """Where the current fit's residual is concentrated: the spans (f_a, f_b) that get dense knots.
+
+    A line counts when it carries more than CONCENTRATED times its channel's mean share of that channel's
+    chi^2 and stands above the noise (|r| > 3 sigma); neighbouring lines form a span, widened by
+    SPAN_MARGIN either side. A misfit spread over most of the band is no resonance: no spans then.
+    """
+    flagged = []
+    for ch in current.channels.values():
+        r2 = np.abs(ch.normalized_residual) ** 2
+        if not np.any(r2 > 0):
+            continue
+        hot = (r2 > CONCENTRATED * np.mean(r2)) & (r2 > 9.0)
+        if hot.mean() > MAX_HOT_SHARE:
+            continue
+        flagged += [float(f) for f in ch.freqs[hot]]
+    if not flagged:
+        return ()
+    spans: list[list[float]] = []
+    for f in sorted(flagged):
+        if spans and f <= spans[-1][1] * SPAN_MARGIN ** 2:
+            spans[-1][1] = f
+        else:
+            spans.append([f, f])
+    widened = [(max(a / SPAN_MARGIN, f_lo), min(b * SPAN_MARGIN, f_hi)) for a, b in spans]
+    # The widest spans first, up to MAX_DENSE_DECADES in all: dense knots everywhere would be a finer spline.
+    kept, total = [], 0.0
+    for a, b in sorted(widened, key=lambda ab: -np.log10(ab[1] / ab[0])):
+        width = np.log10(b / a)
+        if total + width <= MAX_DENSE_DECADES:
+            kept.append((a, b))
+            total += width
+    return tuple(sorted(kept))

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, site_correction
+from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, misfit_spans, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
 from analysis.model.composed import Model
@@ -61,12 +61,9 @@ CORRECTION_POINTS = 120      # where the correction is reported
 DERIVATIVE_STEP = 1e-7       # the shift of h (and the relative step of the model's parameters)
 COMPLIANCE_TOP_OVER_FS = 2.0
 DETERMINED_RATIO = 3.0
-# Dense knots (analysis.diagnosis.site_correction) where the residual is concentrated: lines above this many
-# times their channel's mean chi^2 share, spans widened by this factor either side, at most this much of the band.
-CONCENTRATED = 3.0
-MAX_HOT_SHARE = 0.4
-SPAN_MARGIN = 1.15
-MAX_DENSE_DECADES = 1.0
+# Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)
+# explain the data equally well: the data cannot tell them apart.
+TIE_CHI2 = 10.0
 TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a ranking needs no more
 # The correction replaces what the model already has at its site: the base elements there and the
 # effects there are held at the current fit (the correction can take on any change of theirs, and
@@ -263,41 +260,6 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
                       std, float(score))
 
 
-def misfit_spans(current: FitResult, f_lo: float, f_hi: float) -> tuple[tuple[float, float], ...]:
-    """Where the current fit's residual is concentrated: the spans (f_a, f_b) that get dense knots.
-
-    A line counts when it carries more than CONCENTRATED times its channel's mean share of that channel's
-    chi^2 and stands above the noise (|r| > 3 sigma); neighbouring lines form a span, widened by
-    SPAN_MARGIN either side. A misfit spread over most of the band is no resonance: no spans then.
-    """
-    flagged = []
-    for ch in current.channels.values():
-        r2 = np.abs(ch.normalized_residual) ** 2
-        if not np.any(r2 > 0):
-            continue
-        hot = (r2 > CONCENTRATED * np.mean(r2)) & (r2 > 9.0)
-        if hot.mean() > MAX_HOT_SHARE:
-            continue
-        flagged += [float(f) for f in ch.freqs[hot]]
-    if not flagged:
-        return ()
-    spans: list[list[float]] = []
-    for f in sorted(flagged):
-        if spans and f <= spans[-1][1] * SPAN_MARGIN ** 2:
-            spans[-1][1] = f
-        else:
-            spans.append([f, f])
-    widened = [(max(a / SPAN_MARGIN, f_lo), min(b * SPAN_MARGIN, f_hi)) for a, b in spans]
-    # The widest spans first, up to MAX_DENSE_DECADES in all: dense knots everywhere would be a finer spline.
-    kept, total = [], 0.0
-    for a, b in sorted(widened, key=lambda ab: -np.log10(ab[1] / ab[0])):
-        width = np.log10(b / a)
-        if total + width <= MAX_DENSE_DECADES:
-            kept.append((a, b))
-            total += width
-    return tuple(sorted(kept))
-
-
 def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:
     """Standard error of h (the larger of its real and imaginary part's) at `freqs`, the model's parameters held.
 
@@ -341,6 +303,37 @@ def _inverse(A: np.ndarray) -> np.ndarray:
         return np.linalg.inv(A)
     except np.linalg.LinAlgError:
         return np.linalg.pinv(A)
+
+
+def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:
+    """The sites (after the best) whose correction explains the data as well as the best one's does.
+
+    With the impedance alone every site but the displacement acts on Z only, and any of them can
+    make Z anything: they are all tied, whatever their chi^2 (which differs by how smoothly each
+    correction follows the misfit, not by what the data say).
+    """
+    if not sites:
+        return []
+    best = sites[0]
+    if "displacement" not in best.chi2_red:
+        return list(sites[1:])
+    scale = max(1.0, max(best.chi2_red.values(), default=1.0))
+    return [s for s in sites[1:] if s.chi2 - best.chi2 <= TIE_CHI2 * scale]
+
+
+def first_among_tied(sites: tuple[SiteResult, ...], preferred: set[Site]) -> tuple[SiteResult, ...]:
+    """The sites with, among those the data cannot tell from the best, one of `preferred` first.
+
+    The diagnosis prefers the sites of the effects its path took: when the misfit left is one the data
+    cannot place, the likeliest cause is that an effect found is of a form close to, but not exactly,
+    the physics (a diffusion law of eddy currents left by bl-eddy's first-order fall).
+    """
+    if not sites or sites[0].site in preferred:
+        return sites
+    chosen = next((s for s in tied_sites(sites) if s.site in preferred), None)
+    if chosen is None:
+        return sites
+    return (chosen,) + tuple(s for s in sites if s is not chosen)
 
 
 def localise(data: FitData, current: FitResult, executor: Executor | None = None,
