@@ -190,7 +190,9 @@ class _SiteProblem:
 
     def residual(self, x: np.ndarray) -> np.ndarray:
         coef = x[self.k:]
-        pen = np.concatenate([self.penalty @ coef[: self.n_basis], self.penalty @ coef[self.n_basis:]])
+        # einsum, not BLAS (see _gram): a product this small costs BLAS's threads far more than the work.
+        pen = np.concatenate([np.einsum("ij,j->i", self.penalty, coef[: self.n_basis]),
+                              np.einsum("ij,j->i", self.penalty, coef[self.n_basis:])])
         return np.concatenate([self._data_residual(self.predictions(self.values(x))), pen])
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
