@@ -98,7 +98,8 @@ def rank_pairs(data: FitData, current: FitResult, ranked, refit, run, executor: 
     for (first, partner), (fit, error) in zip(kept, run(calls, executor, cancel)):
         both = PairedEffect(first.effect, partner.effect)
         flags = acceptance.candidate_flags(current, fit, both)
-        pairs.append(candidate_type(first.action, first.effect, None, fit,
-                                    (fit.bic - current.bic) if fit else float("inf"), error, flags,
-                                    acceptance.assess(current, fit, both, flags), partner=partner.effect))
+        pairs.append(candidate_type(action=first.action, effect=first.effect, replaces=None, fit=fit,
+                                    delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
+                                    flags=flags, assessment=acceptance.assess(current, fit, both, flags),
+                                    partner=partner.effect))
     return pairs
