@@ -65,6 +65,7 @@ class CandidateRow:
     flags: tuple[Flag, ...] = ()
     accepted: bool = False          # the acceptance rule would take it (analysis.diagnosis.acceptance)
     judgement: str = ""             # why (not): the assessment's reason code
+    partner: Effect | None = None   # a second effect taken with this one (a pair)
 
     @property
     def chi2_red(self) -> dict[str, float]:
@@ -74,7 +75,7 @@ class CandidateRow:
     def move(self) -> str:
         if self.replaces is not None:
             return f"replace {self.replaces.id} by {self.effect.id}"
-        return f"add {self.effect.id}"
+        return f"add {self.effect.id}" + (f" with {self.partner.id}" if self.partner is not None else "")
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,7 +99,7 @@ class DiagnosisOutcome:
 def _row(base: AnalysisResult, ranked_from: FitResult, c: Candidate) -> CandidateRow:
     return CandidateRow(c.action, c.effect, c.replaces, c.delta_bic, explain(ranked_from, c),
                         lab_fit(base, c.fit) if c.fit is not None else None, c.error, c.flags, c.accepted,
-                        c.assessment.reason if c.assessment else "")
+                        c.assessment.reason if c.assessment else "", c.partner)
 
 
 def diagnosis_outcome(base: AnalysisResult, result: Diagnosis, follow: bool) -> DiagnosisOutcome:

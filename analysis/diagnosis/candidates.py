@@ -26,9 +26,9 @@ from typing import Callable
 
 import numpy as np
 
-from analysis.diagnosis import acceptance, residuals
+from analysis.diagnosis import acceptance, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
-from analysis.diagnosis.sites import SiteResult, localise
+from analysis.diagnosis.sites import SiteResult, first_among_tied, localise
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
@@ -69,6 +69,17 @@ class Candidate:
     error: str | None = None
     flags: tuple[Flag, ...] = ()
     assessment: Assessment | None = None
+    partner: Effect | None = None   # a second effect taken with this one (analysis.diagnosis.pairs)
+
+    @property
+    def judged(self):
+        """What the acceptance rule judges: the effect, or the pair."""
+        return self.effect if self.partner is None else pairs.PairedEffect(self.effect, self.partner)
+
+    @property
+    def label(self) -> str:
+        """The move's effect ids: 'breakup' or 'breakup + breakup-spot'."""
+        return self.effect.id if self.partner is None else f"{self.effect.id} + {self.partner.id}"
 
     @property
     def effects(self) -> tuple[str, ...]:
@@ -254,6 +265,7 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
         candidates.append(Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
                                     delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
                                     flags=flags, assessment=acceptance.assess(current, fit, effect, flags)))
+    candidates += pairs.rank_pairs(data, current, candidates, _refit, _run, executor, cancel, Candidate)
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
 
 
@@ -294,7 +306,7 @@ def choose(current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
     for c in ranked:
         if c.accepted:
             site = sites.done[c.effect.site]
-            c = dataclasses.replace(c, assessment=acceptance.assess(current, c.fit, c.effect, c.flags, site))
+            c = dataclasses.replace(c, assessment=acceptance.assess(current, c.fit, c.judged, c.flags, site))
         judged.append(c)
     chosen = next((c for c in judged if c.accepted), None)
     return tuple(judged), chosen
@@ -308,14 +320,18 @@ def explain(current: FitResult, candidate: Candidate) -> str:
     before = current.chi2_red_by_channel()
     after = candidate.fit.chi2_red_by_channel()
     change = ", ".join(f"{ch} {before[ch]:.3g} -> {after[ch]:.3g}" for ch in before if ch in after)
-    verb = f"replacing {candidate.replaces.id} by {effect.id}" if candidate.replaces else f"adding {effect.id}"
-    head = f"{verb} ({effect.title}) changes the reduced chi^2 {change}, delta BIC {candidate.delta_bic:+.1f}."
+    verb = f"replacing {candidate.replaces.id} by {effect.id}" if candidate.replaces else f"adding {candidate.label}"
+    title = effect.title if candidate.partner is None else f"{effect.title}, with {candidate.partner.title}"
+    head = f"{verb} ({title}) changes the reduced chi^2 {change}, delta BIC {candidate.delta_bic:+.1f}."
     assessment = candidate.assessment
     if assessment is None or (not assessment.accepted and assessment.reason == acceptance.NO_GAIN
                               and candidate.delta_bic > -MIN_BIC_GAIN):
         return head + " Not enough to pay for its parameters: the data do not ask for it."
     if not assessment.accepted:
         return f"{head} Not taken: {assessment.message}."
+    if candidate.partner is not None:
+        return (f"{head} Together they cure what neither does alone: {effect.signature} And: "
+                f"{candidate.partner.signature}")
     return f"{head} It cures: {effect.signature} Physically: {effect.physics}"
 
 
@@ -358,7 +374,13 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
         progress("looking for the site of the misfit left")
     final = result.final
     known = sites.done if final is sites.fit else None
-    return dataclasses.replace(result, sites=localise(data, final, executor, known=known, cancel=cancel))
+    located = localise(data, final, executor, known=known, cancel=cancel)
+    taken = {site for step in result.steps if step.chosen is not None for site in _sites_of(step.chosen)}
+    return dataclasses.replace(result, sites=first_among_tied(located, taken))
+
+
+def _sites_of(candidate: Candidate) -> tuple[Site, ...]:
+    return (candidate.effect.site,) + ((candidate.partner.site,) if candidate.partner is not None else ())
 
 
 def _model_flags(fit: FitResult) -> tuple[Flag, ...]:

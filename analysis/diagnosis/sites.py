@@ -2,11 +2,27 @@
 
 For each of the six sites of docs/physics.md section 8, the current model gets a
 smooth, flexible complex correction there (analysis.diagnosis.site_correction) and is
-refitted with it, its own parameters free. The sites are ranked by how much
-misfit their correction removes, paid for by its effective number of
-parameters:
+refitted with it, its own parameters free. A site's correction is judged by
+how much misfit it removes, paid for by its effective number of parameters:
 
     delta_bic = chi^2(with the correction) - chi^2(current) + edf * ln n
+
+and the sites are ranked by the same criterion with each channel's misfit at
+its own scale, the BIC of a model whose noise level per channel is unknown
+(the profile likelihood, -2 ln L = m_c ln(chi^2_c / m_c) for the m_c values of
+channel c):
+
+    score = sum over Z, Hx of m_c * ln(chi^2_c(with) / chi^2_c(current)) + edf * ln n
+
+At the noise floor (chi^2_c near m_c) this is delta_bic; far from it a
+channel counts by the share of its misfit removed, not by its size. Z
+carries far the larger chi^2 (its noise is smaller against its size), and a
+factor on the measured current can reshape any Z: ranked by delta_bic, a
+site that cured Z alone outranked one that cures both channels.
+
+Where the current fit's residual is concentrated (a mode, a dip), the
+correction gets dense knots there (analysis.diagnosis.site_correction), so
+it can follow a resonance; edf counts them.
 
 edf is the trace of the correction's hat matrix: a roughness penalty
 (second differences of the spline coefficients) and a small ridge keep the
@@ -31,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, site_correction
+from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, misfit_spans, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
 from analysis.model.composed import Model
@@ -45,6 +61,9 @@ CORRECTION_POINTS = 120      # where the correction is reported
 DERIVATIVE_STEP = 1e-7       # the shift of h (and the relative step of the model's parameters)
 COMPLIANCE_TOP_OVER_FS = 2.0
 DETERMINED_RATIO = 3.0
+# Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)
+# explain the data equally well: the data cannot tell them apart.
+TIE_CHI2 = 10.0
 TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a ranking needs no more
 # The correction replaces what the model already has at its site: the base elements there and the
 # effects there are held at the current fit (the correction can take on any change of theirs, and
@@ -70,6 +89,11 @@ class SiteResult:
     # The standard error of the correction at each of `freqs` (of its real and of its imaginary part):
     # where it is large, the data do not see the correction and its shape there means nothing.
     correction_std: np.ndarray | None = None
+    score: float | None = None    # the ranking's: delta_bic with each channel at its own misfit's scale
+
+    @property
+    def rank_key(self) -> float:
+        return self.delta_bic if self.score is None else self.score
 
     @property
     def determined(self) -> np.ndarray:
@@ -84,7 +108,8 @@ class SiteResult:
         return self.site.key
 
     def as_json(self) -> dict:
-        return {"site": self.key, "delta_bic": float(self.delta_bic), "edf": float(self.edf),
+        return {"site": self.key, "delta_bic": float(self.delta_bic), "score": float(self.rank_key),
+                "edf": float(self.edf),
                 "chi2_red": {k: float(v) for k, v in self.chi2_red.items()},
                 "correction": {"f": self.freqs.tolist(), "magnitude": np.abs(self.correction).tolist(),
                                "phase_deg": np.degrees(np.angle(self.correction)).tolist(),
@@ -165,7 +190,9 @@ class _SiteProblem:
 
     def residual(self, x: np.ndarray) -> np.ndarray:
         coef = x[self.k:]
-        pen = np.concatenate([self.penalty @ coef[: self.n_basis], self.penalty @ coef[self.n_basis:]])
+        # einsum, not BLAS (see _gram): a product this small costs BLAS's threads far more than the work.
+        pen = np.concatenate([np.einsum("ij,j->i", self.penalty, coef[: self.n_basis]),
+                              np.einsum("ij,j->i", self.penalty, coef[self.n_basis:])])
         return np.concatenate([self._data_residual(self.predictions(self.values(x))), pen])
 
     def jacobian(self, x: np.ndarray) -> np.ndarray:
@@ -206,7 +233,8 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
         # Above a few fs the stiffness is spent (at 2 fs it is a quarter of the mass's reactance): a
         # compliance that changes there cannot show, so its correction is held constant above.
         f_hi = float(np.clip(COMPLIANCE_TOP_OVER_FS * resonance_frequency(values), 2.0 * f_lo, f_hi))
-    problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale))
+    dense = misfit_spans(current, f_lo, f_hi)
+    problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale, dense))
     x0 = np.zeros(problem.k + 2 * problem.n_basis)
     # MINPACK's Levenberg-Marquardt: its own QR, no threaded LAPACK call per step (on a busy machine
     # OpenBLAS threads made 'trf' 15x slower), and like lmfit's fits it starts from the current fit.
@@ -227,9 +255,11 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
     freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
     shown, unit, acts_as, scale = problem.correction.shown(freqs, p)
     std = scale * _h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
+    score = edf * np.log(n) + sum(m * np.log(max(c, 1e-300) / max(current.channels[name].chi2, 1e-300))
+                                  for name, (c, m) in chi2_by_channel.items())
     return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
                       chi2 - current.chi2 + edf * np.log(n), edf, freqs, shown, unit, acts_as, bool(result.status > 0),
-                      std)
+                      std, float(score))
 
 
 def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:
@@ -277,10 +307,41 @@ def _inverse(A: np.ndarray) -> np.ndarray:
         return np.linalg.pinv(A)
 
 
+def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:
+    """The sites (after the best) whose correction explains the data as well as the best one's does.
+
+    With the impedance alone every site but the displacement acts on Z only, and any of them can
+    make Z anything: they are all tied, whatever their chi^2 (which differs by how smoothly each
+    correction follows the misfit, not by what the data say).
+    """
+    if not sites:
+        return []
+    best = sites[0]
+    if "displacement" not in best.chi2_red:
+        return list(sites[1:])
+    scale = max(1.0, max(best.chi2_red.values(), default=1.0))
+    return [s for s in sites[1:] if s.chi2 - best.chi2 <= TIE_CHI2 * scale]
+
+
+def first_among_tied(sites: tuple[SiteResult, ...], preferred: set[Site]) -> tuple[SiteResult, ...]:
+    """The sites with, among those the data cannot tell from the best, one of `preferred` first.
+
+    The diagnosis prefers the sites of the effects its path took: when the misfit left is one the data
+    cannot place, the likeliest cause is that an effect found is of a form close to, but not exactly,
+    the physics (a diffusion law of eddy currents left by bl-eddy's first-order fall).
+    """
+    if not sites or sites[0].site in preferred:
+        return sites
+    chosen = next((s for s in tied_sites(sites) if s.site in preferred), None)
+    if chosen is None:
+        return sites
+    return (chosen,) + tuple(s for s in sites if s is not chosen)
+
+
 def localise(data: FitData, current: FitResult, executor: Executor | None = None,
              sites: tuple[Site, ...] | None = None, known: dict[Site, SiteResult] | None = None,
              cancel: threading.Event | None = None) -> tuple[SiteResult, ...]:
-    """The sites' corrections (every usable site by default), best (lowest delta BIC) first.
+    """The sites' corrections (every usable site by default), best (lowest score) first.
 
     `known`: results already computed for `current` (the diagnosis computes some on its way).
     """
@@ -295,4 +356,4 @@ def localise(data: FitData, current: FitResult, executor: Executor | None = None
             if cancel is not None and cancel.is_set():
                 raise FitCancelled("site localisation cancelled")
             fitted.append(fit_site(data, current, site))
-    return tuple(sorted(list(known.values()) + fitted, key=lambda r: r.delta_bic))
+    return tuple(sorted(list(known.values()) + fitted, key=lambda r: r.rank_key))

@@ -9,14 +9,11 @@ from typing import Iterable
 
 from analysis.diagnosis import acceptance, residuals
 from analysis.diagnosis.candidates import Diagnosis
-from analysis.diagnosis.sites import SiteResult
+from analysis.diagnosis.sites import TIE_CHI2, SiteResult, tied_sites  # noqa: F401 (said from here too)
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitResult
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
-# Two sites whose corrections leave chi^2 closer than this (in units of the misfit the best one leaves)
-# explain the data equally well: the data cannot tell them apart.
-TIE_CHI2 = 10.0
 SITE_WORDS = {
     Site.BLOCKED: ("electrical", "ohms added to the blocked impedance Ze (the voice coil and what is in series "
                                  "with it)"),
@@ -42,22 +39,6 @@ def residual_json(fit: FitResult) -> list[dict]:
     """Where the residual sits, as data: the words of analysis.diagnosis.residuals.describe."""
     return [{"channel": f.channel, "f_lo": f.f_low, "f_hi": f.f_high, "kind": f.part, "sign": f.sign,
              "size_sigma": f.peak_sigma, "share": f.share} for f in residuals.findings(fit)]
-
-
-def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:
-    """The sites (after the best) whose correction explains the data as well as the best one's does.
-
-    With the impedance alone every site but the displacement acts on Z only, and any of them can
-    make Z anything: they are all tied, whatever their chi^2 (which differs by how smoothly each
-    correction follows the misfit, not by what the data say).
-    """
-    if not sites:
-        return []
-    best = sites[0]
-    if "displacement" not in best.chi2_red:
-        return list(sites[1:])
-    scale = max(1.0, max(best.chi2_red.values(), default=1.0))
-    return [s for s in sites[1:] if s.chi2 - best.chi2 <= TIE_CHI2 * scale]
 
 
 def sites_json(sites: tuple[SiteResult, ...]) -> list[dict]:
@@ -104,10 +85,20 @@ def _flag_sentence(flags: Iterable[acceptance.Flag]) -> str:
     return ("Flags: " + "; ".join(messages) + ".") if messages else ""
 
 
+def first_site(result: Diagnosis) -> Site | None:
+    """The site the verdict points the user at first: where the misfit left belongs when some is left (and a
+    site's correction explains it), else the site of the first effect the path took; None when neither."""
+    if result.verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED) and result.sites \
+            and result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
+        return result.sites[0].site
+    taken = next((step.chosen for step in result.steps if step.chosen is not None), None)
+    return taken.effect.site if taken is not None else None
+
+
 def verdict_headline(result: Diagnosis) -> str:
     """The verdict in one short sentence (verdict_text says it all)."""
     verdict = result.verdict
-    moves = ", ".join(c.effect.id for c in (step.chosen for step in result.steps) if c is not None)
+    moves = ", ".join(c.label for c in (step.chosen for step in result.steps) if c is not None)
     site = ""
     if result.sites and result.sites[0].delta_bic < -acceptance.MIN_BIC_GAIN:
         site = SITE_WORDS[result.sites[0].site][0]
@@ -132,7 +123,7 @@ def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
     verdict = result.verdict
     start, final = result.start, result.final
     taken = [step.chosen for step in result.steps if step.chosen is not None]
-    moves = ", ".join(("replacing " + c.replaces.id + " by " if c.replaces else "adding ") + c.effect.id
+    moves = ", ".join(("replacing " + c.replaces.id + " by " if c.replaces else "adding ") + c.label
                       for c in taken)
     parts = []
     if verdict == acceptance.NOTHING_MISSING:

@@ -38,6 +38,9 @@ import numpy as np
 from analysis.effects.base import Effect, ParamSpec, Site
 
 CATEGORY = "breakup"
+# The spot's local mode is not an alternative to a mode the coil feels: a cone mode can show in both (the
+# diagnosis then takes the two as a pair, analysis.diagnosis.pairs), so it is a category of its own.
+SPOT_CATEGORY = "cone-spot"
 # With only the basic start context, the mode is looked for a decade above fs
 # (where paper and plastic cones of woofers usually break up first), and
 # never above half the top line.
@@ -141,7 +144,7 @@ class SpotMode(Effect):
 
 breakup_spot = SpotMode(
     id="breakup-spot",
-    category=CATEGORY,
+    category=SPOT_CATEGORY,
     title="Cone breakup seen at the laser spot only",
     site=Site.DISPLACEMENT,
     params=(ParamSpec("f2x", "Hz", "Hz", 1.0, 10.0, 1e5, 2000.0, "resonance of the cone area under the laser spot",
@@ -154,8 +157,9 @@ breakup_spot = SpotMode(
                "matching wiggle in Z."),
     typical="f2x 1 to 8 kHz for woofer cones, Q2x 2 to 20",
     reference="W. Klippel, 'Loudspeaker cone vibration and radiation' (Klippel GmbH): scanning vibrometry",
-    notes=("An alternative to `breakup` in its category: choose it when Z shows no trace of the mode. Aim the "
-           "laser at the dust cap or close to the coil to avoid it."),
+    notes=("Alone when Z shows no trace of the mode; with `breakup` when Z shows it too (the spot on the outer "
+           "cone sees more of the mode than the coil). Aim the laser at the dust cap or close to the coil to "
+           "avoid it."),
 )
 
 

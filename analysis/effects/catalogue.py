@@ -30,6 +30,8 @@ _ALL: tuple[Effect, ...] = (
     mechanical.damping_power,
     enclosure.closed_box,
     enclosure.vented_box,
+    enclosure.vented_box_absorption,
+    enclosure.vented_box_port,
 )
 
 CATALOGUE: dict[str, Effect] = {e.id: e for e in _ALL}

@@ -101,6 +101,38 @@ class VentedBox(Effect):
         return [{"alpha_b": 1.0, "fb": ratio * ctx.fs, "QL": 7.0} for ratio in FB_OVER_FS_STARTS]
 
 
+@dataclass(frozen=True)
+class VentedBoxLosses(VentedBox):
+    """A vented box whose losses sit in the box's filling (QA) or in the port (QP) instead of in leaks: see the
+    module docstring. In the model's admittance, with a = alpha_b/LCES,
+
+        absorption  Y += a * s * (1 + s/(wb*QA)) / (s^2 + s*wb/QA + wb^2)
+        port        Y += a * (s + wb/QP) / (s^2 + s*wb/QP + wb^2)
+    """
+
+    q_name: str = "QA"
+
+    def response(self, s, p):
+        wb = 2.0 * np.pi * p["fb"]
+        q = p[self.q_name]
+        a = p["alpha_b"] / p["LCES"]
+        numerator = s * (1.0 + s / (wb * q)) if self.q_name == "QA" else s + wb / q
+        return a * numerator / (s * s + s * wb / q + wb * wb)
+
+    def guess(self, ctx):
+        return _renamed(super().guess(ctx), self.q_name)
+
+    def starts(self, ctx) -> list[dict[str, float]]:
+        return [_renamed(start, self.q_name) for start in super().starts(ctx)]
+
+
+def _renamed(start: dict, q_name: str) -> dict:
+    """A leakage box's start with its QL as the family member's Q (the same peak's damping)."""
+    out = {k: v for k, v in start.items() if k != "QL"}
+    out[q_name] = start.get("QL", 7.0)
+    return out
+
+
 def _two_peaks(ctx) -> tuple[float, float, float] | None:
     """(fL, fM, fH): the two highest peaks of Re(Z) and the minimum of |Z| between them, when the second peak
     is at least a fifth of the first (a box's, not a wiggle's) and within a decade of it. A lower peak
@@ -154,3 +186,38 @@ vented_box = VentedBox(
     # far from the data the box is also fitted from the data's own start (Thiele and Small's reading of Z).
     cold_start=True,
 )
+
+
+def _lossy_box(q_name: str, where: str, physics: str, signature: str) -> VentedBoxLosses:
+    return VentedBoxLosses(
+        id=f"vented-box-{where}",
+        category=CATEGORY,
+        title=f"Vented box, losses in the {'box filling' if where == 'absorption' else 'port'}",
+        site=Site.MECHANICAL,
+        params=(ALPHA, vented_box.params[1],
+                ParamSpec(q_name, "1", "-", 1.0, 0.3, 200.0, 7.0, f"the box's {where} quality factor at fb",
+                          typical=(2.0, 100.0))),
+        physics=physics,
+        signature=signature,
+        typical=f"fb 0.5 to 1.3 fs, alpha_b 0.5 to 5, {q_name} 5 to 100",
+        reference=_REFERENCE,
+        notes=("One of the vented box's loss family (Small 1973: QL leakage, QA absorption, QP port); the "
+               "diagnosis tries each in turn and keeps the one the data take."),
+        cold_start=True,
+        q_name=q_name,
+    )
+
+
+vented_box_absorption = _lossy_box(
+    "QA", "absorption",
+    "A vented box whose filling (wool, foam) absorbs: a resistance in series with the box's air spring. Near fb it "
+    "damps the dip like a leak; well above fb, where the box is a spring, it adds a small resistance to the cone.",
+    "Two impedance peaks with a dip near fb, as a leaky box, but the upper peak a little lower than a leak would "
+    "leave it.")
+vented_box_port = _lossy_box(
+    "QP", "port",
+    "A vented box whose losses sit in the port (friction and turbulence of the air in a long or narrow port): a "
+    "resistance in series with the port's air mass. Near fb it damps the dip; well below fb the cone drives the "
+    "port's air through that resistance.",
+    "Two impedance peaks with a dip near fb, as a leaky box, but below fb extra damping of the lower peak that a "
+    "leak cannot give.")

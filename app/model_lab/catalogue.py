@@ -25,6 +25,7 @@ CATEGORY_TITLES = {       # the ids are for code; these are for the reader
     "electrical-channel": "Current channel",
     "displacement-sensor": "Displacement sensor",
     "breakup": "Cone break-up",
+    "cone-spot": "Cone mode at the laser spot",
     "force-factor": "Force factor",
     "air-load": "Air load",
     "damping": "Mechanical damping",

@@ -39,8 +39,8 @@ CASES = [
     ("displacement-sensor", BASE + ",lowpass-x", {"fc_x": 600.0}, BASE),
     ("breakup", BASE + ",breakup", {"f2": 700.0, "Q2": 5.0, "mu2": 0.1}, BASE),
     ("breakup", BASE + ",breakup", {"f2": 2500.0, "Q2": 10.0, "mu2": 0.05}, BASE),
-    ("breakup", BASE + ",breakup-spot", {"f2x": 1500.0, "Q2x": 5.0}, BASE),
-    ("breakup", BASE + ",breakup-spot", {"f2x": 4000.0, "Q2x": 10.0}, BASE),
+    ("cone-spot", BASE + ",breakup-spot", {"f2x": 1500.0, "Q2x": 5.0}, BASE),
+    ("cone-spot", BASE + ",breakup-spot", {"f2x": 4000.0, "Q2x": 10.0}, BASE),
 ]
 
 # The stages of LR-3 are interchangeable: compare them as a set.

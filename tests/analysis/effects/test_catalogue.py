@@ -77,8 +77,9 @@ def test_each_category_acts_where_its_physics_is():
     assert sites["creep"] == {Site.COMPLIANCE}
     assert sites["electrical-channel"] == {Site.CURRENT}
     assert sites["displacement-sensor"] == {Site.DISPLACEMENT}
-    # a breakup mode the coil feels (mechanical), or one only the laser spot sees (displacement)
-    assert sites["breakup"] == {Site.MECHANICAL, Site.DISPLACEMENT}
+    # a breakup mode the coil feels (mechanical); what the laser spot sees of a mode, alone or with it
+    assert sites["breakup"] == {Site.MECHANICAL}
+    assert sites["cone-spot"] == {Site.DISPLACEMENT}
     assert sites["force-factor"] == {Site.FORCE_FACTOR}
     assert sites["air-load"] == sites["damping"] == sites["enclosure"] == {Site.MECHANICAL}
 

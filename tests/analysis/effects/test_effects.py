@@ -84,6 +84,20 @@ def _vented_box_from_the_acoustic_network(p, w):
     return SD**2 * zab / p["Bl"] ** 2
 
 
+def _lossy_vented_box_from_the_acoustic_network(p, w, where):
+    """Small 1973: the absorption RAB in series with Cab (QA = 1/(wb*Cab*RAB)), or the port's RAP in series with
+    Map (QP = 1/(wb*Cab*RAP)); box branch and port branch in parallel, seen through Sd."""
+    cms = p["LCES"] / p["Bl"] ** 2
+    cab = SD**2 * cms / p["alpha_b"]
+    wb = 2 * math.pi * p["fb"]
+    map_ = 1 / (wb**2 * cab)
+    s = 1j * w
+    box = 1 / (s * cab) + (1 / (wb * cab * p["QA"]) if where == "absorption" else 0.0)
+    port = s * map_ + (1 / (wb * cab * p["QP"]) if where == "port" else 0.0)
+    zab = 1 / (1 / box + 1 / port)
+    return SD**2 * zab / p["Bl"] ** 2
+
+
 # (effect id, parameter values, the documented equation as a function of w), written out independently.
 EQUATIONS = {
     "lr2": ({"L2": 0.264e-3, "R2": 3.52}, lambda p, w: _eddy(p["L2"], p["R2"], w)),
@@ -126,6 +140,10 @@ EQUATIONS = {
                       / p["Bl"] ** 2),
     "closed-box": ({"alpha_b": 2.0}, _box_from_its_volume),
     "vented-box": ({"alpha_b": 1.5, "fb": 50.0, "QL": 7.0}, _vented_box_from_the_acoustic_network),
+    "vented-box-absorption": ({"alpha_b": 1.5, "fb": 50.0, "QA": 10.0},
+                              lambda p, w: _lossy_vented_box_from_the_acoustic_network(p, w, "absorption")),
+    "vented-box-port": ({"alpha_b": 1.5, "fb": 45.0, "QP": 8.0},
+                        lambda p, w: _lossy_vented_box_from_the_acoustic_network(p, w, "port")),
 }
 # The air load's Struve function is tabulated (analysis.effects.mechanical): to 1e-6 of itself.
 EQUATION_RTOL = {"air-load": 1e-6}
