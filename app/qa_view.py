@@ -77,16 +77,19 @@ def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> s
     """
     from analysis.archive.results import StoredResult, calibration_of, header_of_recording, results_document
     from analysis.recording.format import read_recording
-    from analysis.report import build_report, write_report
+    from analysis.archive.atomic import write_atomic
+    from analysis.report import build_report, render_html, render_pdf
     recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
     stored = StoredResult.from_json(results_document(result, recording))
     # The header a report of the same recording has from the command line or the archive.
     header = header_of_recording(recording) if recording is not None else {}
     calibration = calibration_of(recording) if recording is not None else {}
     content = build_report(stored, header, None, calibration, limits)
+    job.check()
+    render = render_html if path.suffix.lower() in (".html", ".htm") else render_pdf
+    data = render(content)          # the seconds a user may cancel in
     job.check()                     # cancelled: nothing written
-    kind = {"html": path} if path.suffix.lower() in (".html", ".htm") else {"pdf": path}
-    return ", ".join(str(p) for p in write_report(content, **kind))
+    return str(write_atomic(path, data))
 
 
 def _interval_tip(verdict) -> str:

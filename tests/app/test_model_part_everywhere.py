@@ -16,12 +16,11 @@ from analysis.recording.format import write_recording
 from app.cli import main
 from tests.realistic_drivers import REALISTIC, realistic_recording
 
-from .conftest import ANALYSIS_TIMEOUT_MS
+from .conftest import analysis_wait_ms
 
 LUMPED = ("RE", "Bl", "Mms", "Kms")
 LIMIT_UNITS = {"RE": "ohm", "Bl": "T*m", "Mms": "kg", "Kms": "N/m"}
 # The refits of the model part take 3-5 s on a busy 2-core machine: waits far beyond that, on events.
-MODEL_PART_TIMEOUT_MS = 4 * ANALYSIS_TIMEOUT_MS
 
 
 def limits_at_the_truth(folder, name: str, tolerance: str = "15%") -> str:
@@ -65,7 +64,7 @@ def test_the_results_and_qa_pages_read_the_woofer_as_the_cli_does(qtbot, window,
         at_first.update(fit=window.results.fit_quality.text(), verdict=window.qa.verdict,
                         std_model=outcome.result.parameters["Mms"].std_model)
     window.analysis_shown.connect(on_shown)
-    with qtbot.waitSignal(window.model_part_shown, timeout=MODEL_PART_TIMEOUT_MS) as done:
+    with qtbot.waitSignal(window.model_part_shown, timeout=analysis_wait_ms(4)) as done:
         window.open_path(wav)
     assert "Model part: estimating…" in at_first["fit"]
     assert at_first["verdict"] == "estimating" and at_first["std_model"] is None

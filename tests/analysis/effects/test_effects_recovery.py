@@ -40,6 +40,8 @@ CASES = {
     "damping-power": {"r_v": 0.8, "n_v": 1.0},
     "closed-box": {"alpha_b": 2.0},
     "vented-box": {"alpha_b": 1.5, "fb": 50.0, "QL": 7.0},
+    "vented-box-port": {"alpha_b": 1.5, "fb": 45.0, "QP": 8.0},
+    "vented-box-absorption": {"alpha_b": 2.0, "fb": 40.0, "QA": 10.0},
 }
 # What Z alone must identify: everything that acts on the impedance directly.
 # (breakup too: its parameterisation is meant to be identifiable from Z alone.)
