@@ -8,25 +8,18 @@ it on first use (module-level __getattr__), so `from analysis.fit import FitResu
 from __future__ import annotations
 
 import importlib
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parent.parent
+from tests.fresh_import import loaded_by_import
+
 LAZY = ("analysis.fit", "analysis.validity", "analysis.diagnosis", "analysis.recording", "analysis.model",
         "app.model_lab")
 
 
 @pytest.mark.parametrize("package", LAZY)
 def test_importing_the_package_loads_none_of_its_submodules(package):
-    code = (f"import sys, {package}\n"
-            f"loaded = sorted(m for m in sys.modules if m.startswith('{package}.'))\n"
-            "print(','.join(loaded))")
-    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == ""
+    assert loaded_by_import(package, f"{package}.") == []
 
 
 @pytest.mark.parametrize("package", LAZY)

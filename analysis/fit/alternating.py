@@ -22,12 +22,9 @@ from __future__ import annotations
 import threading
 from typing import Mapping
 
-import numpy as np
-
-from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _minimize,
-                                        _params, _values, channel_sigmas, fit_model, result_of, start_values)
-from analysis.fit.paper import _two_step_covariance, hx_step_parameters
-from analysis.fit.startvalues import linear_gain
+from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _minimize, _params, _values,
+                                        fit_model, result_of)
+from analysis.fit.paper import _two_step_covariance, bl_from_hx, free_off_bounds, two_step_start
 from analysis.model.composed import Model
 
 TOLERANCE = 1e-3
@@ -40,22 +37,14 @@ def fit_alternating(data: FitData, model: Model, start: Mapping[str, float] | No
     """Fit `model` by alternating the Z and Hx steps (module doc); without Hx, the Z fit alone."""
     if not model.with_displacement:
         return fit_model(data, model, start, cancel, per_parameter)
-    sigmas = channel_sigmas(data, True)
-    values = start_values(model, data)
-    values.update({k: v for k, v in (start or {}).items() if k in values})
-    _check_effects(model, data, values)
-    second = hx_step_parameters(model)
-    first = set(values) - second
+    sigmas, values, first, second = two_step_start(data, model, start)
     nfev, success, messages = 0, True, []
     for round_ in range(MAX_ROUNDS):
         before = dict(values)
         z_step = _minimize(model, _params(model, values, second), data, False, sigmas, cancel, per_parameter)
         values = _values(z_step.params)
-        if round_ == 0 and "Bl" not in (start or {}):      # Bl is a pure gain on Hx: solved linearly first
-            x = data.displacement
-            g = model.displacement(2j * np.pi * x.freqs, {**values, "Bl": 1.0})
-            inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
-            values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
+        if round_ == 0 and "Bl" not in (start or {}):
+            values["Bl"] = bl_from_hx(model, values, data, sigmas)
         x_step = _minimize(model, _params(model, values, first), data, True, sigmas, cancel, per_parameter,
                            use_z=False)
         values = _values(x_step.params)
@@ -64,9 +53,7 @@ def fit_alternating(data: FitData, model: Model, start: Mapping[str, float] | No
         messages = [f"Z step: {z_step.message}", f"Hx step: {x_step.message}"]
         if round_ and _moved(before, values) < TOLERANCE:
             break
-    specs = {s.name: s for s in model.param_specs}
-    free1 = [n for n in sorted(first) if not specs[n].on_bound(values[n])]
-    free2 = [n for n in sorted(second) if not specs[n].on_bound(values[n])]
+    free1, free2 = free_off_bounds(model, values, first), free_off_bounds(model, values, second)
     covar = _two_step_covariance(model, values, values, data, sigmas, free1, free2, set())
     return result_of(model, values, tuple(free1 + free2), covar, data, True, sigmas, success,
                      f"{round_ + 1} rounds; " + "; ".join(messages), int(nfev), birge_scaled=True,

@@ -35,11 +35,36 @@ from analysis.fit.startvalues import linear_gain
 from analysis.model.composed import Model
 
 
-
 def hx_step_parameters(model: Model) -> set[str]:
     """What the second step fits on Hx: Bl, the creep law's parameters, the displacement channel's own."""
     sites = (Site.COMPLIANCE, Site.DISPLACEMENT)
     return {"Bl"} | {s.name for e in model.effects if e.site in sites for s in e.params}
+
+
+def two_step_start(data: FitData, model: Model, start: Mapping[str, float] | None
+                   ) -> tuple[dict[str, float], dict[str, float], set[str], set[str]]:
+    """What both two-step methods start from: (channel sigmas, start values with the user's, Z step's
+    parameters, Hx step's parameters)."""
+    sigmas = channel_sigmas(data, True)
+    values = start_values(model, data)
+    values.update({k: v for k, v in (start or {}).items() if k in values})
+    _check_effects(model, data, values)
+    second = hx_step_parameters(model)
+    return sigmas, values, set(values) - second, second
+
+
+def bl_from_hx(model: Model, values: Mapping[str, float], data: FitData, sigmas: Mapping[str, float]) -> float:
+    """Bl from Hx with the rest held: Bl is a pure gain on Hx, so it is solved linearly (a start for the Hx step)."""
+    x = data.displacement
+    g = model.displacement(2j * np.pi * x.freqs, {**values, "Bl": 1.0})
+    inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
+    return abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
+
+
+def free_off_bounds(model: Model, values: Mapping[str, float], names: set[str]) -> list[str]:
+    """`names` not on a bound, sorted: the parameters a step's covariance is taken over."""
+    specs = {s.name: s for s in model.param_specs}
+    return [n for n in sorted(names) if not specs[n].on_bound(values[n])]
 
 
 def fit_paper(data: FitData, model: Model, start: Mapping[str, float] | None = None,
@@ -47,30 +72,20 @@ def fit_paper(data: FitData, model: Model, start: Mapping[str, float] | None = N
     """Fit `model` in the paper's two steps (module doc); without Hx there is only the first: the joint fit."""
     if not model.with_displacement:
         return fit_model(data, model, start, cancel, per_parameter)
-    sigmas = channel_sigmas(data, True)
-    values = start_values(model, data)
-    values.update({k: v for k, v in (start or {}).items() if k in values})
-    _check_effects(model, data, values)
-    second = hx_step_parameters(model)
-    first = set(values) - second
+    sigmas, values, first, second = two_step_start(data, model, start)
     creep = {s.name for e in model.effects if e.site is Site.COMPLIANCE for s in e.params}
     # Step 1, Z alone: the creep held at its start first (it barely shows in Z), then free with the rest.
     r0 = _minimize(model, _params(model, values, second), data, False, sigmas, cancel, per_parameter)
     r1 = _minimize(model, _params(model, _values(r0.params), second - creep), data, False, sigmas, cancel,
                    per_parameter) if creep else r0
     values = _values(r1.params)
-    if "Bl" not in (start or {}):        # Bl is a pure gain on Hx: solved linearly first
-        x = data.displacement
-        g = model.displacement(2j * np.pi * x.freqs, {**values, "Bl": 1.0})
-        inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
-        values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
+    if "Bl" not in (start or {}):
+        values["Bl"] = bl_from_hx(model, values, data, sigmas)
     # Step 2, Hx alone: Bl and the creep, what Z gave held.
     r2 = _minimize(model, _params(model, values, first), data, True, sigmas, cancel, per_parameter, use_z=False)
     values = _values(r2.params)
     nfev = r0.nfev + (r1.nfev if creep else 0) + r2.nfev
-    specs = {s.name: s for s in model.param_specs}
-    free1 = [n for n in sorted(first) if not specs[n].on_bound(values[n])]
-    free2 = [n for n in sorted(second) if not specs[n].on_bound(values[n])]
+    free1, free2 = free_off_bounds(model, values, first), free_off_bounds(model, values, second)
     z_values = {**values, **{n: r1.params[_lm_name(n)].value for n in creep}}
     covar = _two_step_covariance(model, values, z_values, data, sigmas, free1, free2, creep)
     return result_of(model, values, tuple(free1 + free2), covar, data, True, sigmas,

@@ -7,9 +7,6 @@ the CLI prints them (the CLI only prints result.report() / result.as_json()).
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -18,15 +15,11 @@ import analysis
 from analysis.json_finite import dumps
 from analysis.recording.format import write_recording
 from app.cli.boundary import main as cli
-
-REPO = Path(__file__).resolve().parents[2]
+from tests.fresh_import import loaded_by_import
 
 
 def test_importing_analysis_loads_only_its_table_of_names():
-    code = "import sys, analysis\nprint(','.join(sorted(m for m in sys.modules if m.startswith('analysis.'))))"
-    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "analysis.lazy_exports"
+    assert loaded_by_import("analysis", "analysis.") == ["analysis.lazy_exports"]
 
 
 def test_every_public_name_is_its_home_modules_own():

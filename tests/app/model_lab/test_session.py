@@ -2,9 +2,6 @@
 from __future__ import annotations
 
 import dataclasses
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
@@ -17,15 +14,11 @@ from app.lab_worker import LabFit, lab_fit
 from app.model_lab.session import LabSession
 from app.result_curves import result_curves
 from tests.builders import TYPICAL_NOISE, recording
-
-REPO = Path(__file__).resolve().parents[3]
+from tests.fresh_import import loaded_by_import
 
 
 def test_the_session_imports_no_qt():
-    code = "import sys, app.model_lab.session\nprint(sorted(m for m in sys.modules if m.startswith('PySide6')))"
-    out = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "[]"
+    assert loaded_by_import("app.model_lab.session", "PySide6") == []
 
 
 @pytest.fixture(scope="module")
