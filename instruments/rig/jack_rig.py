@@ -64,6 +64,10 @@ class JackRig:
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._killed = False
+        # Held while the wiring worker talks to the client and while the client is closed: closing it
+        # under the worker's get_ports/connect frees what libjack is using (the rig process died on a
+        # kill-client that met a rescan, and its control socket answered nothing).
+        self._client_lock = threading.Lock()
         self.client.set_process_callback(self._process)
         self.client.set_xrun_callback(self._xrun)
         self.client.set_shutdown_callback(self._shutdown)
@@ -118,12 +122,13 @@ class JackRig:
         while not self._stop.is_set():
             self._wake.wait(_RESCAN_S)
             self._wake.clear()
-            if self._stop.is_set() or self._killed:
-                break
-            try:
-                self.wire()
-            except self._jack.JackError as exc:   # a port that vanished between listing and connecting
-                self.last_error = f"wiring: {exc}"
+            with self._client_lock:
+                if self._stop.is_set() or self._killed:
+                    break
+                try:
+                    self.wire()
+                except self._jack.JackError as exc:   # a port that vanished between listing and connecting
+                    self.last_error = f"wiring: {exc}"
 
     def wire(self) -> int:
         """Connect every matching client's ports to the rig (idempotent); the number of new connections."""
@@ -182,13 +187,14 @@ class JackRig:
 
     def kill_client(self) -> None:
         """The rig's JACK client goes away (as if it crashed); the rig process stays up."""
-        self._killed = True
         self._stop.set()
         self._wake.set()
-        try:
-            self.client.deactivate()
-        finally:
-            self.client.close()
+        with self._client_lock:
+            self._killed = True
+            try:
+                self.client.deactivate()
+            finally:
+                self.client.close()
 
     @property
     def alive(self) -> bool:
@@ -199,11 +205,12 @@ class JackRig:
         self._wake.set()
         if self._worker.is_alive():
             self._worker.join(2.0)
-        if not self._killed and self.shutdown_reason is None:
-            self._killed = True
-            try:
-                self.client.deactivate()
-                self.client.close()
-            except self._jack.JackError:
-                pass
+        with self._client_lock:
+            if not self._killed and self.shutdown_reason is None:
+                self._killed = True
+                try:
+                    self.client.deactivate()
+                    self.client.close()
+                except self._jack.JackError:
+                    pass
 
