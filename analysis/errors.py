@@ -7,7 +7,7 @@ with ONE line that says what was wrong and what to do. They are caught at
 exactly two boundaries:
 
 - `linpar`'s main (app.cli): "linpar: error: <message>", exit 2;
-- the GUI's job runner (app.job_book.failure_text): the message on the page.
+- the GUI's job runner (app.jobs.book.failure_text): the message on the page.
 
 Anything else that escapes is a bug, not bad input: exit 70 and one line
 "internal error: ... (details in FILE)", with a crash report written by

@@ -37,12 +37,12 @@ def _exit_after_s() -> float | None:
 
 def _report_uncaught(window):
     """sys.excepthook for the GUI: a bug in a slot is one message with its crash report, not a traceback on a
-    terminal the user may not see (the jobs' own errors go through app.job_book.failure_text)."""
+    terminal the user may not see (the jobs' own errors go through app.jobs.book.failure_text)."""
     def hook(kind, exc, tb):
         if issubclass(kind, KeyboardInterrupt):
             sys.__excepthook__(kind, exc, tb)
             return
-        from app.job_book import failure_text
+        from app.jobs.book import failure_text
         window.show_error("Internal error", failure_text(exc.with_traceback(tb), "working in the window"))
     return hook
 
@@ -69,23 +69,23 @@ def run_gui(path: str | None = None) -> int:
     from PySide6.QtCore import QTimer, qInstallMessageHandler
     from PySide6.QtWidgets import QApplication
 
-    from app.main_window import MainWindow
-    from app.settings import APPLICATION, ORGANIZATION
+    from app.window.main_window import MainWindow
+    from app.window.settings import APPLICATION, ORGANIZATION
 
     qInstallMessageHandler(_qt_message)
 
     QApplication.setOrganizationName(ORGANIZATION)
     QApplication.setApplicationName(APPLICATION)
     app = QApplication.instance() or QApplication(sys.argv[:1])
-    from app.gui_gc import collect_in_gui_thread
-    collect_in_gui_thread()               # a worker thread must never free a Qt object (app/gui_gc.py)
-    from app.style import app_icon
+    from app.jobs.gui_gc import collect_in_gui_thread
+    collect_in_gui_thread()               # a worker thread must never free a Qt object (app/jobs/gui_gc.py)
+    from app.widgets.style import app_icon
     app.setWindowIcon(app_icon())         # dialogs and the task bar too (on Linux the desktop entry names it)
     problems = _load_user_effects()
     window = MainWindow()
     sys.excepthook = _report_uncaught(window)
     window.model_lab.catalogue.set_problems(problems)
-    from app.window_fit import show_fitted
+    from app.window.window_fit import show_fitted
     show_fitted(window)                   # maximized when the screen is smaller than the window's preferred size
     QTimer.singleShot(0, window.offer_unfinished)     # measurements a crash cut short: keep, analyse, discard
     if path:

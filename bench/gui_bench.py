@@ -44,10 +44,10 @@ def run(workdir: Path) -> list[Row]:
     from PySide6.QtWidgets import QApplication
 
     app = QApplication.instance() or QApplication(["gui-bench"])
-    from app.gui_gc import collect_in_gui_thread
-    collect_in_gui_thread()               # as the workstation runs (app/gui_gc.py)
-    from app.main_window import MainWindow
-    from app.settings import Settings
+    from app.jobs.gui_gc import collect_in_gui_thread
+    collect_in_gui_thread()               # as the workstation runs (app/jobs/gui_gc.py)
+    from app.window.main_window import MainWindow
+    from app.window.settings import Settings
 
     folder = Path(tempfile.mkdtemp(prefix="gui-bench-", dir=workdir))
     settings = Settings(QSettings(str(folder / "settings.ini"), QSettings.IniFormat))

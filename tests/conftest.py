@@ -123,9 +123,9 @@ def pg_database(pg_server, tmp_path, monkeypatch):
 
 @pytest.fixture(scope="session")
 def qapp(qapp):
-    """pytest-qt's application, with the cycle collector in the GUI thread only (app/gui_gc.py: a worker
+    """pytest-qt's application, with the cycle collector in the GUI thread only (app/jobs/gui_gc.py: a worker
     thread that frees a Qt widget deadlocks with the GUI thread)."""
-    from app.gui_gc import collect_in_gui_thread
+    from app.jobs.gui_gc import collect_in_gui_thread
     collect_in_gui_thread()
     return qapp
 
@@ -133,7 +133,7 @@ def qapp(qapp):
 def pytest_runtest_teardown(item):
     # Between tests the timer may not have run: collect here, in the main thread, what is due.
     import sys
-    gui_gc = sys.modules.get("app.gui_gc")
+    gui_gc = sys.modules.get("app.jobs.gui_gc")
     if gui_gc is not None:
         gui_gc.collect_if_due()
 

@@ -57,8 +57,8 @@ def open_main_window(work: Path) -> dict:
     from PySide6.QtCore import QSettings
     from PySide6.QtWidgets import QApplication
 
-    from app.main_window import MainWindow
-    from app.settings import Settings
+    from app.window.main_window import MainWindow
+    from app.window.settings import Settings
 
     app = QApplication.instance() or QApplication([])
     window = MainWindow(Settings(QSettings(str(work / "linpar.ini"), QSettings.IniFormat)))

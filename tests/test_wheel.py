@@ -88,7 +88,7 @@ def test_the_wheel_holds_the_packages_and_their_data(wheel):
     assert set(DATA) <= names, sorted(set(DATA) - names)
     tops = {name.split("/")[0] for name in names if not name.startswith("linpar-")}
     assert tops == {"analysis", "app", "instruments", "resources"}
-    assert "app/main_window.py" in names and "instruments/measurement/runner.py" in names
+    assert "app/window/main_window.py" in names and "instruments/measurement/runner.py" in names
     assert not any(name.startswith(("tests/", "bench/", "tools/")) for name in names)
 
 

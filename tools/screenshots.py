@@ -551,10 +551,10 @@ def main(argv: list[str]) -> int:
     out = Path(argv[1]) if len(argv) > 1 else ROOT / "docs" / "screenshots"
     out.mkdir(parents=True, exist_ok=True)
     app = QApplication.instance() or QApplication(argv[:1])
-    from app.gui_gc import collect_in_gui_thread
-    collect_in_gui_thread()               # a worker thread must never free a Qt object (app/gui_gc.py)
-    from app.main_window import MainWindow
-    from app.settings import Settings
+    from app.jobs.gui_gc import collect_in_gui_thread
+    collect_in_gui_thread()               # a worker thread must never free a Qt object (app/jobs/gui_gc.py)
+    from app.window.main_window import MainWindow
+    from app.window.settings import Settings
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)

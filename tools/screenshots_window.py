@@ -3,7 +3,7 @@ recording whose model misses hidden physics, its residuals beyond the strip's ±
 
     QT_QPA_PLATFORM=offscreen .venv/bin/python tools/screenshots.py [OUTDIR] --only first-window
 
-Writes first-window-<W>x<H>.png (a fresh user's window, sized by app/window_fit.py for that screen) and
+Writes first-window-<W>x<H>.png (a fresh user's window, sized by app/window/window_fit.py for that screen) and
 results-beyond-range-<W>x<H>.png (the Results page, displacement tab: a laser 100 µs late the default model
 does not know about).
 """
@@ -19,9 +19,9 @@ from tools.screenshot_kit import ANALYSIS_TIMEOUT_S, SMALL_AND_LARGE, grab_small
 
 def first_window_screenshots(app: QApplication, window, folder: Path, out: Path, misfit_wav: Path) -> list[Path]:
     """misfit_wav: a recording the default model does not describe (tools/screenshots.hidden_delay_recording)."""
-    import app.window_fit as window_fit
-    from app.main_window import MainWindow
-    from app.settings import Settings
+    import app.window.window_fit as window_fit
+    from app.window.main_window import MainWindow
+    from app.window.settings import Settings
     written = []
     real_room = window_fit._room
     try:

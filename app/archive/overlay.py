@@ -21,7 +21,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter
 
 from analysis.report.numbers import format_number, format_std, pretty_unit
 from app.archive.table import date_text
-from app.plots import LogFrequencyAxis, style_plot
+from app.widgets.plots import LogFrequencyAxis, style_plot
 
 # Eight colours told apart on white paper (Tableau 10 without its grey and olive).
 PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")

@@ -24,13 +24,13 @@ from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QS
 
 from analysis.archive import MAX_COMPARED, ArchiveError, archive_spec, is_url, open_archive
 from analysis.archive.backends import URL_ENV, shown
-from app import style
+from app.widgets import style
 from app.archive.filter import FilterBar
 from app.archive.overlay import CompareView
 from app.archive.table import ArchiveTable
 from app.archive.worker import ArchiveWorker
-from app.job_book import failure_text
-from app.job_controls import JobControls
+from app.jobs.book import failure_text
+from app.jobs.controls import JobControls
 
 
 FILTER_DELAY_MS = 250           # typing a serial number should not list the archive once per key

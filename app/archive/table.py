@@ -13,8 +13,8 @@ from PySide6.QtCore import QAbstractTableModel, QModelIndex, QSortFilterProxyMod
 from PySide6.QtGui import QColor, QIcon, QPainter, QPixmap
 from PySide6.QtWidgets import QAbstractItemView, QHeaderView, QTableView
 
-from app import style
-from app.traffic_light import LAMP_COLOURS
+from app.widgets import style
+from app.widgets.traffic_light import LAMP_COLOURS
 
 SORT_ROLE = Qt.UserRole
 # (name, header, scale from SI to the display unit)

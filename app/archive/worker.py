@@ -1,7 +1,7 @@
 """The archive's slow work off the GUI thread: storing a measurement, loading a comparison, rebuilding the index;
 and for an archive on a PostgreSQL server, listing and sending the station's queue (a server may be slow or gone).
 
-An ArchiveWorker is a JobRunner (app.job_book) with one thread, so a store
+An ArchiveWorker is a JobRunner (app.jobs.book) with one thread, so a store
 and the rebuild that follows it run in the order asked. Each job opens its
 own archive (analysis.archive.open_archive of the page's source: its own
 connection, its own repair notes). What crosses to the GUI thread is frozen,
@@ -16,7 +16,7 @@ from typing import Any, Callable, Mapping
 
 from PySide6.QtCore import QObject, Signal
 
-from app.job_book import Job, JobRunner
+from app.jobs.book import Job, JobRunner
 from instruments.measurement.raw_stream import raw_capture_path
 
 

@@ -2,7 +2,7 @@
 offset, the excursion limits and the distortion the model predicts against the distortion measured.
 
 The identification (analysis.large_signal, a few seconds per recording) is a
-job (app.job_book) shown by a JobControls; the page shows what it returns.
+job (app.jobs.book) shown by a JobControls; the page shows what it returns.
 It is reached from the Series page's level series ("Large-signal curves")
 or with its own button.
 """
@@ -19,10 +19,10 @@ from PySide6.QtWidgets import (QComboBox, QFileDialog, QGridLayout, QHBoxLayout,
                                QVBoxLayout, QWidget)
 
 from analysis.large_signal import LargeSignalResult, large_signal
-from app.job_book import JobRunner, failure_text
-from app.job_controls import JobControls
+from app.jobs.book import JobRunner, failure_text
+from app.jobs.controls import JobControls
 from app.large_signal.plots import CurvePlot, DistortionPlot
-from app.style import VALIDITY_COLOURS
+from app.widgets.style import VALIDITY_COLOURS
 
 RECORDING_FILTER = "Recordings (*.wav *.json)"
 SAVE_FILTER = "PDF report (*.pdf);;HTML report (*.html);;Curves as CSV (*.csv);;Curves as JSON (*.json)"
@@ -36,7 +36,7 @@ class LargeSignalPage(QWidget):
     def __init__(self, parent=None):
         super().__init__(parent)
         # large_signal() cannot stop midway (seconds): a cancelled identification finishes in the background
-        # and its result is dropped (app.job_book).
+        # and its result is dropped (app.jobs.book).
         self.worker = JobRunner(self, max_threads=1)
         self.result: LargeSignalResult | None = None
         self.choose_button = QPushButton("Choose recordings…")

@@ -10,10 +10,10 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import Qt
 
-from app import style
-from app.grid_axis import show_grid
-from app.plot_placeholder import PlotPlaceholder
-from app.plots import LogFrequencyAxis, style_plot
+from app.widgets import style
+from app.widgets.grid_axis import show_grid
+from app.widgets.plot_placeholder import PlotPlaceholder
+from app.widgets.plots import LogFrequencyAxis, style_plot
 
 BAND = (209, 73, 91, 55)              # the model's red, translucent: the 2-sigma band
 RANGE = (31, 95, 191, 22)             # the measured range: a light blue background

@@ -16,7 +16,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLab
                                QSplitter, QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.effects import Effect, categories, registry
-from app import style
+from app.widgets import style
 
 EFFECT_ROLE = Qt.UserRole
 CATEGORY_TITLES = {       # the ids are for code; these are for the reader

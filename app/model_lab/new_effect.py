@@ -29,8 +29,8 @@ from analysis.effects.user import (UNITS_AT_SITE, EffectFileError, ParameterEntr
                                    effect_from_text, load_effect_file)
 from analysis.fit.least_squares import FitResult
 from analysis.model.composed import ModelError
-from app import style
-from app.plots import LogFrequencyAxis, style_plot
+from app.widgets import style
+from app.widgets.plots import LogFrequencyAxis, style_plot
 
 CHECK_DELAY_MS = 200            # a pause in typing, then the check
 SOURCE = "the new effect"       # how the checks name the form (their lines start with it)

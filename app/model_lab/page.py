@@ -22,17 +22,17 @@ from analysis.fit.least_squares import FitData
 from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
 from analysis.diagnosis.refit_words import refit_text
-from app.job_controls import JobControls
-from app.lab_worker import DiagnosisOutcome, LabFit, LabWorker
+from app.jobs.controls import JobControls
+from app.jobs.lab_worker import DiagnosisOutcome, LabFit, LabWorker
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
 from app.model_lab.sites import SitePanel
 from app.model_lab.session import LabSession
 from app.model_lab.versions import LabVersion, changed_model, move_text
-from app.parameter_table import titled_parameter_table
-from app.result_curves import result_curves
-from app.workers import AnalysisOutcome
+from app.results.parameter_table import titled_parameter_table
+from app.results.curves import result_curves
+from app.jobs.workers import AnalysisOutcome
 
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")

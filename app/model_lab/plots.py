@@ -10,10 +10,10 @@ import pyqtgraph as pg
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
-from app import style
-from app.grid_axis import OpaqueGridAxis, show_grid
-from app.plots import LEFT_AXIS_WIDTH, RESIDUAL_MIN_RANGE, LogFrequencyAxis
-from app.result_curves import ChannelCurves, ResultCurves
+from app.widgets import style
+from app.widgets.grid_axis import OpaqueGridAxis, show_grid
+from app.widgets.plots import LEFT_AXIS_WIDTH, RESIDUAL_MIN_RANGE, LogFrequencyAxis
+from app.results.curves import ChannelCurves, ResultCurves
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
 CHANNEL_COLOURS = {"impedance": style.MEASURED, "displacement": style.RESIDUAL_IMAG}

@@ -2,7 +2,7 @@
 
 ModelLab (app.model_lab.page) shows a LabSession and forwards the user's moves to it; the session decides what
 a new recording, an edited Sd, a new version and a diagnosis do to the lab's history. No Qt is imported here
-(the fits it keeps are made by app.lab_worker, named here as types only): tests/app/model_lab/test_session.py
+(the fits it keeps are made by app.jobs.lab_worker, named here as types only): tests/app/model_lab/test_session.py
 drives it without a window.
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ from app.model_lab.versions import LabVersion
 
 if TYPE_CHECKING:
     from analysis.pipeline import AnalysisResult
-    from app.lab_worker import DiagnosisOutcome, LabFit
+    from app.jobs.lab_worker import DiagnosisOutcome, LabFit
 
 
 class LabSession:

@@ -17,9 +17,9 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN
 from analysis.diagnosis.sites import SiteResult
 from analysis.diagnosis.words import SITE_WORDS, chi2_words, tied_sites
-from app import style
-from app.grid_axis import show_grid
-from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
+from app.widgets import style
+from app.widgets.grid_axis import show_grid
+from app.widgets.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
 
 SIZE_COLOUR = "#6a3d9a"
 PHASE_COLOUR = "#e08a00"

@@ -7,9 +7,9 @@ import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import Qt
 
-from app import style
-from app.grid_axis import OpaqueGridAxis, show_grid
-from app.parameter_table import display_name
+from app.widgets import style
+from app.widgets.grid_axis import OpaqueGridAxis, show_grid
+from app.results.parameter_table import display_name
 
 ALARM = "#c62828"
 CONTROL = "#8e5bb5"          # control limits (the process)

@@ -22,11 +22,11 @@ from PySide6.QtWidgets import (QAbstractItemView, QComboBox, QFileDialog, QHBoxL
 
 from analysis.archive.backends import shown
 from analysis.production.capability_interval import MIN_UNITS, centred_interval, spread_interval, too_few
-from app import style
+from app.widgets import style
 from app.archive.filter import NO_DATE, date_edit
 from app.archive.page import archive_source
-from app.job_controls import JobControls
-from app.parameter_table import display_name
+from app.jobs.controls import JobControls
+from app.results.parameter_table import display_name
 from app.production.charts import ALARM, ControlChartView, HistogramView, display_unit
 from app.production.worker import ProductionRequest, ProductionWorker
 
@@ -248,7 +248,7 @@ class ProductionPage(QWidget):
 
     def _loaded_limits_file(self) -> str:
         """The limits file the QA page has loaded (it remembers it), for the command that stores it."""
-        from app.qa_view import LIMITS_KEY
+        from app.qa.view import LIMITS_KEY
         q = getattr(self.settings, "qsettings", None)
         return str(q.value(LIMITS_KEY, "") or "") if q is not None else ""
 
@@ -400,7 +400,7 @@ class ProductionPage(QWidget):
                 payload = population_csv(data.population)
             written = write_atomic(path, payload)
         except Exception as exc:  # noqa: BLE001 - the GUI's error boundary (job_book.failure_text)
-            from app.job_book import failure_text
+            from app.jobs.book import failure_text
             self._say(f"Could not export to {path}: {failure_text(exc, f'exporting to {path}')}")
             return None
         self._say(f"Written: {written} ({len(data.population)} measurement(s)).", "note")

@@ -1,7 +1,7 @@
 """The Production page's statistics off the GUI thread: read the population (a server may be slow or gone),
 compute the statistics, hand back one frozen result or one line of error.
 
-A ProductionWorker is a JobRunner (app.job_book) with one thread: the
+A ProductionWorker is a JobRunner (app.jobs.book) with one thread: the
 newest request is the one shown; an older one still running is cancelled
 and its result dropped.
 """
@@ -12,7 +12,7 @@ from typing import Any
 
 from PySide6.QtCore import QObject
 
-from app.job_book import Job, JobRunner
+from app.jobs.book import Job, JobRunner
 
 
 @dataclass(frozen=True, slots=True)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import QLabel, QWidget
 
-from app.measure_session import MeasureSession
+from app.wizard.measure_session import MeasureSession
 from app.wizard.calibration import Corrections
 from app.wizard.hardware import HardwareConfig
 from app.wizard.plans import DriverInfo
@@ -27,7 +27,7 @@ class WizardState:
     level_v: float | None = None
     level_reason: str = ""
     level_words: str = ""                     # the reason in a few words ("enough signal")
-    outcome: object | None = None            # app.measure_session.MeasureOutcome
+    outcome: object | None = None            # app.wizard.measure_session.MeasureOutcome
 
 
 class WizardPage(QWidget):

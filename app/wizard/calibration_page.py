@@ -9,10 +9,10 @@ import pyqtgraph as pg
 from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QPushButton,
                                QVBoxLayout)
 
-from app import style
-from app.grid_axis import show_grid
-from app.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
-from app.job_controls import JobControls
+from app.widgets import style
+from app.widgets.grid_axis import show_grid
+from app.widgets.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
+from app.jobs.controls import JobControls
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.calibration import Corrections, CorrectionsError
 from app.wizard.hardware import RIG, SIMULATOR

@@ -7,7 +7,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (QButtonGroup, QCheckBox, QComboBox, QGridLayout, QGroupBox, QHBoxLayout, QLabel,
                                QLineEdit, QPushButton, QRadioButton, QVBoxLayout)
 
-from app.job_controls import JobControls
+from app.jobs.controls import JobControls
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.device_lists import SerialPortList, SoundCardList
 from app.wizard.hardware import (

@@ -6,8 +6,8 @@ import html
 from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QDoubleSpinBox, QFormLayout, QHBoxLayout,
                                QHeaderView, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout)
 
-from app.live_panels import LivePanels
-from app.job_controls import JobControls
+from app.live.panels import LivePanels
+from app.jobs.controls import JobControls
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.plans import TEMPLATES
 

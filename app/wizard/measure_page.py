@@ -7,8 +7,8 @@ from pathlib import Path
 from PySide6.QtCore import QStandardPaths, Signal
 from PySide6.QtWidgets import QDoubleSpinBox, QFileDialog, QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
-from app.live_panels import LivePanels
-from app.job_controls import JobControls
+from app.live.panels import LivePanels
+from app.jobs.controls import JobControls
 from app.wizard.base import ERROR_COLOUR, OK_COLOUR, WizardPage, coloured, rich_label
 from app.wizard.plans import LARGE_SIGNAL, TEMPLATES
 from app.wizard.tasks import MeasurementRequest

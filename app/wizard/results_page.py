@@ -6,16 +6,16 @@ import html
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QHBoxLayout, QPushButton, QVBoxLayout
 
-from app.fit_quality import FitQualityBox
-from app.parameter_table import titled_parameter_table
-from app.traffic_light import ValiditySummary
+from app.results.fit_quality import FitQualityBox
+from app.results.parameter_table import titled_parameter_table
+from app.widgets.traffic_light import ValiditySummary
 from app.wizard.base import WizardPage, rich_label
 
 
 class ResultsPage(WizardPage):
     title = "Results"
     subtitle = "The parameters of this measurement and whether it can be trusted, channel by channel."
-    open_requested = Signal(object)          # app.workers.AnalysisOutcome
+    open_requested = Signal(object)          # app.jobs.workers.AnalysisOutcome
     again_requested = Signal()
 
     def __init__(self, state, session, parent=None):

@@ -14,7 +14,7 @@ from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QListWidget, QListWidgetItem, QPushButton,
                                QScrollArea, QStackedWidget, QVBoxLayout, QWidget)
 
-from app.measure_session import MeasureSession
+from app.wizard.measure_session import MeasureSession
 from app.wizard.base import ERROR_COLOUR, WizardPage, WizardState
 from app.wizard.calibration_page import CalibrationPage
 from app.wizard.driver_page import DriverPage
@@ -26,9 +26,9 @@ from instruments.rig.state import DEFAULT_NAME
 
 
 class MeasureWizard(QWidget):
-    measurement_finished = Signal(object)        # app.measure_session.MeasureOutcome
+    measurement_finished = Signal(object)        # app.wizard.measure_session.MeasureOutcome
     large_signal_finished = Signal(object)       # app.wizard.tasks.LargeSignalMeasured (with a result)
-    open_results_requested = Signal(object)      # app.workers.AnalysisOutcome
+    open_results_requested = Signal(object)      # app.jobs.workers.AnalysisOutcome
 
     def __init__(self, settings: QSettings, session: MeasureSession | None = None, parent=None, *,
                  rig_name: str = DEFAULT_NAME, rig_runtime_dir: str | None = None):
@@ -149,7 +149,7 @@ class MeasureWizard(QWidget):
         self.go_to(0)
 
     def model_part_arrived(self, analysis) -> None:
-        """The measurement's analysis (app.workers.AnalysisOutcome) again, its uncertainties with their model part
+        """The measurement's analysis (app.jobs.workers.AnalysisOutcome) again, its uncertainties with their model part
         (estimated in the background after the statistical result): the Results step shows it too."""
         outcome = self.state.outcome
         if outcome is None or outcome.analysis.result.fit is not analysis.result.fit:

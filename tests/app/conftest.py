@@ -59,7 +59,7 @@ def recordings(tmp_path_factory) -> dict[str, Path]:
 
 @pytest.fixture
 def settings(tmp_path):
-    from app.settings import Settings
+    from app.window.settings import Settings
     return Settings(QSettings(str(tmp_path / "linpar.ini"), QSettings.IniFormat))
 
 
@@ -89,7 +89,7 @@ def dialogs(monkeypatch) -> list[tuple[str, str, str]]:
 
 @pytest.fixture
 def window(qtbot, settings):
-    from app.main_window import MainWindow
+    from app.window.main_window import MainWindow
     w = MainWindow(settings)
     qtbot.addWidget(w)
     w.resize(1400, 900)

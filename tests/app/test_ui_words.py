@@ -3,7 +3,7 @@
 The test walks the widget tree of the main window after a measurement is shown (the Results page, the
 Model lab with a diagnosis ranked, QA, the wizard after its sound-card test) and reads every text a user can
 see: labels, buttons, tabs, group titles, text views, table and tree cells and headers, combo entries and
-plot titles and axes. Only a "details" section (app.fit_quality.DETAILS) may carry the numbers behind a
+plot titles and axes. Only a "details" section (app.results.fit_quality.DETAILS) may carry the numbers behind a
 sentence.
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ from PySide6.QtCore import QModelIndex, Qt
 from PySide6.QtWidgets import (QAbstractButton, QAbstractItemView, QComboBox, QGroupBox, QLabel, QLineEdit,
                                QTabWidget, QTextEdit, QWidget)
 
-from app.fit_quality import DETAILS
+from app.results.fit_quality import DETAILS
 
 from .conftest import analysis_wait_ms, open_and_wait
 from tests.app.wizard.test_wizard_helpers import choose_simulator, run_job, to_hardware
@@ -169,7 +169,7 @@ def code_words() -> dict[str, re.Pattern]:
     """What a developer writes and a user should not read: effect ids, the code's parameter names where the
     customary name differs (RE for Re), and units as the code spells them (ohm, T*m, uF)."""
     from analysis.effects import CATALOGUE
-    from app.parameter_table import DISPLAY_NAMES
+    from app.results.parameter_table import DISPLAY_NAMES
     ids = "|".join(re.escape(i) for i in sorted(CATALOGUE, key=len, reverse=True))
     return {
         "an effect id": re.compile(rf"(?<![\w-])(?:{ids})(?![\w-])"),

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from analysis.derived import ParameterValue
-from app.parameter_table import format_value, short_value
-from app.plots import LogFrequencyAxis
-from app.result_curves import aligned_phase_deg
+from app.results.parameter_table import format_value, short_value
+from app.widgets.plots import LogFrequencyAxis
+from app.results.curves import aligned_phase_deg
 
 
 @pytest.mark.parametrize("value, std, scale, expected", [

@@ -1,7 +1,7 @@
 """On the next start the window offers a measurement that a crash cut short: keep, analyse or discard it.
 
 The hook is MainWindow.offer_unfinished (with app/main.py calling it once
-the window shows). Until that is in app/main_window.py the test says so and
+the window shows). Until that is in app/window/main_window.py the test says so and
 skips; instruments.measurement.recovery itself is tested in
 test_crash_safety.py.
 """
@@ -35,10 +35,10 @@ def cut_short(folder, name: str) -> None:
 
 @pytest.fixture
 def window(qtbot, tmp_path):
-    from app.main_window import MainWindow
-    from app.settings import Settings
+    from app.window.main_window import MainWindow
+    from app.window.settings import Settings
     if not hasattr(MainWindow, "offer_unfinished"):
-        pytest.skip("app/main_window.py has no offer_unfinished yet (its diff is in the reliability work's report)")
+        pytest.skip("app/window/main_window.py has no offer_unfinished yet (its diff is in the reliability work's report)")
     from app.wizard.measure_page import OUT_DIR_KEY
     settings = Settings(QSettings(str(tmp_path / "linpar.ini"), QSettings.IniFormat))
     settings.qsettings.setValue(OUT_DIR_KEY, str(tmp_path / "out"))

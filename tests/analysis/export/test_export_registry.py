@@ -41,7 +41,7 @@ def test_a_new_format_is_one_module(tmp_path, monkeypatch):
     assert path.read_text() == f"{len(stored.parameters)} parameters of W6\n"
 
     from app.cli.report import export_options
-    from app.menus import data_filters, suffix_kind
+    from app.window.menus import data_filters, suffix_kind
     assert ("toy", "Toy summary (.toy)") in export_options()
     assert data_filters()["Toy summary (*.toy)"] == "toy" and suffix_kind()[".toy"] == "toy"
 

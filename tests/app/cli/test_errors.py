@@ -1,6 +1,6 @@
 """One error model (analysis.errors): a user error is one line and exit 2, a bug exit 70 with a crash report.
 
-The boundaries are app.cli.main and the GUI's job runner (app.job_book.failure_text): they catch
+The boundaries are app.cli.main and the GUI's job runner (app.jobs.book.failure_text): they catch
 LinparError (and the environment's OSError / MemoryError), never a bare ValueError or KeyError, so a
 bug cannot pass for bad input.
 """

@@ -75,7 +75,7 @@ def test_a_recording_without_the_laser_is_said_not_shown(qtbot, page, recordings
 
 
 def test_the_series_pages_level_series_opens_here(qtbot, settings, steps, monkeypatch):
-    from app.main_window import MainWindow
+    from app.window.main_window import MainWindow
     window = MainWindow(settings)
     qtbot.addWidget(window)
     asked = []

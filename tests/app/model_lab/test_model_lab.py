@@ -16,17 +16,17 @@ import pytest
 from PySide6.QtCore import Qt
 
 import analysis.diagnosis.candidates
-import app.lab_worker
+import app.jobs.lab_worker
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit.least_squares import FitCancelled, FitError
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
-from app import style
+from app.widgets import style
 from app.model_lab.candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
 from app.model_lab.catalogue import EFFECT_ROLE
 from app.model_lab.page import ModelLab
-from app.parameter_table import VALUE
+from app.results.parameter_table import VALUE
 
 from tests.app.conftest import PAPER, analysis_wait_ms, open_and_wait
 from tests.pace import wait_ms
@@ -196,8 +196,8 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
             threads.append(threading.current_thread())
             return real(*args, **kwargs)
         return call
-    monkeypatch.setattr(app.lab_worker, "fit_model", spy(app.lab_worker.fit_model))
-    monkeypatch.setattr(app.lab_worker, "diagnose", spy(app.lab_worker.diagnose))
+    monkeypatch.setattr(app.jobs.lab_worker, "fit_model", spy(app.jobs.lab_worker.fit_model))
+    monkeypatch.setattr(app.jobs.lab_worker, "diagnose", spy(app.jobs.lab_worker.diagnose))
     _toggle(qtbot, lab, "creep-log", checked=True)
     _diagnose(qtbot, lab)
     assert len(threads) == 2
@@ -213,7 +213,7 @@ def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
         if not cancel.wait(240):           # only the Cancel button ends this "fit"
             raise AssertionError("never cancelled")
         raise FitCancelled("fit cancelled")
-    monkeypatch.setattr(app.lab_worker, "fit_model", blocked)
+    monkeypatch.setattr(app.jobs.lab_worker, "fit_model", blocked)
     lab.catalogue.item("creep-log").setCheckState(0, Qt.Checked)
     qtbot.waitUntil(started.is_set, timeout=wait_ms(10))
     assert lab.busy and lab.jobs.cancel_button.isVisible() and lab.jobs.progress.isVisible()
@@ -249,7 +249,7 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
         with OneThreadPool(max_workers=1) as pool:
             yield pool
     monkeypatch.setattr(analysis.diagnosis.candidates, "_refit", slow_refit)
-    monkeypatch.setattr(app.lab_worker, "fit_executor", one_process_pool)
+    monkeypatch.setattr(app.jobs.lab_worker, "fit_executor", one_process_pool)
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: bool(calls), timeout=wait_ms(10))
     with qtbot.waitSignal(lab.job_cancelled, timeout=wait_ms(10)):
@@ -262,12 +262,12 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
 
 def test_follow_the_greedy_path_after_a_diagnosis(qtbot, lab, monkeypatch):
     starts = []
-    real = app.lab_worker.diagnose
+    real = app.jobs.lab_worker.diagnose
 
     def spy(data, model, **kwargs):
         starts.append(kwargs["start_fit"].model.effect_ids)
         return real(data, model, **kwargs)
-    monkeypatch.setattr(app.lab_worker, "diagnose", spy)
+    monkeypatch.setattr(app.jobs.lab_worker, "diagnose", spy)
     _diagnose(qtbot, lab)
     outcome = _diagnose(qtbot, lab, lab.candidates.follow_button)
     # The ranking of version 1 is not repeated: the path goes on from its best candidate.
@@ -298,7 +298,7 @@ def test_the_main_window_hands_its_result_to_the_lab_and_shows_the_labs_model(qt
     assert window.results.result.fit is lab.current.fitted.fit     # the Results page shows the lab's model
     assert len(lab.versions) == 2                                   # and that did not restart the lab
     window.results.on_sd_changed(0.02)
-    # The lab follows the Results page in a later turn of the event loop (app/staged_fanout.py).
+    # The lab follows the Results page in a later turn of the event loop (app/jobs/staged_fanout.py).
     qtbot.waitUntil(lambda: not window.result_pages.pending, timeout=wait_ms(10))
     assert lab.current.fitted.result.sd_m2 == 0.02 and len(lab.versions) == 2
     vas = lab.current.fitted.result.parameters["Vas"]

@@ -10,9 +10,9 @@ from analysis.effects import parse_effects
 from analysis.fit.least_squares import fit_model
 from analysis.model.composed import Model
 from analysis.pipeline import AnalysisResult, analyze_recording
-from app.lab_worker import LabFit, lab_fit
+from app.jobs.lab_worker import LabFit, lab_fit
 from app.model_lab.session import LabSession
-from app.result_curves import result_curves
+from app.results.curves import result_curves
 from tests.builders import TYPICAL_NOISE, recording
 from tests.fresh_import import loaded_by_import
 

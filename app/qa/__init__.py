@@ -1,0 +1,1 @@
+"""The QA page: verdicts against limits, validity, and the report export."""

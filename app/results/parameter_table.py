@@ -1,0 +1,349 @@
+"""The parameter table: name, value, 1-sigma and unit in customary units.
+
+The Thiele-Small parameters come first, in the order a speaker engineer reads
+them; the model's own quantities (CMES, LCES, RES, L2, ...) follow under a
+section row that folds them away. Values are rounded to what their
+uncertainty supports, at most 4 significant digits unless "All digits" is on.
+
+Parameters that could not be determined stay in the table (a missing row
+would look like an oversight): greyed, with the reason in place of the value
+and in full in the tooltip.
+"""
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+import numpy as np
+
+from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
+from PySide6.QtGui import QBrush, QColor, QFont
+from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeaderView, QLabel, QTableView,
+                               QVBoxLayout, QWidget)
+
+from analysis.derived import NO_SD, ParameterValue
+from analysis.parameter_names import DISPLAY_NAMES, THIELE_SMALL, display_name  # noqa: F401 (shared)
+from analysis.report.numbers import pretty_unit
+from app.widgets import style
+
+COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
+NAME, VALUE, STD, UNIT = range(4)
+
+INTERNAL_TITLE = "Model's internal quantities"
+DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
+
+# Tooltips for the derived parameters (fitted ones carry their own description).
+DERIVED_DESCRIPTIONS = {
+    "fs": "resonance frequency, 1 / (2π √(Mms·Cms))",
+    "Mms": "moving mass, CMES·Bl²",
+    "Rms": "mechanical resistance, Bl² / RES",
+    "Cms": "compliance of the suspension, LCES / Bl²",
+    "Kms": "stiffness of the suspension, 1 / Cms",
+    "Qes": "electrical Q at fs",
+    "Qms": "mechanical Q at fs",
+    "Qts": "total Q at fs, Qes·Qms / (Qes + Qms)",
+    "Vas": "equivalent air volume of the compliance, ρc²Sd²Cms",
+    "eta0": "reference efficiency (piston in half space)",
+    "SPL_1W_1m": "sensitivity at 1 W into RE, 1 m, half space",
+    "SPL_2.83V_1m": "sensitivity at 2.83 V, 1 m, half space",
+    "Sd": "effective radiating area of the diaphragm (given, not measured)",
+}
+
+
+def ordered_rows(parameters: Mapping[str, ParameterValue], sd_m2: float | None = None) -> list:
+    """Thiele-Small parameters first, then a section title (a str) and the model's internal quantities."""
+    named = dict(parameters)
+    if sd_m2:
+        named["Sd"] = ParameterValue("Sd", sd_m2, None, "m^2", "cm²", 1e4)
+    rows: list = [named[n] for n in THIELE_SMALL if n in named]
+    internal = [p for n, p in named.items() if n not in THIELE_SMALL]
+    if internal:
+        rows.append(INTERNAL_TITLE)
+        rows.extend(internal)
+    return rows
+
+
+def format_value(p: ParameterValue, all_digits: bool = True) -> tuple[str, str]:
+    """(value, 1-sigma) in display units, the value rounded to the second digit of its sigma.
+
+    all_digits=False: at most DEFAULT_DIGITS significant digits, fewer when the sigma allows fewer.
+    """
+    if p.value is None:
+        return "", ""
+    if not all_digits:
+        return short_value(p)
+    value = p.value * p.display_scale
+    std = None if p.std is None else p.std * abs(p.display_scale)
+    if std is None or not math.isfinite(std) or std <= 0:
+        return f"{value:.5g}", "–"
+    decimals = max(0, -math.floor(math.log10(std)) + 1)
+    if decimals > 9 or abs(value) >= 1e6:
+        return f"{value:.6g}", f"{std:.2g}"
+    return f"{value:.{decimals}f}", f"{std:.{decimals}f}"
+
+
+def uncertainty_parts(p: ParameterValue) -> str:
+    """"±0.12 g noise, ±0.9 g model": the two parts of the uncertainty where the analysis estimated them, or ""."""
+    unit = pretty_unit(p.display_unit)
+    unit = "" if unit in ("", "-", "1") else f" {unit}"
+    parts = [f"±{std * abs(p.display_scale):.2g}{unit} {what}" for std, what in ((p.std_noise, "noise"),
+                                                                                (p.std_model, "model"))
+             if std is not None and math.isfinite(std)]
+    return ", ".join(parts)
+
+
+# The parameters whose two parts the line under the table names (every row's are in its tooltip).
+PARTS_NAMED = ("RE", "Bl", "Mms", "Kms", "fs", "Qts")
+
+
+def parts_summary(parameters: Mapping[str, ParameterValue]) -> str:
+    """"Of each ±1σ (noise and model): Mms ±0.12 g noise, ±0.9 g model; ...", or "" when no part was estimated."""
+    named = [f"{display_name(name)} {uncertainty_parts(parameters[name])}" for name in PARTS_NAMED
+             if name in parameters and parameters[name].value is not None and parameters[name].std_model is not None]
+    return ("Of each ±1σ, the noise's part and the model's (what the model misses): " + "; ".join(named)
+            if named else "")
+
+
+def value_with_unit(p: ParameterValue) -> str:
+    """"3.02 Ω": the value as the table rounds it (at most 4 digits) and its unit, for a page with one cell."""
+    if p.value is None:
+        return "not measured"
+    unit = "" if p.display_unit in ("1", "-") else pretty_unit(p.display_unit)
+    return f"{short_value(p)[0]} {unit}".rstrip()
+
+
+def short_value(p: ParameterValue) -> tuple[str, str]:
+    """(value, 1-sigma): as many significant digits as the sigma supports (its second digit), at most 4;
+    the sigma with 2 significant digits, written out without an exponent."""
+    value = p.value * p.display_scale
+    std = None if p.std is None else p.std * abs(p.display_scale)
+    known = std is not None and math.isfinite(std) and std > 0
+    std_text = (np.format_float_positional(std, precision=2, unique=False, fractional=False, trim="-")
+                if known else "–")
+    if value == 0 or not math.isfinite(value):
+        return f"{value:.{DEFAULT_DIGITS}g}", std_text
+    magnitude = math.floor(math.log10(abs(value)))
+    digits = DEFAULT_DIGITS
+    if known:
+        digits = max(1, min(DEFAULT_DIGITS, magnitude - math.floor(math.log10(std)) + 2))
+    decimals = digits - 1 - magnitude
+    if abs(value) >= 1e6 or decimals > 9:
+        return f"{value:.{digits}g}", std_text
+    return f"{round(value, decimals):.{max(0, decimals)}f}", std_text
+
+
+def shared_reason(rows) -> str:
+    """The one reason every parameter row went unmeasured for (a broken lead: nothing fitted), or "": the table
+    says it once instead of in each row's cell, truncated."""
+    reasons = {p.reason or "" for p in rows if not isinstance(p, str) and p.name != "Sd"}
+    unmeasured = all(p.value is None for p in rows if not isinstance(p, str) and p.name != "Sd")
+    return reasons.pop() if unmeasured and len(reasons) == 1 else ""
+
+
+class ParameterModel(QAbstractTableModel):
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._rows: list = []                      # ParameterValue, or a section title (str)
+        self._descriptions: dict[str, str] = {}
+        self._cells: list[list[dict]] = []         # per row and column: role -> value
+        self._parameters: Mapping[str, ParameterValue] = {}
+        self._sd_m2: float | None = None
+        self.all_digits = False
+        self.common_reason = ""         # every row unmeasured for one reason: said once above the table
+
+    def set_parameters(self, parameters: Mapping[str, ParameterValue],
+                       descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
+        self.beginResetModel()
+        self._parameters, self._sd_m2 = parameters, sd_m2
+        self._rows = ordered_rows(parameters, sd_m2)
+        self._descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
+        # Every role of every cell, worked out once: a view asks for each of them on every repaint
+        # (some 1,700 calls to show the table), and formatting them each time made up half of the
+        # Results page's repaint.
+        self.common_reason = shared_reason(self._rows)
+        self._cells = [self._row_roles(p) for p in self._rows]
+        self.endResetModel()
+
+    def set_all_digits(self, on: bool) -> None:
+        self.all_digits = on
+        self.set_parameters(self._parameters, self._descriptions, self._sd_m2)
+
+    def is_section(self, row: int) -> bool:
+        return isinstance(self._rows[row], str)
+
+    def _row_roles(self, p) -> list[dict]:
+        if isinstance(p, str):          # a section title over the rows below it
+            font = QFont()
+            font.setBold(True)
+            tip = ("What the model computes with: the Thiele-Small parameters above derive from them. "
+                   "Click to fold them away or show them.")
+            return [{Qt.DisplayRole: f"▾ {p}" if col == NAME else "", Qt.FontRole: font, Qt.ToolTipRole: tip}
+                    for col in range(len(COLUMNS))]
+        tooltip = self._tooltip(p)
+        cells = []
+        for col in range(len(COLUMNS)):
+            roles = {Qt.DisplayRole: self._display(p, col), Qt.ToolTipRole: tooltip}
+            if p.value is None:
+                roles[Qt.ForegroundRole] = QBrush(QColor(style.MISSING_TEXT))
+            if col == NAME and p.fitted:
+                font = QFont()
+                font.setBold(True)      # fitted parameters stand out from the derived ones
+                roles[Qt.FontRole] = font
+            if col in (VALUE, STD) and p.value is not None:
+                roles[Qt.TextAlignmentRole] = int(Qt.AlignRight | Qt.AlignVCenter)
+            cells.append(roles)
+        return cells
+
+    def parameter(self, row: int) -> ParameterValue | None:
+        """The row's parameter (None for a section row)."""
+        p = self._rows[row]
+        return None if isinstance(p, str) else p
+
+    def row_of(self, name: str) -> int:
+        for row, p in enumerate(self._rows):
+            if not isinstance(p, str) and p.name == name:
+                return row
+        raise KeyError(name)
+
+    def rowCount(self, parent=QModelIndex()) -> int:
+        return 0 if parent.isValid() else len(self._rows)
+
+    def columnCount(self, parent=QModelIndex()) -> int:
+        return 0 if parent.isValid() else len(COLUMNS)
+
+    def headerData(self, section, orientation, role=Qt.DisplayRole):
+        if orientation == Qt.Horizontal and role == Qt.DisplayRole:
+            return COLUMNS[section]
+        return None
+
+    def data(self, index: QModelIndex, role=Qt.DisplayRole):
+        if not index.isValid():
+            return None
+        return self._cells[index.row()][index.column()].get(role)
+
+    def _display(self, p: ParameterValue, col: int) -> str:
+        if col == NAME:
+            return display_name(p.name)
+        if col == UNIT:
+            return pretty_unit(p.display_unit)
+        if p.value is None:
+            if col != VALUE:
+                return ""
+            return "not measured" if self.common_reason else f"n/a: {p.reason}"
+        value, std = format_value(p, self.all_digits)
+        return value if col == VALUE else std
+
+    def _tooltip(self, p: ParameterValue) -> str:
+        kind = "given" if p.name == "Sd" else ("fitted" if p.fitted else "derived from the fitted values")
+        text = f"{display_name(p.name)} ({kind})"
+        description = self._descriptions.get(p.name)
+        if description:
+            text += f": {description}"
+        if p.value is not None:
+            value, std = format_value(p, all_digits=True)
+            unit = pretty_unit(p.display_unit)
+            spread = f" ± {std}" if std not in ("", "–") else ""
+            text += f"\n= {value}{spread} {unit}".rstrip()
+            parts = uncertainty_parts(p)
+            if parts:
+                text += f"\nof which {parts}"
+            if spread:
+                text += "\n± is one standard deviation: the true value lies within it with about 68 % probability."
+        if p.value is None:
+            text += f"\nNot reported: {p.reason}"
+            if p.reason == NO_SD:      # the analysis words it for the command line
+                text += "\nIn this window: enter Sd on the Predicted SPL tab."
+        return text
+
+
+class ParameterTable(QTableView):
+    """The view: spans the reason of a missing value over the value and sigma columns."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.parameter_model = ParameterModel(self)
+        self.setModel(self.parameter_model)
+        self.setSelectionBehavior(QAbstractItemView.SelectRows)
+        self.setEditTriggers(QAbstractItemView.NoEditTriggers)
+        self.setAlternatingRowColors(True)
+        self.setWordWrap(False)
+        self.setTextElideMode(Qt.ElideRight)
+        self.verticalHeader().setVisible(False)
+        self.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 8)
+        header = self.horizontalHeader()
+        header.setSectionResizeMode(NAME, QHeaderView.ResizeToContents)
+        header.setSectionResizeMode(VALUE, QHeaderView.Stretch)
+        header.setSectionResizeMode(STD, QHeaderView.ResizeToContents)
+        header.setSectionResizeMode(UNIT, QHeaderView.ResizeToContents)
+        self.internal_folded = False
+        self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
+        self.parameter_model.modelReset.connect(self._apply_spans)
+        self.clicked.connect(self._on_clicked)
+
+    def set_parameters(self, parameters: Mapping[str, ParameterValue],
+                       descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
+        self.parameter_model.set_parameters(parameters, descriptions, sd_m2)
+        if self.parts_label is not None:
+            summary = parts_summary(parameters)
+            self.parts_label.setText(summary)
+            self.parts_label.setVisible(bool(summary))
+
+    def set_all_digits(self, on: bool) -> None:
+        self.parameter_model.set_all_digits(on)
+
+    def _apply_spans(self) -> None:
+        self.clearSpans()
+        model = self.parameter_model
+        below_section = False
+        for row in range(model.rowCount()):
+            if model.is_section(row):
+                self.setSpan(row, NAME, 1, len(COLUMNS))
+                below_section = True
+                continue
+            self.setRowHidden(row, below_section and self.internal_folded)
+            if model.parameter(row).value is None:
+                self.setSpan(row, VALUE, 1, 2)
+
+    def _on_clicked(self, index: QModelIndex) -> None:
+        if index.isValid() and self.parameter_model.is_section(index.row()):
+            self.internal_folded = not self.internal_folded
+            self._apply_spans()
+
+
+def titled_parameter_table(title_html: str) -> tuple[QWidget, "ParameterTable"]:
+    """A ParameterTable under a bold title and its "All digits" switch, in a box for a splitter: (box, table)."""
+    table = ParameterTable()
+    box = QWidget()
+    layout = QVBoxLayout(box)
+    layout.setContentsMargins(0, 0, 0, 0)
+    title = QLabel(title_html)
+    title.setWordWrap(True)
+    all_digits = QCheckBox("All digits")
+    all_digits.setToolTip("Show every digit the uncertainty supports (to its second digit) instead of at most "
+                          f"{DEFAULT_DIGITS} significant digits")
+    all_digits.toggled.connect(table.set_all_digits)
+    table.all_digits_box = all_digits
+    note = QLabel()                     # the one reason nothing was measured, when that is so
+    note.setWordWrap(True)
+    note.setTextFormat(Qt.PlainText)
+    note.hide()
+    table.note = note
+
+    def show_note():
+        reason = table.parameter_model.common_reason
+        note.setText(f"Not measured: {reason}" if reason else "")
+        note.setVisible(bool(reason))
+    table.parameter_model.modelReset.connect(show_note)
+    top = QHBoxLayout()
+    top.addWidget(title, 1)
+    top.addWidget(all_digits)
+    layout.addLayout(top)
+    layout.addWidget(note)
+    layout.addWidget(table, 1)
+    parts = QLabel()
+    parts.setWordWrap(True)
+    parts.setTextFormat(Qt.PlainText)
+    parts.hide()
+    table.parts_label = parts
+    layout.addWidget(parts)
+    return box, table

@@ -1,0 +1,1 @@
+"""Widgets and styles every page uses: plots, grids, placeholders, traffic lights, colours."""

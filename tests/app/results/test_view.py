@@ -1,0 +1,215 @@
+"""The Results page on synthetic recordings of the paper's driver."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import Qt
+
+from app.results.parameter_table import NAME, STD, UNIT, VALUE
+
+from tests.app.conftest import PAPER, open_and_wait
+
+
+def _cell(table, name: str, column: int, role=Qt.DisplayRole):
+    model = table.parameter_model
+    return model.data(model.index(model.row_of(name), column), role)
+
+
+def _lengths(*items) -> list[int]:
+    return [len(item.getData()[0]) for item in items]
+
+
+@pytest.fixture
+def shown(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["paper"])
+    return window.results
+
+
+def test_parameter_table_shows_re_within_one_percent(shown):
+    value = float(_cell(shown.parameter_table, "RE", VALUE))
+    assert value == pytest.approx(PAPER.parameters["RE"], rel=0.01)
+    assert _cell(shown.parameter_table, "RE", UNIT) == "Ω"
+    assert float(_cell(shown.parameter_table, "RE", STD)) > 0
+
+
+def test_table_uses_customary_units(shown):
+    assert _cell(shown.parameter_table, "LE", UNIT) == "mH"
+    assert float(_cell(shown.parameter_table, "LE", VALUE)) == pytest.approx(PAPER.parameters["LE"] * 1e3, rel=0.01)
+    assert _cell(shown.parameter_table, "Mms", UNIT) == "g"
+    assert float(_cell(shown.parameter_table, "Mms", VALUE)) == pytest.approx(11.87, rel=0.01)
+
+
+def test_every_plot_has_measured_model_and_residual_data(shown):
+    for plot in (shown.impedance_plot, shown.displacement_plot):
+        n_lines, n_dense, *rest = _lengths(plot.magnitude_measured, plot.magnitude_model, plot.phase_measured,
+                                           plot.phase_model, plot.residual_real, plot.residual_imag)
+        assert n_lines > 50 and n_dense > n_lines
+        assert rest == [n_lines, n_dense, n_lines, n_lines]
+    spl = shown.spl_panel
+    assert spl.stack.currentWidget() is spl.plot
+    assert min(_lengths(spl.plot.measured, spl.plot.model)) > 0
+
+
+def test_residual_strip_is_in_sigma_units(shown):
+    x, y = shown.impedance_plot.residual_real.getData()
+    assert np.isfinite(y).all()
+    assert np.std(y) == pytest.approx(1.0, abs=0.3)          # noise only: unit scatter
+
+
+def test_model_line_follows_the_measured_points(shown):
+    plot = shown.impedance_plot
+    f, measured = plot.magnitude_measured.getData()
+    fd, model = plot.magnitude_model.getData()
+    assert np.interp(f, fd, model) == pytest.approx(measured, rel=0.01)
+    _, phase = shown.displacement_plot.phase_measured.getData()
+    fd, phase_model = shown.displacement_plot.phase_model.getData()
+    assert np.abs(np.interp(_, fd, phase_model) - phase).max() < 5.0      # same branch, no 360 jumps
+
+
+def test_fit_quality_and_validity(shown):
+    headline = shown.fit_quality.headline.text()
+    # In words: the model by its effects' titles, and how well it explains each channel.
+    assert "LR-2" in headline and "Logarithmic creep" in headline
+    assert "explains the impedance and the displacement down to their noise" in headline
+    for part in ("χ²", "AIC", "BIC", "lr2"):
+        assert part not in headline
+    # The numbers behind it, folded away until asked for.
+    details = shown.fit_quality.details
+    assert not details.isVisible()
+    shown.fit_quality.toggle.click()
+    assert details.isVisible()
+    for part in ("lr2", "creep-log", "reduced χ²", "Z ", "Hx ", "AIC", "BIC"):
+        assert part in details.text()
+    # a clean simulated measurement: the validity checks find nothing wrong
+    assert shown.validity_box.state == "green"
+    assert "green" in shown.validity_box.text().lower()
+
+
+def test_spl_follows_voltage(shown):
+    spl = shown.spl_panel
+    _, before = spl.plot.model.getData()
+    spl.voltage.setValue(spl.voltage.value() * 2)
+    _, after = spl.plot.model.getData()
+    assert after - before == pytest.approx(20 * np.log10(2), abs=1e-6)
+
+
+def test_without_sd_the_spl_asks_for_it_and_entering_it_recomputes(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["no_sd"])
+    results = window.results
+    spl = results.spl_panel
+    assert spl.stack.currentWidget() is spl.message
+    assert "Enter Sd" in spl.message.text()
+    assert results.result.parameters["Vas"].value is None
+    with qtbot.waitSignal(results.result_changed):
+        spl.sd.setValue(133.0)                        # cm^2
+    assert spl.stack.currentWidget() is spl.plot
+    assert results.result.sd_m2 == pytest.approx(0.0133)
+    vas = float(_cell(results.parameter_table, "Vas", VALUE))
+    assert vas == pytest.approx(10.5, rel=0.02)
+
+
+def test_without_displacement_missing_values_are_greyed_with_reasons(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["no_laser"])
+    results = window.results
+    table = results.parameter_table
+    assert _cell(table, "Bl", VALUE).startswith("n/a: not identifiable without displacement")
+    assert "Bl only appears in Hx" in _cell(table, "Bl", VALUE, Qt.ToolTipRole)
+    assert _cell(table, "Bl", VALUE, Qt.ForegroundRole) is not None
+    row = table.parameter_model.row_of("Bl")
+    assert table.columnSpan(row, VALUE) == 2
+    assert _cell(table, "RE", VALUE, Qt.ForegroundRole) is None
+    assert results.displacement_stack.currentWidget() is results.no_displacement
+    assert "no displacement channel" in results.spl_panel.message.text()
+    assert "Z only" in results.source_label.text()
+
+
+def test_a_new_recording_replaces_the_old_one(qtbot, window, recordings):
+    open_and_wait(qtbot, window, recordings["paper"])
+    open_and_wait(qtbot, window, recordings["no_laser"])
+    results = window.results
+    assert results.displacement_plot.magnitude_measured.getData()[0] is None or \
+        len(results.displacement_plot.magnitude_measured.getData()[0]) == 0
+    assert "no-laser.wav" in window.windowTitle()
+
+
+@pytest.mark.parametrize("state", ["green", "yellow", "red", "unknown", "something new"])
+def test_validity_box_shows_each_state_in_its_colour(qapp, state):
+    from app.widgets import style
+    from app.results.view import ValidityBox
+    box = ValidityBox()
+    box.set_state(state)
+    background, _ = style.validity_colours(state)
+    assert state in box.text() and background in box.styleSheet()
+
+
+def _names(table) -> list[str]:
+    model = table.parameter_model
+    return [model.data(model.index(row, NAME)) for row in range(model.rowCount())]
+
+
+def test_parameter_table_reads_thiele_small_first_then_the_model_quantities(shown):
+    table = shown.parameter_table
+    names = _names(table)
+    assert names[:5] == ["fs", "Qts", "Qes", "Qms", "Vas"]
+    assert names[5:9] == ["Re", "Le", "Bl", "Mms"]
+    assert "Sd" in names and "Sensitivity (2.83 V, 1 m)" in names      # the given Sd and the sensitivity
+    section = next(row for row, name in enumerate(names) if "internal quantities" in name)
+    assert {"CMES", "LCES", "RES", "L2", "R2", "lambda"} <= set(names[section + 1:])
+    assert section > names.index("Sensitivity (2.83 V, 1 m)")
+    # The section folds away and back with a click on its row.
+    model = table.parameter_model
+    qtbot_click_row = lambda: table.clicked.emit(model.index(section, NAME))      # noqa: E731
+    qtbot_click_row()
+    assert table.isRowHidden(model.row_of("CMES")) and not table.isRowHidden(model.row_of("fs"))
+    qtbot_click_row()
+    assert not table.isRowHidden(model.row_of("CMES"))
+
+
+def test_parameter_units_are_written_properly(shown):
+    table = shown.parameter_table
+    expected = {"RE": "Ω", "LE": "mH", "Bl": "T·m", "Mms": "g", "Cms": "mm/N", "Vas": "l", "CMES": "µF",
+                "SPL_2.83V_1m": "dB SPL", "Qts": ""}
+    assert {name: _cell(table, name, UNIT) for name in expected} == expected
+
+
+def test_values_show_at_most_four_digits_unless_all_digits_is_on(shown):
+    table = shown.parameter_table
+
+    def digits(text: str) -> int:
+        return len(text.replace("-", "").replace(".", "").lstrip("0"))
+    for name in ("RE", "fs", "Qts", "Bl", "Mms", "CMES"):
+        assert digits(_cell(table, name, VALUE)) <= 4, name
+    short = _cell(table, "RE", VALUE)
+    table.all_digits_box.setChecked(True)
+    full = _cell(table, "RE", VALUE)
+    assert digits(full) > digits(short) and float(full) == pytest.approx(float(short), rel=1e-3)
+    assert "±" in _cell(table, "RE", VALUE, Qt.ToolTipRole)       # every value explains itself
+
+
+def test_residuals_beyond_the_strip_are_pinned_at_its_edge_and_counted(shown):
+    """A misfit of thousands of sigma at the lowest lines (hidden physics) must not vanish off the strip."""
+    import dataclasses
+
+    from app.widgets.plots import EDGE, RESIDUAL_MAX_RANGE, beyond_range
+    plot = shown.impedance_plot
+    from app.results.curves import result_curves
+    curves = result_curves(shown.result).impedance
+    residual = np.array(curves.residual, dtype=complex)
+    low = np.arange(5)                                    # the lowest lines, as hidden physics below 20 Hz
+    residual[low] = 28_000.0 - 500j                       # far above: pinned at the top edge
+    residual[-1] = -5e3j                                  # one far below: the imaginary part
+    plot.set_curves(dataclasses.replace(curves, residual=residual), "Impedance")
+    up_f, up_y = plot.residual_beyond_up.xData, plot.residual_beyond_up.yData        # as given, not log10
+    down_f, down_y = plot.residual_beyond_down.xData, plot.residual_beyond_down.yData
+    assert sorted(up_f) == sorted(curves.freqs[low]) and list(down_f) == [curves.freqs[-1]]
+    low_edge, high_edge = plot.residual.viewRange()[1]
+    assert high_edge == pytest.approx(RESIDUAL_MAX_RANGE) and np.allclose(up_y, EDGE * high_edge)
+    assert np.allclose(down_y, EDGE * low_edge)              # inside the strip, where the eye finds them
+    words = f"{low.size + 1} points beyond ±30σ"
+    assert plot.beyond_text.startswith(words) and "2.8e+04σ" in plot.beyond_text
+    assert words in plot.residual.titleLabel.text
+    # Back to a good fit: no marker, no count.
+    plot.set_curves(curves, "Impedance")
+    assert plot.residual_beyond_up.getData()[0] is None or len(plot.residual_beyond_up.getData()[0]) == 0
+    assert plot.beyond_text == ""
+    assert beyond_range(curves.freqs, curves.residual, 1e9)[2] == ""
