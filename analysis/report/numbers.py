@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 from analysis.derived import ParameterValue
 
@@ -22,6 +23,31 @@ def format_number(value: float | None, std: float | None = None) -> str:
         if abs(value) < 1e6 and (abs(value) >= 1e-3 or value == 0):
             return f"{value:.{decimals}f}"
     return f"{value:.6g}" if std is None else f"{value:.4g}"
+
+
+SHORT_DIGITS = 4        # significant digits of a value read against a limit, when its sigma supports as many
+
+
+def short_number(value: float, std: float | None = None, digits: int = SHORT_DIGITS) -> str:
+    """At most `digits` significant digits, fewer when the sigma supports fewer (down to its second digit); no
+    exponent below 1e6. The Results and QA pages' value and the report's QA table: "3.020", where the full
+    rounding to a sigma of 5e-6 reads "3.0199964"."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:.{digits}g}"
+    magnitude = math.floor(math.log10(abs(value)))
+    if std is not None and math.isfinite(std) and std > 0:
+        digits = max(1, min(digits, magnitude - math.floor(math.log10(std)) + 2))
+    decimals = digits - 1 - magnitude
+    if abs(value) >= 1e6 or decimals > 9:
+        return f"{value:.{digits}g}"
+    return f"{round(value, decimals):.{max(0, decimals)}f}"
+
+
+def plain_number(value: float, digits: int = 3) -> str:
+    """`digits` significant digits, trailing zeros dropped, never an exponent ("0.27", "0.0000123", "19.6"): a
+    margin beside its value."""
+    text = f"{value:.{digits}g}"
+    return format(Decimal(text), "f") if "e" in text and math.isfinite(value) else text
 
 
 def format_std(std: float | None) -> str:
