@@ -50,6 +50,18 @@ def plain_number(value: float, digits: int = 3) -> str:
     return format(Decimal(text), "f") if "e" in text and math.isfinite(value) else text
 
 
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def readable_number(value: float, digits: int = 2) -> str:
+    """`digits` significant digits for people: written out ("120", "0.0025") from 1e-4 to 1e5, else with a power of
+    ten ("2.8 × 10⁸"), never Python's "1.2e+02" (a customer reads that as a typo)."""
+    if not math.isfinite(value) or value == 0 or 1e-4 <= abs(value) < 1e5:
+        return plain_number(value, digits) if math.isfinite(value) else f"{value}"
+    mantissa, exponent = f"{value:.{digits - 1}e}".split("e")
+    return f"{mantissa} × 10{str(int(exponent)).translate(_SUPERSCRIPT)}"
+
+
 def format_std(std: float | None) -> str:
     """Two significant digits, written out ("0.000016", "1200"): an exponent is unreadable beside its value."""
     if std is None or not math.isfinite(std):
@@ -71,5 +83,5 @@ def parameter_cells(p: ParameterValue) -> tuple[str, str, str, str]:
     s = None if p.std is None else p.std * abs(p.display_scale)
     # A relative uncertainty of a level in dB means nothing: its std in dB already is one.
     relative_ok = s is not None and v != 0 and math.isfinite(s) and not p.display_unit.startswith("dB")
-    rel = f"{100 * s / abs(v):.2g} %" if relative_ok else ""
+    rel = f"{readable_number(100 * s / abs(v))} %" if relative_ok else ""
     return format_number(v, s), format_std(s), pretty_unit(p.display_unit), rel

@@ -18,7 +18,7 @@ from typing import Mapping
 
 from analysis.derived import ParameterValue
 from analysis.parameter_names import display_name
-from analysis.report.numbers import pretty_unit, short_number
+from analysis.report.numbers import pretty_unit, readable_number, short_number
 from analysis.validity.fit import FAIL, INVALID, NOT_JUDGED, PASS, UNCERTAIN, VERDICT_HEADLINES
 
 # (background, text) of the verdict banner, also the QA page's. INVALID has its own colour (violet), not FAIL's
@@ -78,6 +78,6 @@ def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mappi
     from analysis.qa_verdict import judge
     judgement = judge(limits, parameters, validity)
     rows = tuple(_row(v, parameters.get(v.limit.name), judgement.judged) for v in judgement.verdicts)
-    fit_error = ", ".join(f"{name} {err:.2g} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
+    fit_error = ", ".join(f"{name} {readable_number(err)} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
                           for name, err in judgement.fit_error_percent.items())
     return QASection(limits.path.name, limits.name, judgement.verdict, judgement.why, rows, fit_error)

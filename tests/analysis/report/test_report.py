@@ -292,3 +292,17 @@ def test_pdf_export_is_quiet(caplog, stored, tmp_path):
     with caplog.at_level(logging.INFO):
         write_report(build_report(stored, HEADER), pdf=tmp_path / "q.pdf")
     assert [r for r in caplog.records if r.name.startswith(("fontTools", "matplotlib"))] == []
+
+
+def test_customer_numbers_never_read_as_pythons_exponent():
+    """A wizard measurement with a misfit printed "1e+02 %" (Le's relative sigma), a fit error of "1.2e+02 %" and
+    a reduced χ² of "2.75e+08" on the customer's page."""
+    from analysis.derived import ParameterValue
+    from analysis.report.content import _chi2_text
+    from analysis.report.numbers import parameter_cells, readable_number
+    le = ParameterValue("LE", 0.11e-3, 0.11e-3, "H", "mH", 1e3)
+    assert parameter_cells(le)[3] == "100 %"
+    assert readable_number(123.0) == "120" and readable_number(0.0025) == "0.0025"
+    assert readable_number(2.75e8, 3) == "2.75 × 10⁸" and readable_number(4.2e-6) == "4.2 × 10⁻⁶"
+    assert _chi2_text({"chi2_red": {"impedance": 2.75e8, "displacement": 1.14}}) == \
+        "2.75 × 10⁸ (impedance), 1.14 (displacement)"
