@@ -306,3 +306,29 @@ def test_customer_numbers_never_read_as_pythons_exponent():
     assert readable_number(2.75e8, 3) == "2.75 × 10⁸" and readable_number(4.2e-6) == "4.2 × 10⁻⁶"
     assert _chi2_text({"chi2_red": {"impedance": 2.75e8, "displacement": 1.14}}) == \
         "2.75 × 10⁸ (impedance), 1.14 (displacement)"
+
+
+def _words(pdf) -> list[tuple[str, float, float, float]]:
+    """(word, xMin, xMax, (page, yMin)) of every word pdftotext finds, in points."""
+    html = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], check=True, capture_output=True, text=True).stdout
+    word = r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="[\d.]+">([^<]*)</word>'
+    return [(w, float(x0), float(x1), (page, float(y0))) for page, text in enumerate(html.split("<page")[1:])
+            for x0, y0, x1, w in re.findall(word, text)]
+
+
+@needs_pdftotext
+def test_the_appendix_never_prints_a_key_over_its_value(tmp_path):
+    """The appendix's 'Calibration as recorded' printed calibration.sound_card.volts_per_fs_current_sense over its
+    own value in a 2-inch key column: a long key's column is widened, or the key takes a line of its own."""
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=9)
+    result = StoredResult.from_json(results_document(analyze_recording(rec), rec))
+    calibration = {"calibration": {**WIZARD_CALIBRATION["calibration"],
+                                   "a_much_longer_key_than_any_column_can_hold_beside_its_value_x": 7.0}}
+    pdf = tmp_path / "r.pdf"
+    write_report(build_report(result, HEADER, None, calibration), pdf=pdf)
+    words = _words(pdf)
+    keys = [w for w in words if w[0].startswith("calibration.")]
+    assert len(keys) >= 8
+    for key, x0, x1, y in keys:
+        beside = [w for w in words if w[3][0] == y[0] and abs(w[3][1] - y[1]) < 2 and x0 < w[1] < x1 and w[0] != key]
+        assert not beside, (key, beside)
