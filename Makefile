@@ -30,8 +30,14 @@ TEST_WORKERS ?= 3
 test: setup
 	QT_QPA_PLATFORM=offscreen $(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile --durations=40 tests
 
+# `make bench` runs every suite; `make bench gui validity` only those (the words after bench name suites, not
+# targets of their own).
+ifeq (bench,$(firstword $(MAKECMDGOALS)))
+BENCH_SUITES := $(wordlist 2,$(words $(MAKECMDGOALS)),$(MAKECMDGOALS))
+$(eval $(BENCH_SUITES):;@:)
+endif
 bench: setup
-	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench
+	QT_QPA_PLATFORM=offscreen $(BIN)/python -m bench $(BENCH_SUITES)
 
 # 200 measurements on the virtual rig in one process: memory, files and threads must not grow (not in CI).
 soak: setup

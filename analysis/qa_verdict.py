@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN, verdict_of
-from analysis.report.numbers import pretty_unit
+from analysis.report.numbers import plain_number, pretty_unit
 from analysis.validity.fit import VERDICT_HEADLINES, qa_blocker
 
 
@@ -42,7 +42,7 @@ def margin_text(verdict) -> str:
     if margin is None:
         return ""
     distance, side = margin
-    shown = f"{abs(distance) / verdict.limit.to_si:.3g} {_unit(verdict)}".rstrip()
+    shown = f"{plain_number(abs(distance) / verdict.limit.to_si)} {_unit(verdict)}".rstrip()     # never "1.2e-05"
     return f"inside by {shown}" if distance >= 0 else f"{shown} {'below min' if side == 'min' else 'above max'}"
 
 

@@ -8,12 +8,12 @@ import tempfile
 import time
 from pathlib import Path
 
-from bench import (analysis_bench, archive_bench, gui_bench, large_signal_bench, production_bench, rig_bench,
-                   validity_bench)
+from bench import (analysis_bench, archive_bench, gui_bench, large_signal_bench, production_bench, report_bench,
+                   rig_bench, validity_bench)
 from bench.common import RESULTS_DIR
 
 SUITES = {"analysis": analysis_bench.run, "validity": validity_bench.run, "rig": rig_bench.run, "archive": archive_bench.run,
-          "production": production_bench.run, "gui": gui_bench.run, "large-signal": large_signal_bench.run}
+          "production": production_bench.run, "report": report_bench.run, "gui": gui_bench.run, "large-signal": large_signal_bench.run}
 
 
 def main(argv: list[str]) -> int:

@@ -17,7 +17,7 @@ from analysis.fit.report import fit_report_rows
 from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.customer import (calibration_rows, file_name, model_title, parameter_row_cells,
                                       split_parameters)
-from analysis.report.numbers import format_number, format_std, pretty_unit
+from analysis.report.numbers import format_number, format_std, pretty_unit, readable_number
 from analysis.report.qa import LimitRow, QASection, qa_section
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
@@ -133,7 +133,7 @@ def _method_text(name) -> str:
 
 def _chi2_text(info: Mapping) -> str:
     chi = info.get("chi2_red") or {}
-    return ", ".join(f"{v:.3g} ({channel})" if isinstance(v, (int, float)) else f"n/a ({channel})"
+    return ", ".join(f"{readable_number(v, 3)} ({channel})" if isinstance(v, (int, float)) else f"n/a ({channel})"
                      for channel, v in chi.items())
 
 
@@ -145,7 +145,7 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     info = result.model_info
     rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
-        rows.append((f"Fit error ({channel})", f"{value:.2g} % (rms misfit in its fitted band)"))
+        rows.append((f"Fit error ({channel})", f"{readable_number(value)} % (rms misfit in its fitted band)"))
     from analysis.fit.model_uncertainty import model_part_words
     words = model_part_words(result.validity)
     if words:           # what each ± holds besides the noise (analysis.fit.model_uncertainty)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 from analysis.derived import ParameterValue
 
@@ -22,6 +23,43 @@ def format_number(value: float | None, std: float | None = None) -> str:
         if abs(value) < 1e6 and (abs(value) >= 1e-3 or value == 0):
             return f"{value:.{decimals}f}"
     return f"{value:.6g}" if std is None else f"{value:.4g}"
+
+
+SHORT_DIGITS = 4        # significant digits of a value read against a limit, when its sigma supports as many
+
+
+def short_number(value: float, std: float | None = None, digits: int = SHORT_DIGITS) -> str:
+    """At most `digits` significant digits, fewer when the sigma supports fewer (down to its second digit); no
+    exponent below 1e6. The Results and QA pages' value and the report's QA table: "3.020", where the full
+    rounding to a sigma of 5e-6 reads "3.0199964"."""
+    if value == 0 or not math.isfinite(value):
+        return f"{value:.{digits}g}"
+    magnitude = math.floor(math.log10(abs(value)))
+    if std is not None and math.isfinite(std) and std > 0:
+        digits = max(1, min(digits, magnitude - math.floor(math.log10(std)) + 2))
+    decimals = digits - 1 - magnitude
+    if abs(value) >= 1e6 or decimals > 9:
+        return f"{value:.{digits}g}"
+    return f"{round(value, decimals):.{max(0, decimals)}f}"
+
+
+def plain_number(value: float, digits: int = 3) -> str:
+    """`digits` significant digits, trailing zeros dropped, never an exponent ("0.27", "0.0000123", "19.6"): a
+    margin beside its value."""
+    text = f"{value:.{digits}g}"
+    return format(Decimal(text), "f") if "e" in text and math.isfinite(value) else text
+
+
+_SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def readable_number(value: float, digits: int = 2) -> str:
+    """`digits` significant digits for people: written out ("120", "0.0025") from 1e-4 to 1e5, else with a power of
+    ten ("2.8 × 10⁸"), never Python's "1.2e+02" (a customer reads that as a typo)."""
+    if not math.isfinite(value) or value == 0 or 1e-4 <= abs(value) < 1e5:
+        return plain_number(value, digits) if math.isfinite(value) else f"{value}"
+    mantissa, exponent = f"{value:.{digits - 1}e}".split("e")
+    return f"{mantissa} × 10{str(int(exponent)).translate(_SUPERSCRIPT)}"
 
 
 def format_std(std: float | None) -> str:
@@ -45,5 +83,5 @@ def parameter_cells(p: ParameterValue) -> tuple[str, str, str, str]:
     s = None if p.std is None else p.std * abs(p.display_scale)
     # A relative uncertainty of a level in dB means nothing: its std in dB already is one.
     relative_ok = s is not None and v != 0 and math.isfinite(s) and not p.display_unit.startswith("dB")
-    rel = f"{100 * s / abs(v):.2g} %" if relative_ok else ""
+    rel = f"{readable_number(100 * s / abs(v))} %" if relative_ok else ""
     return format_number(v, s), format_std(s), pretty_unit(p.display_unit), rel

@@ -56,6 +56,18 @@ def _chars(width_in: float) -> int:
     return max(12, int(width_in * 72 / (BODY_PT * EM)))
 
 
+BOLD_EM = 0.64           # DejaVu Sans Bold's characters are wider: a key's width is estimated with this
+
+
+def _key_inches(key: str) -> float:
+    return len(key) * BODY_PT * BOLD_EM / 72
+
+
+def _key_width(rows, least: float = 2.0, most: float = 3.8) -> float:
+    """A key column as wide as the longest key needs, between least and most inches."""
+    return min(most, max(least, max((_key_inches(k) for k, _ in rows), default=0.0) + 0.15))
+
+
 class _DryPage:
     """A page of a dry run: takes the text and shapes, draws nothing. Making real Figures only to count pages
     cost the export seconds (a Figure and its texts per page, for each of up to 7 layouts tried)."""
@@ -139,7 +151,8 @@ class _Pages:
 
     def section(self, title: str, rows, key_width: float = 2.0) -> None:
         """A heading and its key-value rows, kept on one page when they are short (up to KEEP_TOGETHER)."""
-        height = LINE * sum(len(self._wrap_value(value, key_width)) for _, value in rows)
+        height = LINE * sum(len(self._wrap_value(value, key_width)) + self._own_line(key, key_width)
+                            for key, value in rows)
         self.heading(title, keep=0.55 + height if height <= KEEP_TOGETHER else 0.7)
         self.pairs(rows, key_width)
 
@@ -147,11 +160,20 @@ class _Pages:
     def _wrap_value(value: str, key_width: float) -> list[str]:
         return textwrap.wrap(value, _chars(A4[0] - 2 * MARGIN - key_width)) or [""]
 
+    @staticmethod
+    def _own_line(key: str, key_width: float) -> int:
+        """1 when the key would run into its value (it takes a line of its own), else 0."""
+        return int(_key_inches(key) > key_width - 0.08)
+
     def pairs(self, rows, key_width: float = 2.0) -> None:
         for key, value in rows:
             lines = self._wrap_value(value, key_width)
-            self._room(LINE * len(lines))
-            self.text(0, key, weight="bold")
+            own_line = self._own_line(key, key_width)
+            self._room(LINE * (len(lines) + own_line))
+            if own_line:            # a key longer than its column was printed over its value
+                self.line(key, weight="bold")
+            else:
+                self.text(0, key, weight="bold")
             for part in lines:
                 self.line(part, x=key_width)
 
@@ -332,9 +354,9 @@ def _flow(pages: _Pages, c: ReportContent) -> None:
         pages.section("Fit", c.fit)
     if c.internal:
         _parameters(pages, c.internal, "Model's internal quantities")
-    pages.section("Measurement settings", c.settings)
+    pages.section("Measurement settings", c.settings, _key_width(c.settings))
     if c.calibration_detail:           # nothing recorded: the first page says so already
-        pages.section("Calibration as recorded", c.calibration_detail)
+        pages.section("Calibration as recorded", c.calibration_detail, _key_width(c.calibration_detail))
     if plots:          # last: a plot may shrink to stay on the page, where text would run over onto a new one
         residuals = PLOT_HEIGHTS["residuals"] * len(c.result.curves)
         pages.heading("Residuals", keep=0.5 + PLOT_SHRINK * residuals * pages.plot_scale)

@@ -1,7 +1,10 @@
 """The QA limits part of a report: the overall verdict and, per parameter, value, limit and margin.
 
 Numbers are shown in the unit the limits file uses for that parameter, so
-the operator reads them against the file as written. The verdict is the QA
+the operator reads them against the file as written, rounded as the QA and
+Results pages show them (at most 4 significant digits, fewer when the sigma
+supports fewer; the parameter table beside it has every digit the sigma
+allows), under the names the pages use (Re, not RE). The verdict is the QA
 page's and the CLI's (analysis.qa_verdict): a red measurement is INVALID
 (measure again; the unit itself was not judged), one whose model misses a
 curve by more than the fit-error tolerance is NOT JUDGED (find the model);
@@ -14,7 +17,8 @@ from dataclasses import dataclass
 from typing import Mapping
 
 from analysis.derived import ParameterValue
-from analysis.report.numbers import format_number, pretty_unit
+from analysis.parameter_names import display_name
+from analysis.report.numbers import pretty_unit, readable_number, short_number
 from analysis.validity.fit import FAIL, INVALID, NOT_JUDGED, PASS, UNCERTAIN, VERDICT_HEADLINES
 
 # (background, text) of the verdict banner, also the QA page's. INVALID has its own colour (violet), not FAIL's
@@ -60,11 +64,11 @@ def _row(verdict, parameter: ParameterValue | None, judged: bool) -> LimitRow:
     if verdict.value is None:
         # "not measured: not identifiable without displacement: Bl only appears in Hx; ..." -> up to the 2nd colon
         note = ":".join(verdict.note.split(":")[:2])
-        return LimitRow(limit.name, "n/a", limit.text, "", "", outcome, note)
+        return LimitRow(display_name(limit.name), "n/a", limit.text, "", "", outcome, note)
     std = parameter.std / limit.to_si if parameter is not None and parameter.std is not None else None
-    value = f"{format_number(verdict.value / limit.to_si, std)} {unit}".rstrip()
+    value = f"{short_number(verdict.value / limit.to_si, std)} {unit}".rstrip()
     used = verdict.tolerance_used()
-    return LimitRow(limit.name, value, limit.text, margin_text(verdict), "" if used is None else f"{100 * used:.0f} %",
+    return LimitRow(display_name(limit.name), value, limit.text, margin_text(verdict), "" if used is None else f"{100 * used:.0f} %",
                     outcome, "")
 
 
@@ -74,6 +78,6 @@ def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mappi
     from analysis.qa_verdict import judge
     judgement = judge(limits, parameters, validity)
     rows = tuple(_row(v, parameters.get(v.limit.name), judgement.judged) for v in judgement.verdicts)
-    fit_error = ", ".join(f"{name} {err:.2g} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
+    fit_error = ", ".join(f"{name} {readable_number(err)} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
                           for name, err in judgement.fit_error_percent.items())
     return QASection(limits.path.name, limits.name, judgement.verdict, judgement.why, rows, fit_error)

@@ -19,7 +19,7 @@ from PySide6.QtGui import QBrush, QColor
 from PySide6.QtWidgets import (QAbstractItemView, QHeaderView, QLabel, QSplitter, QTableWidget, QTableWidgetItem,
                                QVBoxLayout, QWidget)
 
-from analysis.report.numbers import format_number, format_std, pretty_unit
+from analysis.report.numbers import format_number, format_std, plain_number, pretty_unit
 from app.archive.table import date_text
 from app.widgets.plots import LogFrequencyAxis, style_plot
 
@@ -141,7 +141,7 @@ class ComparisonTable(QTableWidget):
                 if i and dev is not None:
                     item.setToolTip(f"{dev:+.2f} % from measurement 1")
                 self.setItem(r, i, item)
-            spread = QTableWidgetItem("" if row.spread is None else f"{row.spread:.3g}")
+            spread = QTableWidgetItem("" if row.spread is None else plain_number(row.spread))    # no "1.6e-05"
             spread.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
             if row.mean is not None:
                 spread.setToolTip(f"mean {row.mean:.6g} {pretty_unit(row.display_unit)}")

@@ -23,7 +23,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeade
 
 from analysis.derived import NO_SD, ParameterValue
 from analysis.parameter_names import DISPLAY_NAMES, THIELE_SMALL, display_name  # noqa: F401 (shared)
-from analysis.report.numbers import pretty_unit
+from analysis.report.numbers import pretty_unit, short_number
 from app.widgets import style
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
@@ -120,16 +120,7 @@ def short_value(p: ParameterValue) -> tuple[str, str]:
     known = std is not None and math.isfinite(std) and std > 0
     std_text = (np.format_float_positional(std, precision=2, unique=False, fractional=False, trim="-")
                 if known else "–")
-    if value == 0 or not math.isfinite(value):
-        return f"{value:.{DEFAULT_DIGITS}g}", std_text
-    magnitude = math.floor(math.log10(abs(value)))
-    digits = DEFAULT_DIGITS
-    if known:
-        digits = max(1, min(DEFAULT_DIGITS, magnitude - math.floor(math.log10(std)) + 2))
-    decimals = digits - 1 - magnitude
-    if abs(value) >= 1e6 or decimals > 9:
-        return f"{value:.{digits}g}", std_text
-    return f"{round(value, decimals):.{max(0, decimals)}f}", std_text
+    return short_number(value, std if known else None, DEFAULT_DIGITS), std_text
 
 
 def shared_reason(rows) -> str:

@@ -137,10 +137,11 @@ def test_passing_limits_give_pass_with_margins_in_the_files_units(stored, tmp_pa
     c = build_report(stored, HEADER, limits=limits_file(tmp_path, "ok.json", **PASSING))
     assert c.qa.verdict == "pass" and c.qa.headline == "PASS" and c.qa.file == "ok.json"
     rows = {r.name: r for r in c.qa.rows}
+    assert list(rows) == ["Re", "fs", "Bl"]                           # the pages' names, not RE
     assert [r.outcome for r in c.qa.rows] == ["pass"] * 3
     # fs = 70.56 Hz against 65..75 Hz: 4.44 Hz inside the max, 11 % of the half-width used.
     assert rows["fs"].margin == "inside by 4.44 Hz" and rows["fs"].used == "11 %"
-    assert rows["fs"].value.startswith("70.55") and rows["fs"].value.endswith(" Hz")
+    assert rows["fs"].value == "70.56 Hz"                             # 4 significant digits, as the pages
     assert rows["Bl"].used == ""                                     # one-sided: no share of a tolerance
 
 
@@ -149,7 +150,7 @@ def test_failing_limits_say_which_and_by_how_much(stored, tmp_path):
     assert c.qa.verdict == "fail" and "3 of 4" in c.qa.why
     assert "fs 19.6 Hz above max, Mms 0.844 g above max, Bl 0.27 T·m below min" in c.qa.why    # with the margins
     rows = {r.name: r for r in c.qa.rows}
-    assert rows["RE"].outcome == "pass" and rows["fs"].outcome == "FAIL" and rows["Mms"].outcome == "FAIL"
+    assert rows["Re"].outcome == "pass" and rows["fs"].outcome == "FAIL" and rows["Mms"].outcome == "FAIL"
     assert rows["fs"].margin == "19.6 Hz above max"    # 70.56 Hz against 50 Hz ± 1 Hz
     assert rows["fs"].used == "2056 %"
     assert rows["Mms"].margin == "0.844 g above max"   # 11.84 g against <= 11 g
@@ -178,6 +179,40 @@ def test_html_carries_the_verdict_banner_and_table_only_with_limits(stored, tmp_
     assert bad.index("QA: FAIL") < bad.index("<h2>Validity")              # in the header area
     assert "<h2>QA limits</h2>" in bad and bad.count("class='fail'>FAIL<") == 3
     assert "QA:" not in none and "QA limits" not in none and "qa-verdict" not in none
+
+
+def _significant_digits(number: str) -> int:
+    return len(number.replace("-", "").replace(".", "").lstrip("0"))
+
+
+EXAMPLE_LIMITS = "resources/limits/example.json"
+
+
+@needs_pdftotext
+def test_the_qa_table_rounds_values_and_margins_as_the_pages_do(stored, tmp_path):
+    """The QA table printed "3.0199964 Ω": every digit a noise-only sigma allows. It reads the value as the QA
+    and Results pages show it (at most 4 significant digits, fewer when the sigma supports fewer), the margin
+    in 3 significant digits without an exponent, under the pages' names."""
+    from analysis.limits import load_limits
+    from analysis.parameter_names import display_name
+    limits = load_limits(EXAMPLE_LIMITS)
+    c = build_report(stored, HEADER, limits=limits)
+    by_limit = {display_name(lim.name): lim for lim in limits.limits}
+    assert [r.name for r in c.qa.rows] == list(by_limit) and "Re" in by_limit
+    for row in c.qa.rows:
+        number, *unit = row.value.split(" ")
+        p = stored.parameters[by_limit[row.name].name]
+        true = p.value / by_limit[row.name].to_si
+        decimals = len(number.split(".")[1]) if "." in number else 0
+        assert _significant_digits(number) <= 4, row
+        assert abs(float(number) - true) <= 0.5 * 10.0 ** -decimals + 1e-12, (row, true)   # rounded, not cut
+        margin = re.search(r"[\d.]+(e[-+]?\d+)?", row.margin).group(0)
+        assert "e" not in margin and _significant_digits(margin) <= 3, row
+    pdf = tmp_path / "qa.pdf"
+    write_report(c, pdf=pdf)
+    table = pdf_text(pdf).split("QA limits")[1].split("Parameters")[0]
+    assert re.search(r"^\s*Re\s+pass\s+3\.0\d{0,2} Ω", table, re.M), table
+    assert not re.search(r"\d\.\d{5,}", table), table         # no 7-digit value left in the table
 
 
 _pdf_text = pdf_text
@@ -257,3 +292,43 @@ def test_pdf_export_is_quiet(caplog, stored, tmp_path):
     with caplog.at_level(logging.INFO):
         write_report(build_report(stored, HEADER), pdf=tmp_path / "q.pdf")
     assert [r for r in caplog.records if r.name.startswith(("fontTools", "matplotlib"))] == []
+
+
+def test_customer_numbers_never_read_as_pythons_exponent():
+    """A wizard measurement with a misfit printed "1e+02 %" (Le's relative sigma), a fit error of "1.2e+02 %" and
+    a reduced χ² of "2.75e+08" on the customer's page."""
+    from analysis.derived import ParameterValue
+    from analysis.report.content import _chi2_text
+    from analysis.report.numbers import parameter_cells, readable_number
+    le = ParameterValue("LE", 0.11e-3, 0.11e-3, "H", "mH", 1e3)
+    assert parameter_cells(le)[3] == "100 %"
+    assert readable_number(123.0) == "120" and readable_number(0.0025) == "0.0025"
+    assert readable_number(2.75e8, 3) == "2.75 × 10⁸" and readable_number(4.2e-6) == "4.2 × 10⁻⁶"
+    assert _chi2_text({"chi2_red": {"impedance": 2.75e8, "displacement": 1.14}}) == \
+        "2.75 × 10⁸ (impedance), 1.14 (displacement)"
+
+
+def _words(pdf) -> list[tuple[str, float, float, float]]:
+    """(word, xMin, xMax, (page, yMin)) of every word pdftotext finds, in points."""
+    html = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], check=True, capture_output=True, text=True).stdout
+    word = r'<word xMin="([\d.]+)" yMin="([\d.]+)" xMax="([\d.]+)" yMax="[\d.]+">([^<]*)</word>'
+    return [(w, float(x0), float(x1), (page, float(y0))) for page, text in enumerate(html.split("<page")[1:])
+            for x0, y0, x1, w in re.findall(word, text)]
+
+
+@needs_pdftotext
+def test_the_appendix_never_prints_a_key_over_its_value(tmp_path):
+    """The appendix's 'Calibration as recorded' printed calibration.sound_card.volts_per_fs_current_sense over its
+    own value in a 2-inch key column: a long key's column is widened, or the key takes a line of its own."""
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=9)
+    result = StoredResult.from_json(results_document(analyze_recording(rec), rec))
+    calibration = {"calibration": {**WIZARD_CALIBRATION["calibration"],
+                                   "a_much_longer_key_than_any_column_can_hold_beside_its_value_x": 7.0}}
+    pdf = tmp_path / "r.pdf"
+    write_report(build_report(result, HEADER, None, calibration), pdf=pdf)
+    words = _words(pdf)
+    keys = [w for w in words if w[0].startswith("calibration.")]
+    assert len(keys) >= 8
+    for key, x0, x1, y in keys:
+        beside = [w for w in words if w[3][0] == y[0] and abs(w[3][1] - y[1]) < 2 and x0 < w[1] < x1 and w[0] != key]
+        assert not beside, (key, beside)

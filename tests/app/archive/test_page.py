@@ -177,6 +177,9 @@ def test_compare_three_overlays_their_curves_and_tabulates_their_parameters(qtbo
     re_row = table.names.index("RE")
     assert table.verticalHeaderItem(re_row).text() == "RE (Ω)"
     assert "±" in table.item(re_row, 0).text()            # with its stored uncertainty
+    cells = [table.item(r, c).text() for r in range(table.rowCount()) for c in range(table.columnCount())
+             if table.item(r, c) is not None]
+    assert not [t for t in cells if re.search(r"\de[-+]\d", t)]       # written out, never "1.6e-05"
 
 
 def test_more_than_eight_selected_is_a_message_not_a_crash(qtbot, window, archive, measured):
