@@ -146,6 +146,9 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{readable_number(value)} % (rms misfit in its fitted band)"))
+    from analysis.curves.reference import comparison_detail
+    for channel, beside in result.reference_fit.items():     # imported curves: the tool's fit, overlaid
+        rows.append((f"The export's fit ({channel})", comparison_detail(beside)))
     from analysis.fit.model_uncertainty import model_part_words
     words = model_part_words(result.validity)
     if words:           # what each ± holds besides the noise (analysis.fit.model_uncertainty)

@@ -11,6 +11,7 @@ from analysis.derived import parameter_table
 from analysis.pipeline import AnalysisResult
 from app.widgets import style
 from app.results.fit_quality import FitQualityBox
+from app.results.imported import draw_references, is_imported, source_html
 from app.results.measured_spectra import MeasuredSpectraView
 from app.results.parameter_table import titled_parameter_table
 from app.widgets.plots import TransferPlot
@@ -140,7 +141,9 @@ class ResultsView(QWidget):
     def show_outcome(self, outcome: AnalysisOutcome) -> None:
         result, curves = outcome.result, outcome.curves
         self.result, self.curves = result, curves
-        self.source_label.setText(source_text(result) + self._re_remark(result, outcome.nominal_ohm))
+        imported = is_imported(result)
+        self.source_label.setText(source_html(result) if imported else
+                                  source_text(result) + self._re_remark(result, outcome.nominal_ohm))
         self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
         self.fit_quality.set_result(result)
         self._show_parameters(result)
@@ -164,6 +167,8 @@ class ResultsView(QWidget):
         else:
             self.displacement_plot.clear_curves()
             self.displacement_stack.setCurrentWidget(self.no_displacement)
+        if imported:
+            draw_references(result, {"impedance": self.impedance_plot, "displacement": self.displacement_plot})
         self.spl_panel.set_data(curves.displacement, result.sd_m2)
         self.stack.setCurrentWidget(self.content)
         self.result_changed.emit(result)
