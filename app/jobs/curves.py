@@ -22,11 +22,9 @@ class CurvesRequest:
 
 
 def analyse_curves(job: Job, request: CurvesRequest):
-    """The AnalysisOutcome of `request`'s curves (its result an analysis.curves.fitting.CurveAnalysis)."""
+    """`request`'s curves fitted: an analysis.curves.fitting.CurveAnalysis with its files and references."""
     from analysis.curves.fitting import fit_curves
     from analysis.importers import read_curve
-    from app.jobs.workers import AnalysisOutcome
-    from app.results.curves import result_curves
     job.say(f"reading {request.name}")
     z = read_curve(request.impedance, "impedance", None)
     hx = None if request.hx is None else read_curve(request.hx, "displacement", None,
@@ -37,5 +35,4 @@ def analyse_curves(job: Job, request: CurvesRequest):
     result = fit_curves(z.transfer, None if hx is None else hx.transfer, notes=[c.describe() for c in read])
     references = {name: c.reference for name, c in zip(("impedance", "displacement"), read) if c.reference is not None}
     files = tuple(p for p in (request.impedance, request.hx) if p is not None)
-    result = dataclasses.replace(result, files=files, references=references)
-    return AnalysisOutcome(job.id, request.impedance, result, result_curves(result))
+    return dataclasses.replace(result, files=files, references=references)

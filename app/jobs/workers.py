@@ -52,4 +52,8 @@ class AnalysisWorker(JobRunner):
     def start_curves(self, request) -> Job:
         """Imported curves (app.jobs.curves.CurvesRequest) read and fitted; the outcome's result a CurveAnalysis."""
         from app.jobs.curves import analyse_curves
-        return self.run("analysis", lambda job: analyse_curves(job, request), f"analysing {request.name}")
+
+        def work(job: Job) -> AnalysisOutcome:
+            result = analyse_curves(job, request)
+            return AnalysisOutcome(job.id, request.impedance, result, result_curves(result))
+        return self.run("analysis", work, f"analysing {request.name}")

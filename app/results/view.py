@@ -33,12 +33,13 @@ class ValidityBox(QLabel):
         self.state = "unknown"
         self.set_state("unknown")
 
-    def set_state(self, state: str) -> None:
+    def set_state(self, state: str, meaning: str | None = None) -> None:
+        """`meaning`: what the state means here, when not the usual (imported curves: nothing was checked)."""
         self.state = state
         background, text = style.validity_colours(state)
         self.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; border: 1px solid {text}; "
                            f"border-radius: 4px; }}")
-        meaning = style.VALIDITY_TEXT.get(state, "a state this version does not know")
+        meaning = meaning or style.VALIDITY_TEXT.get(state, "a state this version does not know")
         self.setText(f"<b>Validity: {html.escape(state)}</b> — {html.escape(meaning)}")
 
 
@@ -144,7 +145,8 @@ class ResultsView(QWidget):
         imported = is_imported(result)
         self.source_label.setText(source_html(result) if imported else
                                   source_text(result) + self._re_remark(result, outcome.nominal_ohm))
-        self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
+        self.validity_box.set_state(str(result.validity.get("overall", "unknown")),
+                                    result.validity.get("note") if imported else None)
         self.fit_quality.set_result(result)
         self._show_parameters(result)
         if curves is None:          # a broken measurement: judged (validity, reasons), nothing fitted

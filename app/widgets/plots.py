@@ -188,6 +188,7 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         shown = slice(None) if has_phase else slice(0, 0)
         self.phase_measured.setData(curves.freqs[shown], phase[shown])
         self.phase_model.setData(curves.dense_freqs, curves.dense_phase_deg())
+        self.phase.setTitle(None if has_phase else "the model's phase only: the curves have no phase", size="9pt")
         set_error_bars(self.phase_error, curves.freqs[shown], phase[shown], curves.phase_std_deg()[shown])
 
         res = curves.residual

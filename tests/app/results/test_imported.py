@@ -65,6 +65,7 @@ def test_an_lpm_export_shows_three_traces_the_parameters_and_the_comparison(qtbo
     assert "midwoofer_Z.txt" in source and "midwoofer_HX.txt" in source
     for channel in ("impedance", "displacement"):
         assert f"The export's own fit of {channel}" in source and "rms from linpar's fitted curve" in source
+    assert "no validity checks" in view.validity_box.text()     # imported curves: nothing was checked
     assert window.settings.recent_files() == []           # Open recent is for recordings
     # The report of it carries the export's fit beside linpar's.
     report = tmp_path / "midwoofer-report.html"
@@ -73,6 +74,9 @@ def test_an_lpm_export_shows_three_traces_the_parameters_and_the_comparison(qtbo
     text = html.unescape(report.read_text(encoding="utf-8"))
     assert "The export's fit (impedance)" in text
     assert "midwoofer_Z.txt + midwoofer_HX.txt" in text
+    # File > Export data… of it: the parameters, not an attempt to read Z.txt as a recording.
+    assert window.menus.export_data_to(tmp_path / "midwoofer.csv") and not dialogs
+    assert "Mms" in (tmp_path / "midwoofer.csv").read_text(encoding="utf-8")
 
 
 def test_a_bad_export_is_one_line_and_the_result_shown_stays(qtbot, window, midwoofer, dialogs, tmp_path):
