@@ -46,6 +46,7 @@ def comparison_words(name: str, c: Mapping) -> str:
 
 def comparison_detail(c: Mapping) -> str:
     """"5-180 Hz: fit error 1.2 % (linpar's 0.8 %), 0.9 % rms from linpar's fitted curve"."""
-    return (f"{c['band_hz'][0]:.4g}-{c['band_hz'][1]:.4g} Hz: fit error {c['tool_fit_error_percent']:.2g} % "
-            f"(linpar's {c['linpar_fit_error_percent']:.2g} %), {c['tool_vs_linpar_percent']:.2g} % rms from "
+    from analysis.report.numbers import readable_number as n      # never Python's exponent for people
+    return (f"{c['band_hz'][0]:.4g}-{c['band_hz'][1]:.4g} Hz: fit error {n(c['tool_fit_error_percent'])} % "
+            f"(linpar's {n(c['linpar_fit_error_percent'])} %), {n(c['tool_vs_linpar_percent'])} % rms from "
             "linpar's fitted curve")
