@@ -31,6 +31,8 @@ station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
 --only model-part: the Results page of a realistic woofer while its model part is estimated and after, and
 its report's first page, at both sizes (tools/screenshots_model_part.py).
+--only curves: the Results page on a Klippel LPM export with the export's own fit overlaid, at both sizes
+(tools/screenshots_curves.py).
 --only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
 (tools/screenshots_verdicts.py).
 --only pages: every page and every wizard step at both sizes (tools/screenshots_pages.py).
@@ -526,6 +528,11 @@ def model_part_screenshots(app: QApplication, window, folder: Path, out: Path) -
     return shots(app, window, folder, out)
 
 
+def curves_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
+    from tools.screenshots_curves import curves_screenshots as shots
+    return shots(app, window, folder, out)
+
+
 def verdicts_screenshots(app: QApplication, window, folder: Path, out: Path) -> list[Path]:
     from tools.screenshots_verdicts import verdict_screenshots
     return verdict_screenshots(app, window, folder, out)
@@ -536,7 +543,7 @@ ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect
         "pages": pages_screenshots, "qa": qa_broken_screenshots, "hardware": hardware_screenshots,
         "verdicts": verdicts_screenshots, "real-like": real_like_screenshots,
         "first-window": first_window_screenshots, "production-counts": production_counts_screenshots,
-        "model-part": model_part_screenshots}
+        "model-part": model_part_screenshots, "curves": curves_screenshots}
 
 
 def main(argv: list[str]) -> int:

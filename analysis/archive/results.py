@@ -92,7 +92,8 @@ def results_document(result, recording=None) -> dict:
         "model": _model_json(fit) if fit is not None else not_fitted_model(result.not_fitted),
         "validity": result.validity,
         "sd_m2": _num(result.sd_m2),
-        "settings": _settings_of(recording, result),
+        # Imported curves (analysis.curves.stored) have no spectra: their settings are their fitted bands.
+        "settings": _settings_of(recording, result) if hasattr(result, "spectra") else {},
         "curves": {} if fit is None else _curves_json(fit),
     }
     session = session_of(recording) if recording is not None else {}
@@ -233,6 +234,10 @@ class StoredResult:
     curves: dict[str, Curve] = field(default_factory=dict)
     user_effects: dict = field(default_factory=dict)     # id -> the Effect rebuilt from its stored file text
     session: dict = field(default_factory=dict)          # the recording's traceability (analysis.session)
+    # Imported curves (analysis.curves.stored): the exporting tool's fitted |Z| / |Hx| as (freqs, magnitude in
+    # SI), and how far it lies from the measured curve and from linpar's fit (analysis.curves.reference).
+    reference_curves: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    reference_fit: dict = field(default_factory=dict)
 
     @classmethod
     def from_json(cls, doc: Mapping) -> "StoredResult":
@@ -280,7 +285,8 @@ class StoredResult:
         return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
                    dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
                    None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
-                   curves, _user_effects(model), _session(doc))
+                   curves, _user_effects(model), _session(doc), _reference_curves(doc),
+                   _object(doc, "reference_fit", ""))
 
     def model(self):
         """The analysis.model.composed.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
@@ -303,6 +309,20 @@ class StoredResult:
         """Why nothing was fitted (a broken measurement), or None for a fitted result."""
         why = self.model_info.get("not_fitted")
         return str(why) if why else None
+
+
+def _reference_curves(doc: Mapping) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    out = {}
+    for name, c in _object(doc, "reference_curves", "").items():
+        if name not in CHANNELS:
+            continue
+        where = f"reference_curves.{name}."
+        freqs = _array(_get(c, "freqs_hz", list, where), where + "freqs_hz")
+        magnitude = _array(_get(c, "magnitude", list, where), where + "magnitude")
+        if len(freqs) != len(magnitude):
+            raise ResultsFormatError(f"{where}: the lists differ in length")
+        out[name] = (freqs, magnitude)
+    return out
 
 
 def _session(doc: Mapping) -> dict:

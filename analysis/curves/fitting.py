@@ -36,7 +36,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -138,6 +139,17 @@ class CurveAnalysis:
     # spanning the fits over the other Z bands too.
     model_part_always: bool = False
     other_bands: tuple[FitData, ...] = ()
+    # The model part of the uncertainties once estimated (analysis.fit.model_uncertainty.with_estimated).
+    model_part: object | None = None
+    # The GUI's and the report's: the files read (the impedance file first), and each channel's fitted curve of
+    # the tool that exported them (a Klippel export's "Fitted" column), overlaid on linpar's (analysis.curves.reference).
+    files: tuple[Path, ...] = ()
+    references: Mapping[str, TransferFunction] = field(default_factory=dict)
+
+    @property
+    def source(self) -> Path | None:
+        """The impedance file: what the pages that show a recording's name show for imported curves."""
+        return self.files[0] if self.files else None
 
     @property
     def model(self) -> Model:

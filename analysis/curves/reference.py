@@ -37,3 +37,16 @@ def compare_with_reference(fit: FitResult, references: Mapping[str, TransferFunc
                      "linpar_fit_error_percent": _rms_percent(model, measured),
                      "tool_vs_linpar_percent": _rms_percent(model, tool)}
     return out
+
+
+def comparison_words(name: str, c: Mapping) -> str:
+    """One line on one channel (`compare_with_reference`'s entry): the CLI, the Results page and the report say it."""
+    return f"the export's own fit of {name}, {comparison_detail(c)}"
+
+
+def comparison_detail(c: Mapping) -> str:
+    """"5-180 Hz: fit error 1.2 % (linpar's 0.8 %), 0.9 % rms from linpar's fitted curve"."""
+    from analysis.report.numbers import readable_number as n      # never Python's exponent for people
+    return (f"{c['band_hz'][0]:.4g}-{c['band_hz'][1]:.4g} Hz: fit error {n(c['tool_fit_error_percent'])} % "
+            f"(linpar's {n(c['linpar_fit_error_percent'])} %), {n(c['tool_vs_linpar_percent'])} % rms from "
+            "linpar's fitted curve")

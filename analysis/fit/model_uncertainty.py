@@ -96,9 +96,11 @@ class ModelPart:
 
 
 def pending(result) -> bool:
-    """True when `result` still lacks a model part it needs: a fit that misses its data, not yet refitted."""
+    """True when `result` still lacks a model part it needs: a fit that misses its data (or magnitude-only curves,
+    which want it always: analysis.curves.fitting), not yet refitted."""
     fit = getattr(result, "fit", None)
-    return fit is not None and getattr(result, "model_part", None) is None and not describes_the_data(fit)
+    return (fit is not None and getattr(result, "model_part", None) is None
+            and (getattr(result, "model_part_always", False) or not describes_the_data(fit)))
 
 
 def describes_the_data(fit: FitResult) -> bool:

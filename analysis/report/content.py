@@ -32,6 +32,8 @@ SETTING_LABELS = {
     "periods_analysed": ("Periods analysed", ""), "settle_periods": ("Settle periods", ""),
     "excited_lines": ("Excited lines", ""), "f_min_hz": ("Lowest line", "Hz"), "f_max_hz": ("Highest line", "Hz"),
     "duration_s": ("Duration", "s"), "voltage_rms_v": ("Drive voltage", "V rms"), "channels": ("Channels", ""),
+    # Imported curves (analysis.curves.stored): the band each was fitted over, [low, high].
+    "impedance_band_hz": ("Impedance fitted", "Hz"), "displacement_band_hz": ("Hx fitted", "Hz"),
 }
 
 
@@ -146,6 +148,9 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
         rows.append((f"Fit error ({channel})", f"{readable_number(value)} % (rms misfit in its fitted band)"))
+    from analysis.curves.reference import comparison_detail
+    for channel, beside in result.reference_fit.items():     # imported curves: the tool's fit, overlaid
+        rows.append((f"The export's fit ({channel})", comparison_detail(beside)))
     from analysis.fit.model_uncertainty import model_part_words
     words = model_part_words(result.validity)
     if words:           # what each ± holds besides the noise (analysis.fit.model_uncertainty)
@@ -197,6 +202,9 @@ def _settings_rows(settings: Mapping) -> tuple[tuple[str, str], ...]:
             text = format_number(value)
         elif isinstance(value, list) and all(isinstance(v, str) for v in value):
             text = ", ".join(value)
+        elif (key.endswith("_band_hz") and isinstance(value, list) and len(value) == 2
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
+            text = " – ".join(f"{v:.4g}" for v in value)
         elif isinstance(value, (Mapping, list)):
             flat: list[tuple[str, str]] = []
             _flatten(key, value, flat)

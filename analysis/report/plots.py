@@ -21,6 +21,8 @@ from analysis.spl import predicted_spl
 
 MEASURED = dict(linestyle="none", marker="o", markersize=2.8, color="#1f5fa8", label="measured")
 MODEL = dict(linewidth=1.3, color="#d2542c", label="model")
+# Imported curves: the exporting tool's own fitted curve (a Klippel export's "Fitted" column), beside linpar's.
+REFERENCE = dict(linewidth=1.2, linestyle="--", color="#2e8b57", label="the export's fit")
 DENSE_PER_DECADE = 200
 SPL_VOLTAGE = 2.83
 # pdf.fonttype 3: the glyphs drawn as the PDF's own procedures. TrueType embedding (42) had fontTools subset
@@ -116,12 +118,23 @@ def _unwrapped_phases(result: StoredResult, name: str, f_dense: np.ndarray):
     return np.degrees(model_dense), np.degrees(measured)
 
 
+def _reference(result: StoredResult, name: str, plot, scale: float) -> None:
+    """The exporting tool's fitted curve over the band linpar fitted (beyond it the comparison says nothing)."""
+    if name not in result.reference_curves:
+        return
+    freqs, magnitude = result.reference_curves[name]
+    band = result.curves[name].freqs
+    inside = (freqs >= band.min()) & (freqs <= band.max())
+    plot(freqs[inside], magnitude[inside] * scale, **REFERENCE)
+
+
 def draw_impedance(result: StoredResult, ax_mag, ax_phase) -> None:
     c = result.curves["impedance"]
     f = _dense(c.freqs)
     model = result.model_curve("impedance", f)
     ax_mag.plot(c.freqs, np.abs(c.measured), **MEASURED)
     ax_mag.plot(f, np.abs(model), **MODEL)
+    _reference(result, "impedance", ax_mag.plot, 1.0)
     ax_mag.set_ylabel("|Z| [Ω]")
     ax_mag.set_title("Impedance Z = U / I")
     ax_mag.legend(loc="upper left")
@@ -141,6 +154,7 @@ def draw_hx(result: StoredResult, ax_mag, ax_phase) -> None:
     model = result.model_curve("displacement", f)
     ax_mag.loglog(c.freqs, np.abs(c.measured) * 1e3, **MEASURED)
     ax_mag.loglog(f, np.abs(model) * 1e3, **MODEL)
+    _reference(result, "displacement", ax_mag.loglog, 1e3)
     ax_mag.set_ylabel("|Hx| [mm/V]")
     ax_mag.set_title("Displacement per volt Hx = X / U")
     ax_mag.legend(loc="lower left")

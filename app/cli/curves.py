@@ -85,7 +85,7 @@ def load_curves(args: argparse.Namespace, references: dict | None = None):
 
 def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
-    from analysis.curves.reference import compare_with_reference
+    from analysis.curves.reference import compare_with_reference, comparison_words
     from analysis.fit.model_uncertainty import model_uncertainty
     references: dict = {}
     z, hx, notes = load_curves(args, references)
@@ -107,9 +107,7 @@ def analyze_curves(args: argparse.Namespace) -> int:
     print(f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)")
     print(f"note: {result.validity['note']}; {result.validity['uncertainties']}")
     for name, c in beside.items():
-        print(f"the export's own fit of {name}, {c['band_hz'][0]:g}-{c['band_hz'][1]:g} Hz: fit error "
-              f"{c['tool_fit_error_percent']:.2g} % (linpar's {c['linpar_fit_error_percent']:.2g} %), "
-              f"{c['tool_vs_linpar_percent']:.2g} % rms from linpar's fitted curve")
+        print(comparison_words(name, c))
     for note in result.notes:
         print(f"  {note}")
     return 0

@@ -48,3 +48,12 @@ class AnalysisWorker(JobRunner):
             result = model_uncertainty(outcome.result, cancel=job.cancel_event)
             return AnalysisOutcome(job.id, outcome.path, result, outcome.curves, outcome.nominal_ohm)
         return self.run("model part", work, f"estimating the model part of {outcome.path.name}'s uncertainties")
+
+    def start_curves(self, request) -> Job:
+        """Imported curves (app.jobs.curves.CurvesRequest) read and fitted; the outcome's result a CurveAnalysis."""
+        from app.jobs.curves import analyse_curves
+
+        def work(job: Job) -> AnalysisOutcome:
+            result = analyse_curves(job, request)
+            return AnalysisOutcome(job.id, request.impedance, result, result_curves(result))
+        return self.run("analysis", work, f"analysing {request.name}")

@@ -148,6 +148,12 @@ class ModelLab(QWidget):
     @Slot(object)
     def set_result(self, result: AnalysisResult) -> None:
         """A result from the Results page: a new recording restarts the lab from its model."""
+        if not hasattr(result, "spectra"):      # imported curves (File > Open curves…): no recording to model
+            self.jobs.drop()
+            self.empty.setText("The Model lab works on recordings; imported curves are analysed on the Results page "
+                               "(and by `linpar diagnose --impedance`).")
+            self.stack.setCurrentWidget(self.empty)
+            return
         if self.session.is_same_recording(result):
             # The same recording: the Results page shows one of our versions, or Sd was edited.
             if self.session.set_sd(result.sd_m2):

@@ -79,10 +79,14 @@ def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> s
     from analysis.recording.format import read_recording
     from analysis.archive.atomic import write_atomic
     from analysis.report import build_report, render_html, render_pdf
-    recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
-    stored = StoredResult.from_json(results_document(result, recording))
-    # The header a report of the same recording has from the command line or the archive.
-    header = header_of_recording(recording) if recording is not None else {}
+    if not hasattr(result, "spectra"):          # imported curves (File > Open curves…): no recording to read
+        from analysis.curves.stored import curve_header, curve_results_document
+        recording, stored, header = None, StoredResult.from_json(curve_results_document(result)), curve_header(result)
+    else:
+        recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
+        stored = StoredResult.from_json(results_document(result, recording))
+        # The header a report of the same recording has from the command line or the archive.
+        header = header_of_recording(recording) if recording is not None else {}
     calibration = calibration_of(recording) if recording is not None else {}
     content = build_report(stored, header, None, calibration, limits)
     job.check()

@@ -28,6 +28,7 @@ class ChannelCurves:
     chi2_red: float
     dense_freqs: np.ndarray
     dense_model: np.ndarray    # complex, SI
+    has_phase: bool = True     # False: magnitude-only curves (imported), `measured` holds |value|
 
     def measured_phase_deg(self) -> np.ndarray:
         return aligned_phase_deg(self.measured, self.dense_freqs, self.dense_phase_deg(), self.freqs)
@@ -70,7 +71,7 @@ def _channel(result: AnalysisResult, name: str, dense: np.ndarray) -> ChannelCur
     values = result.fit.values
     dense_model = model.impedance(s, values) if name == "impedance" else model.displacement(s, values)
     return ChannelCurves(name, fit.freqs, fit.measured, fit.std, fit.normalized_residual, fit.chi2_red,
-                         dense, dense_model)
+                         dense, dense_model, bool(getattr(fit, "has_phase", True)))
 
 
 def result_curves(result: AnalysisResult, points: int = DENSE_POINTS) -> ResultCurves | None:

@@ -11,6 +11,7 @@ from analysis.derived import parameter_table
 from analysis.pipeline import AnalysisResult
 from app.widgets import style
 from app.results.fit_quality import FitQualityBox
+from app.results.imported import draw_references, is_imported, source_html
 from app.results.measured_spectra import MeasuredSpectraView
 from app.results.parameter_table import titled_parameter_table
 from app.widgets.plots import TransferPlot
@@ -32,12 +33,13 @@ class ValidityBox(QLabel):
         self.state = "unknown"
         self.set_state("unknown")
 
-    def set_state(self, state: str) -> None:
+    def set_state(self, state: str, meaning: str | None = None) -> None:
+        """`meaning`: what the state means here, when not the usual (imported curves: nothing was checked)."""
         self.state = state
         background, text = style.validity_colours(state)
         self.setStyleSheet(f"QLabel {{ background: {background}; color: {text}; border: 1px solid {text}; "
                            f"border-radius: 4px; }}")
-        meaning = style.VALIDITY_TEXT.get(state, "a state this version does not know")
+        meaning = meaning or style.VALIDITY_TEXT.get(state, "a state this version does not know")
         self.setText(f"<b>Validity: {html.escape(state)}</b> — {html.escape(meaning)}")
 
 
@@ -140,8 +142,11 @@ class ResultsView(QWidget):
     def show_outcome(self, outcome: AnalysisOutcome) -> None:
         result, curves = outcome.result, outcome.curves
         self.result, self.curves = result, curves
-        self.source_label.setText(source_text(result) + self._re_remark(result, outcome.nominal_ohm))
-        self.validity_box.set_state(str(result.validity.get("overall", "unknown")))
+        imported = is_imported(result)
+        self.source_label.setText(source_html(result) if imported else
+                                  source_text(result) + self._re_remark(result, outcome.nominal_ohm))
+        self.validity_box.set_state(str(result.validity.get("overall", "unknown")),
+                                    result.validity.get("note") if imported else None)
         self.fit_quality.set_result(result)
         self._show_parameters(result)
         if curves is None:          # a broken measurement: judged (validity, reasons), nothing fitted
@@ -164,6 +169,8 @@ class ResultsView(QWidget):
         else:
             self.displacement_plot.clear_curves()
             self.displacement_stack.setCurrentWidget(self.no_displacement)
+        if imported:
+            draw_references(result, {"impedance": self.impedance_plot, "displacement": self.displacement_plot})
         self.spl_panel.set_data(curves.displacement, result.sd_m2)
         self.stack.setCurrentWidget(self.content)
         self.result_changed.emit(result)

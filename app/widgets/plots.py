@@ -168,6 +168,8 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         self.residual.addItem(self.residual_beyond_down)
         self.beyond_text = ""
         self.placeholder = PlotPlaceholder(self, NO_CURVES)
+        # Imported curves: the exporting tool's fitted curve, in the plot (and its legend) only while it is drawn.
+        self.magnitude_reference: pg.PlotDataItem | None = None
 
     def set_curves(self, curves, title: str) -> None:
         """Draw an app.results.curves.ChannelCurves."""
@@ -179,14 +181,19 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         self.magnitude_model.setData(curves.dense_freqs, np.abs(curves.dense_model) * k)
         set_error_bars(self.magnitude_error, curves.freqs, magnitude, np.abs(curves.std) * k, self.log_y)
 
+        self.clear_reference()
+        # Magnitude-only curves (an LPM export): no measured phase to draw, one residual per line (the magnitude's).
+        has_phase = getattr(curves, "has_phase", True)
         phase = curves.measured_phase_deg()
-        self.phase_measured.setData(curves.freqs, phase)
+        shown = slice(None) if has_phase else slice(0, 0)
+        self.phase_measured.setData(curves.freqs[shown], phase[shown])
         self.phase_model.setData(curves.dense_freqs, curves.dense_phase_deg())
-        set_error_bars(self.phase_error, curves.freqs, phase, curves.phase_std_deg())
+        self.phase.setTitle(None if has_phase else "the model's phase only: the curves have no phase", size="9pt")
+        set_error_bars(self.phase_error, curves.freqs[shown], phase[shown], curves.phase_std_deg()[shown])
 
         res = curves.residual
         self.residual_real.setData(curves.freqs, res.real)
-        self.residual_imag.setData(curves.freqs, res.imag)
+        self.residual_imag.setData(curves.freqs[shown], np.imag(res)[shown])
         limit = self._residual_range(res)
         freqs, sign, self.beyond_text = beyond_range(curves.freqs, res, limit)
         self.residual_beyond_up.setData(freqs[sign > 0], np.full(int((sign > 0).sum()), EDGE * limit))
@@ -195,11 +202,25 @@ class TransferPlot(pg.GraphicsLayoutWidget):
                   if self.beyond_text else "")
         # In the title rather than a legend: a legend would cover the points of the thin strip.
         self.residual.setTitle(
-            f"residual (model − measured)/σ: <span style='color:{style.RESIDUAL_REAL}'>● real</span>"
-            f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span>; reduced χ² = "
+            f"residual (model − measured)/σ: " + (
+                f"<span style='color:{style.RESIDUAL_REAL}'>● real</span>"
+                f" <span style='color:{style.RESIDUAL_IMAG}'>▼ imaginary</span>" if has_phase else
+                f"<span style='color:{style.RESIDUAL_REAL}'>● magnitude</span>") + "; reduced χ² = "
             f"{curves.chi2_red:.3g}{beyond}", size="9pt")
         self.magnitude.enableAutoRange()
         self.phase.enableAutoRange(axis="y")
+
+    def set_reference(self, freqs: np.ndarray, magnitude: np.ndarray, name: str) -> None:
+        """Another tool's fitted |value| (SI) as a third, dashed line beside the measured points and linpar's model."""
+        self.clear_reference()
+        self.magnitude_reference = pg.PlotDataItem(freqs, np.asarray(magnitude) * self.display_scale,
+                                                   pen=style.reference_pen(), name=name)
+        self.magnitude.addItem(self.magnitude_reference)
+
+    def clear_reference(self) -> None:
+        if self.magnitude_reference is not None:
+            self.magnitude.removeItem(self.magnitude_reference)     # and from the legend
+            self.magnitude_reference = None
 
     def _residual_range(self, res: np.ndarray) -> float:
         parts = np.abs(np.concatenate([res.real, res.imag]))
@@ -210,6 +231,7 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         return limit
 
     def clear_curves(self) -> None:
+        self.clear_reference()
         for item in (self.magnitude_measured, self.magnitude_model, self.phase_measured, self.phase_model,
                      self.residual_real, self.residual_imag, self.residual_beyond_up, self.residual_beyond_down):
             item.setData([], [])

@@ -12,6 +12,7 @@ from PySide6.QtGui import QIcon
 
 MEASURED = "#1f5fbf"        # measured lines: blue points
 MODEL = "#d1495b"           # the fitted model: red line
+REFERENCE = "#2e8b57"       # imported curves: the exporting tool's own fitted curve, a green dashed line
 RESIDUAL_REAL = "#1f5fbf"
 RESIDUAL_IMAG = "#e08a00"
 RESIDUAL_BEYOND = "#8e1b1b"  # residuals beyond the strip's range, pinned at its edge
@@ -47,6 +48,11 @@ def validity_colours(state: str) -> tuple[str, str]:
 
 def model_pen():
     return pg.mkPen(MODEL, width=MODEL_WIDTH)
+
+
+def reference_pen():
+    from PySide6.QtCore import Qt
+    return pg.mkPen(REFERENCE, width=MODEL_WIDTH, style=Qt.DashLine)
 
 
 def measured_brush():

@@ -25,6 +25,8 @@ from app.window.window_fit import fit_window
 from app.wizard import MeasureWizard
 from app.wizard.archive_meta import measurement_meta
 from app.jobs.workers import AnalysisOutcome, AnalysisWorker
+from app.jobs.curves import CurvesRequest
+from app.window.open_curves import OpenCurvesDialog
 
 RECORDING_SUFFIXES = (".wav", ".json")
 FILE_FILTER = "Recordings (*.wav *.json);;All files (*)"
@@ -178,11 +180,21 @@ class MainWindow(QMainWindow):
         self.pages.setCurrentWidget(self.results)
         self.analysis_started.emit(str(path))
 
+    def open_curves(self, request: CurvesRequest) -> None:
+        """Analyse imported curves (File > Open curves…) in a worker thread, as open_path a recording."""
+        self._started_at = time.monotonic()
+        self.status_label.setText("")
+        self.jobs.run(self.worker.start_curves(request), f"Analysing {request.name}…", self.on_finished,
+                      lambda message: self.on_failed(request.impedance, message), self.on_cancelled)
+        self.pages.setCurrentWidget(self.results)
+        self.analysis_started.emit(str(request.impedance))
+
     def on_finished(self, outcome: AnalysisOutcome) -> None:
         elapsed = time.monotonic() - self._started_at
         self.results.show_outcome(outcome)
-        self.settings.add_recent_file(outcome.path)
-        self._rebuild_recent_menu()
+        if hasattr(outcome.result, "spectra"):      # Open recent opens recordings, not imported curves
+            self.settings.add_recent_file(outcome.path)
+            self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {self._titles.get(outcome.path, outcome.path.name)}")
         fit = outcome.result.fit
         model = "fitted" if fit is not None else "nothing could be fitted"
@@ -335,6 +347,13 @@ class MainWindow(QMainWindow):
         path, _ = QFileDialog.getOpenFileName(self, "Open recording", start, FILE_FILTER)
         if path:
             self.open_path(path)
+
+    @Slot()
+    def on_open_curves(self) -> None:
+        recent = self.settings.recent_files()
+        dialog = OpenCurvesDialog(str(Path(recent[0]).parent) if recent else "", self)
+        if dialog.exec() == OpenCurvesDialog.Accepted:
+            self.open_curves(dialog.request())
 
     @Slot()
     def on_recent(self) -> None:

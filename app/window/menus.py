@@ -1,6 +1,6 @@
 """The main window's menus: File, View and Help, their shortcuts, and the dialogs Help opens.
 
-File: Open, Open recent, Export report…, Export data…, Load limits…, Quit. View: each page (Ctrl+1..).
+File: Open recording, Open curves (another tool's exported curves), Open recent, Export report…, Export data…, Load limits…, Quit. View: each page (Ctrl+1..).
 Help: the user guide (resources/guide.md, shown in the window), the keyboard shortcuts, About (the
 version and the licences of the libraries linpar is built on).
 """
@@ -99,6 +99,7 @@ class Menus:
         bar = window.menuBar()
         file_menu = bar.addMenu("&File")
         self.open_action = self._action(file_menu, "&Open recording…", QKeySequence.Open, window.on_open)
+        self.open_curves_action = self._action(file_menu, "Open &curves…", "Ctrl+Shift+O", window.on_open_curves)
         window.recent_menu = file_menu.addMenu("Open &recent")
         file_menu.addSeparator()
         self.export_report_action = self._action(file_menu, "Export &report…", "Ctrl+E", self.on_export_report)
@@ -169,9 +170,14 @@ class Menus:
                                    f"{', '.join(suffixes)} (the file type says what is written)")
             return False
         try:
-            recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
-            stored = StoredResult.from_json(results_document(result, recording))
-            header = header_of_recording(recording) if recording is not None else {}
+            if not hasattr(result, "spectra"):      # imported curves (File > Open curves…): no recording to read
+                from analysis.curves.stored import curve_header, curve_results_document
+                stored = StoredResult.from_json(curve_results_document(result))
+                header = curve_header(result)
+            else:
+                recording = read_recording(result.source) if result.source and Path(result.source).exists() else None
+                stored = StoredResult.from_json(results_document(result, recording))
+                header = header_of_recording(recording) if recording is not None else {}
             written = write_exports(stored, {kind: path}, header)
         except (LinparError, OSError) as exc:
             self.window.show_error(f"Cannot export {path.name}", str(exc))
@@ -207,6 +213,6 @@ class Menus:
         return dialog
 
     def actions(self) -> list[QAction]:
-        return [self.open_action, self.export_report_action, self.export_data_action, self.load_limits_action,
+        return [self.open_action, self.open_curves_action, self.export_report_action, self.export_data_action, self.load_limits_action,
                 self.quit_action, *self.page_actions.values(), self.guide_action, self.shortcuts_action,
                 self.about_action]

@@ -25,13 +25,14 @@ def titles(menu) -> list[str]:
 def test_the_menus_hold_every_command_with_its_shortcut(window):
     menus = {a.text().replace("&", ""): a.menu() for a in window.menuBar().actions()}
     assert list(menus) == ["File", "View", "Help"]
-    assert titles(menus["File"]) == ["Open recording…", "Open recent", "Export report…", "Export data…",
-                                     "Load limits…", "Quit"]
+    assert titles(menus["File"]) == ["Open recording…", "Open curves…", "Open recent", "Export report…",
+                                     "Export data…", "Load limits…", "Quit"]
     assert titles(menus["View"]) == [f"{i} {name}" for i, name in enumerate(PAGE_ORDER, start=1)]
     assert titles(menus["Help"]) == ["User guide", "Keyboard shortcuts", "About linpar"]
     shortcuts = {a.text().replace("&", ""): a.shortcut().toString() for a in window.menus.actions()}
     assert shortcuts["Open recording…"] == "Ctrl+O" and shortcuts["Quit"] == "Ctrl+Q"
     assert shortcuts["Export report…"] == "Ctrl+E" and shortcuts["Load limits…"] == "Ctrl+L"
+    assert shortcuts["Open curves…"] == "Ctrl+Shift+O"
     assert shortcuts["1 Measure"] == "Ctrl+1" and shortcuts["User guide"] == "F1"
     assert len({s for s in shortcuts.values() if s}) == len([s for s in shortcuts.values() if s])    # no clash
 
