@@ -26,9 +26,9 @@ from typing import Callable
 
 import numpy as np
 
-from analysis.diagnosis import acceptance, pairs, residuals
+from analysis.diagnosis import acceptance, noise_floor, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
-from analysis.diagnosis.sites import SiteResult, first_among_tied, localise
+from analysis.diagnosis.sites import SiteResult, first_among_tied, localise, usable_sites
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
@@ -97,6 +97,7 @@ class Step:
     residual: str                       # where the residual sat before choosing
     chosen: Candidate | None
     flags: tuple[Flag, ...] = ()        # of this step's model (and the step cap on the last one)
+    at_noise_floor: bool = False        # nothing to find: no candidate refitted (analysis.diagnosis.noise_floor)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -349,10 +350,16 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     steps: list[Step] = []
     capped = False
     while True:
+        sites = _SiteFits(data, current, executor)
+        if noise_floor.channels_at_noise(current):
+            sites.need(usable_sites(current.model))
+            if noise_floor.nothing_to_find(current, sites.done):
+                steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current), chosen=None,
+                                  flags=_model_flags(current), at_noise_floor=True))
+                break
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
         ranked = rank_candidates(data, current, executor, cancel)
-        sites = _SiteFits(data, current, executor)
         ranked, best = choose(current, ranked, sites)
         steps.append(Step(fit=current, candidates=ranked, residual=residuals.describe(current), chosen=best,
                           flags=_model_flags(current)))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from analysis.derived import parameter_table
-from analysis.diagnosis import acceptance
+from analysis.diagnosis import acceptance, noise_floor
 from analysis.diagnosis.candidates import Diagnosis, explain
 from analysis.diagnosis.words import (VERDICT_TITLES, chi2_words, residual_json, sites_json, tied_sites,
                                       verdict_text)
@@ -65,7 +65,7 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
 
 def _step_json(step: Step) -> dict:
     return {**_fit_summary(step.fit), "chosen": step.chosen.effect.id if step.chosen else None,
-            "flags": acceptance.flags_json(step.flags)}
+            "flags": acceptance.flags_json(step.flags), "at_noise_floor": step.at_noise_floor}
 
 
 def diagnosis_json(result: Diagnosis, sd_m2: float | None = None, drift: str | None = None) -> dict:
@@ -105,6 +105,8 @@ def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
         lines.append(f"{rank:<5}{move:<34}{dbic:>12}  {taken:<12} {chi}")
     if result.first_candidates:
         lines += ["", "why: " + explain(result.start, result.first_candidates[0])]
+    elif result.steps[0].at_noise_floor:
+        lines += ["", "none: " + noise_floor.SKIPPED_WORDS]
     lines += ["", "path:"]
     previous = None
     for i, step in enumerate(result.steps):

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Iterable
 
-from analysis.diagnosis import acceptance, residuals
+from analysis.diagnosis import acceptance, noise_floor, residuals
 from analysis.diagnosis.candidates import Diagnosis
 from analysis.diagnosis.sites import TIE_CHI2, SiteResult, tied_sites  # noqa: F401 (said from here too)
 from analysis.effects.base import Site
@@ -139,6 +139,8 @@ def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
     else:
         parts.append(f"Unexplained: no effect of the catalogue explains the misfit (reduced χ² "
                      f"{chi2_words(start.chi2_red_by_channel())}); none was added.")
+    if result.steps[-1].at_noise_floor:
+        parts.append(noise_floor.SKIPPED_WORDS)
     if verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED):
         parts.append(f"Where: {residuals.describe(final)}.")
         if result.sites:

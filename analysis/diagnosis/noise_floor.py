@@ -1,0 +1,55 @@
+"""A model with nothing left to find: the noise floor, where the greedy path ends without refitting.
+
+Every candidate's refit (about 40 of them) is most of a diagnosis's time,
+and on a model that already explains the measurement down to its noise it
+only confirms that no effect pays for itself. The path ends there, without
+them, when both hold:
+
+1. every channel's chi^2 is within chance of its noise: chi^2_c <= m_c +
+   3 sqrt(2 m_c) for the m_c values of channel c (chi^2 with m_c degrees of
+   freedom has mean m_c and standard deviation sqrt(2 m_c));
+2. no site's smooth correction (analysis.diagnosis.sites) removes more than
+   its own flexibility takes from noise alone: fitting pure noise with edf
+   effective parameters lowers chi^2 by about edf, standard deviation
+   sqrt(2 edf), so a drop above edf + 3 sqrt(2 edf) is structure.
+
+The sites' corrections are the ones the diagnosis reports at its end, so
+the check costs nothing a diagnosis did not already compute. What it gives
+up: an effect whose whole gain is within the chi^2's scatter (rule 1) and
+that no site's correction sees above its own chance drop (rule 2). The
+acceptance rule would take such an effect when its chi^2 drop exceeds
+MIN_BIC_GAIN + k ln n (about 20 to 40): effects that small are not looked
+for on a model already at its noise floor, and the words say so.
+"""
+from __future__ import annotations
+
+import math
+
+from analysis.diagnosis.sites import SiteResult
+from analysis.fit.least_squares import FitResult
+
+CHANCE_SIGMAS = 3.0
+
+SKIPPED_WORDS = ("No candidate was refitted: the model meets the noise on every channel and no site's smooth "
+                 "correction removes more than noise would, so no effect of the catalogue has anything to "
+                 "explain (one whose whole effect is within the noise is not looked for).")
+
+
+def within_chance(chi2: float, dof: float) -> bool:
+    """chi^2 with `dof` degrees of freedom no larger than chance allows (CHANCE_SIGMAS above its mean)."""
+    return chi2 <= dof + CHANCE_SIGMAS * math.sqrt(2.0 * max(dof, 1.0))
+
+
+def channels_at_noise(fit: FitResult) -> bool:
+    """Rule 1: every channel's chi^2 within chance of its number of values."""
+    return all(within_chance(ch.chi2, ch.n_points) for ch in fit.channels.values())
+
+
+def nothing_to_find(fit: FitResult, sites: dict) -> bool:
+    """Rules 1 and 2: the model meets the noise, and no site's correction (`sites`, by site: all the usable
+    sites' results for `fit`) removes more than noise would."""
+    return channels_at_noise(fit) and all(_noise_only(fit, s) for s in sites.values())
+
+
+def _noise_only(fit: FitResult, site: SiteResult) -> bool:
+    return within_chance(fit.chi2 - site.chi2, site.edf)
