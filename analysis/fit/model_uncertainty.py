@@ -86,12 +86,11 @@ class ModelPart:
         if self.state != ESTIMATED:
             return {}
         reported = _with_derived(values, sd_m2)
-        spread = {name: 0.0 for name in reported}
-        for member in self.members:
-            theirs = _with_derived(member.values, sd_m2)
-            for name, value in reported.items():
-                if name in theirs and math.isfinite(theirs[name]):
-                    spread[name] = max(spread[name], abs(theirs[name] - value))
+        theirs = [_with_derived(member.values, sd_m2) for member in self.members]
+        spread = {}
+        for name, value in reported.items():
+            ensemble = [value] + [t[name] for t in theirs if name in t and math.isfinite(t[name])]
+            spread[name] = float(np.std(ensemble))
         return spread
 
 
@@ -162,13 +161,15 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
 
 
 def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event | None = None, always: bool = False,
-                        other_bands: tuple[FitData, ...] = ()) -> ModelPart:
+                        other_bands: tuple[FitData, ...] = (), drop_degenerate: bool | None = None) -> ModelPart:
     """The refits' outcome (module doc): NOT_NEEDED when the model describes the data (nothing is refitted),
-    unless `always`; `other_bands` as model_spread's."""
+    unless `always`; `other_bands` as model_spread's; degenerate alternatives dropped (members) when
+    `drop_degenerate` (None: when `always`)."""
     if describes_the_data(fit) and not always:
         return ModelPart(NOT_NEEDED)
     started = time.perf_counter()
-    indistinct = members(fit, data, cancel, drop_degenerate=always) + _band_members(fit, other_bands, cancel)
+    drop = always if drop_degenerate is None else drop_degenerate
+    indistinct = members(fit, data, cancel, drop_degenerate=drop) + _band_members(fit, other_bands, cancel)
     seconds = time.perf_counter() - started
     if len(indistinct) < 2:
         # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
@@ -244,8 +245,9 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
         return result
     data = getattr(result, "data", None) or FitData.from_spectra(result.spectra)
     # Imported magnitude-only curves (analysis.curves.fitting) say whether they want it always, and their other bands.
-    part = estimate_model_part(result.fit, data, cancel, getattr(result, "model_part_always", False),
-                               getattr(result, "other_bands", ()))
+    always = getattr(result, "model_part_always", False)
+    part = estimate_model_part(result.fit, data, cancel, always, getattr(result, "other_bands", ()),
+                               drop_degenerate=always or hasattr(result, "spectra"))
     return with_estimated(result, part)
 
 
