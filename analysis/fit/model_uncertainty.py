@@ -104,8 +104,8 @@ class ModelPart:
         spread = {}
         for name, value in reported.items():
             others = [t[name] for t in theirs if name in t and math.isfinite(t[name])]
-            if self.ensemble:
-                spread[name] = float(np.std([value] + others))
+            if self.ensemble:           # the members begin with the reported fit (estimate_model_part)
+                spread[name] = float(np.std(others)) if others else 0.0
             else:
                 spread[name] = max((abs(v - value) for v in others), default=0.0)
         return spread
@@ -178,16 +178,25 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
 
 
 def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event | None = None, always: bool = False,
-                        other_bands: tuple[FitData, ...] = (), drop_degenerate: bool | None = None) -> ModelPart:
+                        other_bands: tuple[FitData, ...] = (), drop_degenerate: bool | None = None,
+                        ensemble: bool = False) -> ModelPart:
     """The refits' outcome (module doc): NOT_NEEDED when the model describes the data (nothing is refitted),
     unless `always`; `other_bands` as model_spread's; degenerate alternatives dropped (members) when
-    `drop_degenerate` (None: when `always`)."""
+    `drop_degenerate` (None: when `always`). `ensemble` (a recording's): the spread is the std over the reported
+    fit and the members, the reported fit first even when the data reject it (one alternative the data prefer
+    is then enough)."""
     if describes_the_data(fit) and not always:
         return ModelPart(NOT_NEEDED)
     started = time.perf_counter()
     drop = always if drop_degenerate is None else drop_degenerate
     indistinct = members(fit, data, cancel, drop_degenerate=drop) + _band_members(fit, other_bands, cancel)
     seconds = time.perf_counter() - started
+    if ensemble:
+        reported = Member(fit.model.effect_ids, fit.chi2, dict(fit.values))
+        others = [m for m in indistinct if m.effects != reported.effects]
+        if not others:
+            return ModelPart(NOT_ESTIMATED, seconds=seconds)
+        return ModelPart(ESTIMATED, (reported, *others), seconds, ensemble=True)
     if len(indistinct) < 2:
         # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
         # the model part is not estimated, which is not the same as zero.
@@ -265,9 +274,7 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
     always = getattr(result, "model_part_always", False)
     recorded = hasattr(result, "spectra")           # a recording's result (module doc), not imported curves
     part = estimate_model_part(result.fit, data, cancel, always, getattr(result, "other_bands", ()),
-                               drop_degenerate=always or recorded)
-    if part.state == ESTIMATED and recorded:
-        part = dataclasses.replace(part, ensemble=True)
+                               drop_degenerate=always or recorded, ensemble=recorded)
     return with_estimated(result, part)
 
 
