@@ -8,9 +8,10 @@ do not describe (and the laser's noise floor far above fs) as misfit: the tests'
 midrange and subwoofer (tests/realistic_drivers.py) are missed by 8, 4.5 and 17 % on Z and 31, 25 and
 198 % on Hx over 15 Hz-10 kHz, their RE 2.5-3.2 % high.
 
-So when the default fit misses a channel by more than the fit error a real driver measured well shows
-(analysis.fit.error.FIT_ERROR_DEFAULTS), it is fitted again over the piston band, read from the data as
-the curves' path does (analysis.curves.fitting), fs from the first fit:
+So when the default fit misses the displacement by more than the fit error a real driver measured well
+shows (analysis.fit.error.FIT_ERROR_DEFAULTS: the laser sees the cone stop moving as a piston;
+analysis.pipeline.misses_the_band says why Z alone does not decide), it is fitted again over the piston
+band, read from the data as the curves' path does (analysis.curves.fitting), fs from the first fit:
 
 - Z up to Z_MAX_OVER_FS * fs (50: 0.9-4.8 kHz on the three): the motional parameters and RE, LE and the
   blocked impedance's, which need the band where the inductance rises (up to 5 or 10 fs RE trades with
