@@ -310,6 +310,9 @@ def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], valid
            "parameters": [v.as_json() for v in judgement.verdicts]}
     if judgement.fit_error_percent:
         doc["fit_error_percent"] = dict(judgement.fit_error_percent)
+        bands = validity.get("fit_band_hz") if isinstance(validity, Mapping) else None
+        if bands:
+            doc["fit_band_hz"] = dict(bands)
     return doc
 
 
@@ -327,8 +330,10 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
         lines.append(f"  {limit.name:<14}{shown:>34}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))
     if judgement.fit_error_percent:
+        from analysis.fit.error import band_text
+        shown = validity if isinstance(validity, Mapping) else {}
         lines.append("  fit error: " + ", ".join(
-            f"{name} {err:.2g} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
+            f"{name} {err:.2g} %{band_text(shown, name)} (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
             for name, err in judgement.fit_error_percent.items()))
     lines.append(f"QA: {judgement.headline} — {judgement.why}")
     return "\n".join(lines)

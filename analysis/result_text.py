@@ -52,8 +52,8 @@ def format_result(result) -> str:
                       f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
         errors = (result.validity or {}).get("fit_error_percent") or {}
         if errors:
-            lines.append("fit error: " + ", ".join(f"{k} {v:.2g} %" for k, v in errors.items())
-                         + " (rms misfit of each curve in its fitted band)")
+            from analysis.fit.error import fit_error_text
+            lines.append("fit error: " + fit_error_text(result.validity) + " (rms misfit of each curve in its fitted band)")
         from analysis.fit.model_uncertainty import model_part_words
         if model_part_words(result.validity):
             lines.append(model_part_words(result.validity))

@@ -5,7 +5,9 @@ misfit relative to the measured value, sqrt(mean(|model - measured|^2 /
 |measured|^2)), complex where the phase was measured, on the magnitude where
 it was not. Unlike the reduced chi^2 it does not grow with the number of
 periods averaged: a real driver measured well shows 1.5-3 % on the impedance,
-however clean the recording. QA judges whether the model describes the
+however clean the recording. A line at its noise floor says nothing of the model's misfit: where the
+noise is known (a recording's, an imported curve's estimate) lines standing less than MIN_SNR times their
+noise above it (a laser at its noise floor far above fs) are left out. QA judges whether the model describes the
 measurement by it (analysis.qa_verdict), and the reduced chi^2 stays in the
 Model lab and the fit report.
 """
@@ -21,20 +23,41 @@ import numpy as np
 # spot of a cone that stops moving as a piston (its modes) near the top of the band, so the same model misses
 # Hx by more; 10 %.
 FIT_ERROR_DEFAULTS = {"impedance": 5.0, "displacement": 10.0}
+# A line within this many standard deviations of its noise floor says nothing of the model's misfit.
+MIN_SNR = 3.0
 
 
 def rms_relative_residual(fit) -> dict[str, float]:
-    """channel -> rms relative misfit (a fraction) of an analysis.fit.FitResult; NaN for a channel with no line."""
+    """channel -> rms relative misfit (a fraction) of an analysis.fit.FitResult over its lines above the noise
+    floor (module doc); NaN for a channel with no such line."""
     out = {}
     for name, ch in fit.channels.items():
         model = ch.model if ch.has_phase else np.abs(ch.model)
+        size = np.abs(ch.measured)
         with np.errstate(divide="ignore", invalid="ignore"):
-            rel = np.abs(model - ch.measured) ** 2 / np.abs(ch.measured) ** 2
-        rel = rel[np.isfinite(rel)]
-        out[name] = float(np.sqrt(np.mean(rel))) if rel.size else float("nan")
+            rel = np.abs(model - ch.measured) ** 2 / size ** 2
+            keep = size >= MIN_SNR * ch.std if fit.noise_known else np.ones(rel.shape, dtype=bool)
+        keep &= np.isfinite(rel)
+        out[name] = float(np.sqrt(np.mean(rel[keep]))) if keep.any() else float("nan")
     return out
 
 
 def fit_error_percent(fit) -> dict[str, float]:
     """channel -> fit error in %, finite channels only (JSON has no NaN)."""
     return {name: 100.0 * v for name, v in rms_relative_residual(fit).items() if np.isfinite(v)}
+
+
+def band_text(validity, channel: str) -> str:
+    """" (14.6-915 Hz)": the band a channel's fit error was measured over, from a result's validity (as JSON), or ""."""
+    band = ((validity or {}).get("fit_band_hz") or {}).get(channel)
+    return f" ({_hz(band[0])}-{_hz(band[1])} Hz)" if band else ""
+
+
+def _hz(f: float) -> str:
+    return f"{f:.3g}" if f < 1000 else f"{f:.0f}"
+
+
+def fit_error_text(validity) -> str:
+    """"impedance 2.8 % (14.6-915 Hz), displacement 1.8 % (14.6-138 Hz)": each curve's fit error and its band."""
+    errors = (validity or {}).get("fit_error_percent") or {}
+    return ", ".join(f"{name} {value:.2g} %{band_text(validity, name)}" for name, value in errors.items())

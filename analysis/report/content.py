@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
+from analysis.fit.error import band_text
 from analysis.fit.report import fit_report_rows
 from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.customer import (calibration_rows, file_name, model_title, parameter_row_cells,
@@ -147,7 +148,9 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     info = result.model_info
     rows = [("Model", model_title(titles, result.with_displacement))]
     for channel, value in (result.validity.get("fit_error_percent") or {}).items():
-        rows.append((f"Fit error ({channel})", f"{readable_number(value)} % (rms misfit in its fitted band)"))
+        band = band_text(result.validity, channel).strip(" ()")
+        rows.append((f"Fit error ({channel})", (f"over {band}: " if band else "")
+                     + f"{readable_number(value)} % (rms misfit in its fitted band)"))
     from analysis.curves.reference import comparison_detail
     for channel, beside in result.reference_fit.items():     # imported curves: the tool's fit, overlaid
         rows.append((f"The export's fit ({channel})", comparison_detail(beside)))

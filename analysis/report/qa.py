@@ -78,6 +78,9 @@ def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mappi
     from analysis.qa_verdict import judge
     judgement = judge(limits, parameters, validity)
     rows = tuple(_row(v, parameters.get(v.limit.name), judgement.judged) for v in judgement.verdicts)
-    fit_error = ", ".join(f"{name} {readable_number(err)} % (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
+    from analysis.fit.error import band_text
+    shown = validity if isinstance(validity, Mapping) else {}
+    fit_error = ", ".join(f"{name} {readable_number(err)} %{band_text(shown, name)} (tolerance "
+                          f"{limits.fit_error_percent.get(name, float('nan')):g} %)"
                           for name, err in judgement.fit_error_percent.items())
     return QASection(limits.path.name, limits.name, judgement.verdict, judgement.why, rows, fit_error)

@@ -6,7 +6,7 @@ from analysis.effects import parse_effects
 from analysis.fit.covariance import jacobian, normal_inverse
 from analysis.fit.least_squares import FitData, _residual_vector, channel_sigmas, fit_model
 from analysis.model.composed import Model
-from analysis.pipeline import analyze_recording
+from analysis.derived import parameter_table
 from analysis.spectra import estimate_spectra
 from tests.builders import TYPICAL_NOISE, recording
 from tests.realistic_drivers import realistic_recording
@@ -24,8 +24,12 @@ def test_the_jacobian_covariance_is_minpacks():
 
 
 def test_a_fit_minpack_leaves_without_error_bars_gets_them_from_the_jacobian():
-    # The realistic subwoofer, seed 1: MINPACK stops on "tolerance too small" with no covariance.
-    result = analyze_recording(realistic_recording("subwoofer", 1))
+    # The realistic subwoofer, seed 1, over every line (the default analysis fits it over its piston band since
+    # issue 29: analysis.fit.bands): MINPACK stops on "tolerance too small" with no covariance.
+    data = FitData.from_spectra(estimate_spectra(realistic_recording("subwoofer", 1)))
+    fit = fit_model(data, Model(parse_effects("lr2,creep-log"), with_displacement=True))
+    assert "error-bars" in fit.message
+    table = parameter_table(fit, 0.038)
     for name in ("RE", "Bl", "CMES", "LCES", "RES", "lambda", "Mms", "Kms", "fs"):
-        p = result.parameters[name]
+        p = table[name]
         assert p.std is not None and 0 < p.std < 0.1 * abs(p.value), name
