@@ -10,6 +10,7 @@ right after the work: the load that stretched the work is still there.
 """
 from __future__ import annotations
 
+import os
 import statistics
 import time
 
@@ -41,3 +42,10 @@ def wait_ms(seconds: float) -> int:
     machine, at the pace when the wait begins. A timeout bounds a hang, never a speed: give the work several
     times what it takes on an idle machine, and the load that slows the work stretches the wait too."""
     return int(1000 * seconds * machine_pace(WAIT_PROBES))
+
+
+def load_pace() -> float:
+    """Runnable processes per core over the last minute (the load average), at least 1: the pace a long test
+    meets, read for free. pytest-timeout's limits use it (tests/conftest.py): a probe per test would cost
+    the suite minutes of CPU, and a test that runs for minutes sees the minute's load, not the moment's."""
+    return max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
