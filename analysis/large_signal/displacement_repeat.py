@@ -12,12 +12,15 @@ The voltage's periods repeat (the card's own clock); the driver answers each
 in the same way, so at the excited lines b each period's displacement is
 H(b) times its voltage, H = mean(X) / mean(U). What is left,
 
-    e_p = X_p - H U_p,   change^2 = (sum_b sum_p |e_p - mean(e)|^2 / (P - 1) - n_b s^2) / sum_b |mean(X)|^2
+    e_p = X_p - H U_p,   change^2 = (sum_b sum_p |e_p - mean(e)|^2 / (P - 1) - n_b s^2 (1 + 3 / sqrt(n_b (P - 1))))
+                                   / sum_b |mean(X)|^2
 
 is the relative rms change of one period's displacement that the drive does
 not explain, less what the laser's noise explains: s^2, the scatter of one
 line between periods, from the lines not excited (their distortion repeats,
-so their scatter is noise). A voice coil that warms during a step changes the
+so their scatter is noise), and three standard deviations of that noise's
+own scatter over the n_b lines (so a displacement buried in noise is not
+judged changed by chance). A voice coil that warms during a step changes the
 displacement by a few percent at most; a misplaced stream by tens of percent.
 """
 from __future__ import annotations
@@ -49,7 +52,8 @@ def displacement_change(recording: Recording) -> float | None:
         h = np.where(np.abs(mean_u) > 0, mean_x / mean_u, 0.0)
     e = x[:, excited] - h[None, :] * u[:, excited]
     scatter = float(np.sum(np.abs(e - e.mean(axis=0)) ** 2)) / (p - 1)
-    return float(np.sqrt(max(scatter - excited.size * _line_noise(x, excited), 0.0) / signal))
+    noise = excited.size * _line_noise(x, excited) * (1.0 + 3.0 / np.sqrt(excited.size * (p - 1)))
+    return float(np.sqrt(max(scatter - noise, 0.0) / signal))
 
 
 def _line_noise(x: np.ndarray, excited: np.ndarray) -> float:
@@ -59,4 +63,4 @@ def _line_noise(x: np.ndarray, excited: np.ndarray) -> float:
     if carried.size == 0:
         return 0.0
     spread = np.sum(np.abs(x[:, carried] - x[:, carried].mean(axis=0)) ** 2, axis=0) / (x.shape[0] - 1)
-    return float(np.median(spread))
+    return float(np.mean(spread))
