@@ -125,11 +125,11 @@ def test_a_step_whose_audio_was_timed_late_is_not_trusted_and_the_plan_stops_bel
     rig = InProcessRig(known_driver(8192), "simulated", calibration=LARGE_SIGNAL_CHAIN)
     limits = StepLimits(max_excursion_m=2.0e-3, max_voltage_v=20.0)
     try:
-        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 1.0, step=2.0, limits=limits), rig.audio,
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits), rig.audio,
                                    rig.laser, tmp_path, name="ls", measure=measure)
     finally:
         rig.close()
-    assert [s.level_v for s in outcome.steps] == [1.0, 2.0, 4.0], outcome.message
+    assert [s.level_v for s in outcome.steps] == [2.0, 4.0], outcome.message
     assert outcome.stopped_by == "fault" and "displacement" in outcome.message
     late = outcome.steps[-1]
     assert late.measures.displacement_change > 0.2 and not late.usable
