@@ -3,7 +3,9 @@
 Each step is one multitone recording at a level (V RMS at the terminals).
 What it says about the driver, from its periods:
 
-    peak excursion       the coherent mean period's largest |x - mean| (analysis.excursion)
+    peak excursion       the coherent mean period's largest |x - mean| (analysis.excursion), trusted only
+                         when the displacement repeated from period to period as the voltage did
+                         (displacement_repeat.py): a laser stream misplaced in time averages to a low peak
     current distortion   the power at the lines not excited, within the excitation's band, less the
                          noise, over the power at the excited lines, in dB (analysis.large_signal.distortion's
                          measure; -20 dB: the distortion is a tenth of the signal in amplitude)
@@ -15,8 +17,9 @@ What it says about the driver, from its periods:
                          distorted voltage, or one below the level asked for, is the amplifier or the sound
                          card limiting
 
-The plan stops as soon as a step reaches any limit (the user's peak
-excursion, the voltage, the current distortion, the coil's temperature
+The plan stops as soon as a step's displacement did not repeat (its peak
+cannot be trusted, and the next level is predicted from it: a "fault"), or a
+step reaches any limit (the user's peak excursion, the voltage, the current distortion, the coil's temperature
 rise), or the chain cannot deliver the level (the voltage distorted above
 VOLTAGE_DISTORTION_DB, more than 10 % below the level, or an input at its
 converter's full scale: the sidecar's capture counts), keeping every step. Otherwise the next level is the present one
@@ -40,6 +43,7 @@ import numpy as np
 
 from analysis.bounds import DISTORTION_DB, EXCURSION_MM, LEVEL_V_RMS, TEMPERATURE_RISE_K
 from analysis.excursion import recording_peak_displacement
+from analysis.large_signal.displacement_repeat import MAX_DISPLACEMENT_CHANGE, displacement_change
 from analysis.large_signal.data import LargeSignalError
 from analysis.recording.format import Recording
 
@@ -80,6 +84,12 @@ class StepMeasures:
     drive_rms_v: float = float("nan")
     voltage_distortion_db: float = -math.inf
     clipped: tuple[str, ...] = ()           # inputs that reached their converter's full scale
+    displacement_change: float | None = None    # relative, period to period (displacement_repeat.py)
+
+    @property
+    def displacement_repeats(self) -> bool:
+        """The displacement's periods agree (or there is no displacement): its peak can be trusted."""
+        return self.displacement_change is None or self.displacement_change <= MAX_DISPLACEMENT_CHANGE
 
     @property
     def re_ohm(self) -> float:
@@ -96,6 +106,7 @@ class StepMeasures:
                 "peak_displacement_m": self.peak_m,
                 "current_distortion_db": _finite(self.current_distortion_db),
                 "voltage_distortion_db": _finite(self.voltage_distortion_db), "clipped": list(self.clipped),
+                "displacement_change": self.displacement_change,
                 "re_ohm_per_period": list(self.re_per_period),
                 "temperature_rise_k": _finite(self.temperature_rise_k(re_reference))}
 
@@ -115,7 +126,8 @@ def step_measures(recording: Recording, level_v: float, re_lines: np.ndarray | N
         re = np.real(u[:, re_lines] / i[:, re_lines]).mean(axis=1)
     peak = recording_peak_displacement(recording) if recording.signal("displacement") is not None else None
     return StepMeasures(float(level_v), peak, distortion_db(i, excited), tuple(float(r) for r in re), drive,
-                        distortion_db(u, excited), clipped_inputs(recording)), re_lines
+                        distortion_db(u, excited), clipped_inputs(recording),
+                        displacement_change(recording)), re_lines
 
 
 def clipped_inputs(recording: Recording) -> tuple[str, ...]:
@@ -140,7 +152,13 @@ def distortion_db(per_period: np.ndarray, excited: np.ndarray) -> float:
 
 
 def stop_reason(step: StepMeasures, limits: StepLimits, re_reference: float) -> tuple[str, str] | None:
-    """(code, words) when this step reached a limit, else None."""
+    """(code, words) when this step reached a limit or its displacement cannot be trusted, else None."""
+    if not step.displacement_repeats:
+        peak = "" if step.peak_m is None else f" (its peak {step.peak_m * 1e3:.2f} mm may be too low)"
+        return "fault", f"the displacement at {step.level_v:.3g} V changed by {step.displacement_change:.0%} " \
+                        f"from period to period while the voltage repeated{peak}: the laser's stream was not " \
+                        f"placed right in time (a busy machine?); the plan stops rather than step on past the " \
+                        f"excursion limit: measure again with the machine less busy"
     if step.clipped:
         return "clipping", f"the {' and '.join(step.clipped)} input reached its full scale at {step.level_v:.3g} V: " \
                            f"a larger input range (lower sense gain) would let the plan go on"

@@ -8,7 +8,10 @@ What is estimated from what (see clocks.py for the reasoning):
 2. The laser's time line and the audio's time line from the host arrival
    times of their blocks (lower envelopes): the ratio (audio samples per
    laser sample) and the offset (the audio index of laser sample 0), and so
-   the laser's clock error in ppm and its start latency.
+   the laser's clock error in ppm and its start latency. An envelope whose
+   rate is implausibly far from its stream's nominal rate (PLAUSIBLE_PPM) was
+   tilted by the host's scheduling: that line runs at the nominal rate under
+   the stream's most timely block instead (clocks.floor_line).
 3. The ratio refined by the excitation: the resampled displacement must
    repeat exactly with the excitation period (``refine_ratio``).
 4. The offset stays as the host times put it (less a known sensor latency):
@@ -50,7 +53,7 @@ import numpy as np
 
 from instruments.laser.sensor import NO_COUNTER, LaserBlock
 from instruments.measurement.clocks import (
-    LaserClock, TimeLine, clock_from_host_times, lower_envelope, period_phase_drift)
+    LaserClock, TimeLine, clock_from_host_times, floor_line, lower_envelope, period_phase_drift)
 from instruments.measurement.laser_gaps import LaserGaps, gap_accounting, refill
 from instruments.measurement.resample import HALF_TAPS, PASSBAND, covered, interpolate
 
@@ -165,20 +168,24 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
     laser_line = lower_envelope(stream.block_last, stream.block_host_time)
     audio_line = lower_envelope(audio_stops, audio_host_times)
     host_clock = clock_from_host_times(laser_line, audio_line, latency_s)
+    # A starved host's arrivals, later and later, tilt an envelope (a 4 V step measured 0.25 s off: a period
+    # read after the drive stopped, its peak halved): such a line is replaced (_timely).
+    placed = clock_from_host_times(_timely(laser_line, stream.block_last, stream.block_host_time, nominal_rate),
+                                   _timely(audio_line, audio_stops, audio_host_times, audio_rate), latency_s)
     starts = np.asarray(period_starts, dtype=np.int64)
-    n_periods = _covered_periods(host_clock, starts, period_samples, stream.n_samples)
+    n_periods = _covered_periods(placed, starts, period_samples, stream.n_samples)
     if n_periods == 0:
         raise ValueError("the laser's stream does not cover any of the captured periods")
     starts = starts[:n_periods]
     grid = (starts[:, None] + np.arange(period_samples)[None, :]).ravel()
-    used = _used_laser_range(host_clock, grid, stream.n_samples)
+    used = _used_laser_range(placed, grid, stream.n_samples)
     outliers = outlier_mask(stream.distance_m)
     missing = ~np.isfinite(stream.distance_m) | outliers
     filled = _bridged(np.where(outliers, np.nan, stream.distance_m))
     pivot = float(np.mean(stream.block_last))      # where the host times place the stream best
-    start_clock = host_clock
-    if refine and abs(host_clock.ppm(audio_rate, nominal_rate)) > PLAUSIBLE_PPM:
-        start_clock = host_clock.pivoted(audio_rate / nominal_rate, pivot)     # the nominal rate: far closer
+    start_clock = placed
+    if refine and abs(placed.ppm(audio_rate, nominal_rate)) > PLAUSIBLE_PPM:
+        start_clock = placed.pivoted(audio_rate / nominal_rate, pivot)     # the nominal rate: far closer
     laser_rate = audio_rate / start_clock.ratio
     max_hz = PASSBAND * min(laser_rate, nominal_rate)
     max_bin = int(np.floor(max_hz * period_samples / audio_rate))
@@ -228,6 +235,15 @@ def align_laser(stream: LaserStream, audio_stops: np.ndarray, audio_host_times: 
     x = _band_limited(sign * (x - np.mean(x)), n_periods, period_samples, max_hz / audio_rate)
     return AlignedDisplacement(x, n_periods, clock, host_clock, laser_line, audio_line, counts, float(max_hz),
                                lines, passes)
+
+
+def _timely(line: TimeLine, index: np.ndarray, host_time: np.ndarray, rate: float) -> TimeLine:
+    """The envelope, or, when its rate is implausibly far from the stream's nominal ``rate`` (the host's
+    scheduling tilted it, and its line at the centre is as late as the arrivals there), the line at the
+    nominal rate under the stream's most timely block (clocks.floor_line)."""
+    if abs(line.slope * rate - 1.0) * 1e6 <= PLAUSIBLE_PPM:
+        return line
+    return floor_line(index, host_time, 1.0 / rate)
 
 
 def _decimation(audio_rate: float, max_hz: float, period: int) -> int:

@@ -118,6 +118,22 @@ def lower_envelope(index: np.ndarray, host_time: np.ndarray) -> TimeLine:
     return TimeLine(float(t0 + intercept - slope * i0), float(slope), float(np.median(above)), int(index.size))
 
 
+def floor_line(index: np.ndarray, host_time: np.ndarray, slope: float) -> TimeLine:
+    """The line of a known ``slope`` (s per sample: the stream's nominal rate) under every arrival: it rests on
+    the single most timely block. The fallback when the envelope's own slope is implausible (alignment.py):
+    arrivals late by a growing amount (a starved thread) tilt the envelope's edge, and its line at the centre
+    is then as late as the arrivals there, while the most timely block, wherever it lies, still places the
+    stream to its lateness plus the rate's error (tens of ppm) times its distance."""
+    index = np.asarray(index, dtype=np.float64)
+    host_time = np.asarray(host_time, dtype=np.float64)
+    if index.size < MIN_POINTS:
+        raise ValueError(f"{index.size} blocks are too few to place a stream in time (need {MIN_POINTS})")
+    i0, t0 = float(index[0]), float(host_time[0])
+    above = (host_time - t0) - slope * (index - i0)         # small numbers: no cancellation
+    floor = float(np.min(above))
+    return TimeLine(t0 + floor - slope * i0, float(slope), float(np.median(above - floor)), int(index.size))
+
+
 def _lower_hull(x: np.ndarray, t: np.ndarray) -> list[int]:
     """Indices of the lower convex hull of points sorted by x (monotone chain), at least two."""
     hull: list[int] = []

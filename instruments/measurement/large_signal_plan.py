@@ -74,8 +74,10 @@ class PlanStep:
 
     @property
     def usable(self) -> bool:
-        """Complete and no input clipped: a step the identification may take (the others stay on disk)."""
-        return not self.partial and self.measures is not None and not self.measures.clipped
+        """Complete, no input clipped, the displacement repeating: a step the identification may take (the
+        others stay on disk)."""
+        return (not self.partial and self.measures is not None and not self.measures.clipped
+                and self.measures.displacement_repeats)
 
 
 @dataclass(frozen=True, slots=True)

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from instruments.laser.sensor import LaserBlock
-from instruments.measurement.alignment import align_laser, stream_of_blocks
+from instruments.measurement.alignment import PLAUSIBLE_PPM, align_laser, stream_of_blocks
 from instruments.measurement.clocks import LaserClock, lower_envelope, period_phase_drift
 from instruments.measurement.raw_stream import blocks_of, read_raw_capture, write_raw_capture
 from instruments.measurement.resample import PASSBAND, interpolate
@@ -214,3 +214,21 @@ def test_host_times_off_by_thousands_of_ppm_do_not_keep_the_refinement_from_the_
     assert aligned.clock.ppm(FS, RATE) == pytest.approx(37.0, abs=0.05) and aligned.passes >= 1
     freqs, ratio = scene.line_ratio(aligned)
     assert np.max(np.abs(np.abs(ratio) - 1)[freqs < 300]) < 2e-3
+
+
+def test_audio_arrivals_ever_later_from_a_starved_host_do_not_misplace_the_laser():
+    """A starved host takes the audio's blocks later and later (here from a third of the way in, up to 0.25 s
+    by the end): the envelope's edge at the centre runs along the late arrivals, its ratio ~100,000 ppm off,
+    and its line at the centre is as late as they were there. Placed by the most timely blocks at the nominal
+    rates instead, the laser lands where it was (the rig measured a 4 V step placed 0.25 s late before)."""
+    scene = Scene(ppm=37.0)
+    since = scene.audio_times[scene.audio_times.size // 3]
+    scene.audio_times = scene.audio_times + np.clip(scene.audio_times - since, 0.0, None) * 0.25 / (
+        scene.audio_times[-1] - since)
+    aligned = scene.align()
+    assert abs(aligned.host_clock.ppm(FS, RATE)) > 10 * PLAUSIBLE_PPM
+    k = np.array([0.0, 1e4, 3e4])
+    assert np.max(np.abs(aligned.clock.audio_index(k) - scene.true_clock.audio_index(k))) < 0.1 * FS * 1e-3
+    assert aligned.clock.ppm(FS, RATE) == pytest.approx(37.0, abs=0.05)
+    freqs, ratio = scene.line_ratio(aligned)
+    assert np.max(np.abs(ratio - 1)[freqs < 300]) < 0.01          # magnitude and phase: no period misplaced

@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import time
+from types import SimpleNamespace
 
 import pytest
 
 from analysis.large_signal import large_signal
 from analysis.large_signal.stepping import StepLimits
-from instruments.measurement import MeasurementPlan, run_measurement
+from instruments.measurement import MeasurementPlan, run_measurement, timed_audio
 from instruments.measurement.large_signal_plan import LargeSignalPlan, run_large_signal
 from instruments.rig.engine import RIG_CALIBRATION
 from instruments.rig.in_process import InProcessRig
@@ -105,6 +107,35 @@ def test_the_plan_steps_up_to_the_excursion_limit_and_keeps_every_step(tmp_path)
     assert summary["stopped_by"] == "excursion"
     assert [s["recording"] for s in summary["steps"]] == [p.name for p in outcome.recordings]
     assert all(len(s["measures"]["re_ohm_per_period"]) == 2 for s in summary["steps"])
+
+
+def test_a_step_whose_audio_was_timed_late_is_not_trusted_and_the_plan_stops_below_the_limit(tmp_path, monkeypatch):
+    """A starved host notes the audio's blocks late (here: every block of the 4 V step by 0.3 s, injected in the
+    time stamps, so the same whatever the load): the laser's stream is placed 0.3 s off, one period of the
+    coherent mean is the cone after the drive stopped, and the peak comes out about half the truth. The plan
+    used to step from that to 8 V and 3.1 mm, past the 2 mm limit; the displacement not repeating while the
+    voltage did says the peak cannot be trusted, and the plan stops there."""
+    lateness = {"s": 0.0}
+    monkeypatch.setattr(timed_audio, "time", SimpleNamespace(monotonic=lambda: time.monotonic() + lateness["s"]))
+
+    def measure(step_plan, *args, **kwargs):
+        lateness["s"] = 0.3 if step_plan.level_v_rms == 4.0 else 0.0
+        return run_measurement(step_plan, *args, **kwargs)
+
+    rig = InProcessRig(known_driver(8192), "simulated", calibration=LARGE_SIGNAL_CHAIN)
+    limits = StepLimits(max_excursion_m=2.0e-3, max_voltage_v=20.0)
+    try:
+        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits), rig.audio,
+                                   rig.laser, tmp_path, name="ls", measure=measure)
+    finally:
+        rig.close()
+    assert [s.level_v for s in outcome.steps] == [2.0, 4.0], outcome.message
+    assert outcome.stopped_by == "fault" and "displacement" in outcome.message
+    late = outcome.steps[-1]
+    assert late.measures.displacement_change > 0.2 and not late.usable
+    assert late.recording_path.is_file() and late.recording_path not in outcome.recordings
+    assert all(s.measures.displacement_change < 0.01 for s in outcome.steps[:-1])
+    assert json.loads(outcome.summary_path.read_text())["steps"][-1]["usable"] is False
 
 
 def test_the_plan_stops_at_the_voltage_limit(tmp_path):
