@@ -31,6 +31,7 @@ from analysis.fit.startvalues import StartValueError, start_context
 from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model, ModelError
+from analysis.model.lumped import resonance_frequency
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.plausibility import plausibility_findings
@@ -189,8 +190,7 @@ def in_the_piston_band(fit: FitResult, data: FitData, method: str, cancel: threa
     if not misses_the_band(fit):
         return fit, data
     values = dict(fit.values)
-    fs = 1.0 / (2.0 * math.pi * math.sqrt(values["CMES"] * values["LCES"]))
-    band = piston_band(data, fs)
+    band = piston_band(data, resonance_frequency(values))
     if band is None:
         return fit, data
     # From the whole band's values and from the model's own start: the first may hold a creep that imitated the

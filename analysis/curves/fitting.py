@@ -48,6 +48,7 @@ from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
 from analysis.errors import LinparError
+from analysis.fit.bands import HX_MAX_OVER_FS    # the piston band's top for Hx, as for recordings
 from analysis.fit.error import fit_error_percent, rms_relative_residual
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, FitData, FitError, FitResult, component_sigma
 from analysis.fit.startvalues import start_context
@@ -56,7 +57,6 @@ from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
 
-HX_MAX_OVER_FS = 4.0
 Z_MAX_OVER_FS = 5.0
 # The other Z bands whose fits the model part of magnitude-only curves spans (analysis.fit.model_uncertainty):
 # every one describes its lines about as well, and the data cannot say which band's blocked impedance is right.
