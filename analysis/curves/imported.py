@@ -1,13 +1,15 @@
 """Curves read from other tools' files, ready to fit: Z, optional Hx, how they were read, and the band to fit.
 
-`import_curves` reads them (analysis.importers) and keeps the fit's frequency range with them, so that
-`analysis.analyze(curves)` and `analysis.diagnose(curves)` fit the same lines `linpar analyze --impedance`
-and `linpar diagnose --impedance` fit.
+`import_curves` reads them (analysis.importers) and keeps the fit's frequency range with them. It is the one
+way curves are read: the library (`analysis.analyze(curves)`, `analysis.diagnose(curves)`), the CLI
+(`linpar analyze --impedance`, `linpar diagnose --impedance`) and the GUI (File > Open curves…) all call it, so
+the three fit the same lines of the same files.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Mapping
 
 from analysis.curves.fitting import LINES_PER_DECADE, CurveFitError, FitRange
 from analysis.spectra import TransferFunction
@@ -21,6 +23,9 @@ class ImportedCurves:
     displacement: TransferFunction | None       # Hx in m/V; None: Z alone (no Bl)
     notes: tuple[str, ...]                      # each file: what was read, and how
     fit_range: FitRange = FitRange()
+    files: tuple[Path, ...] = ()                # the files read, the impedance's (or the uiv) first
+    # Each channel's fitted curve of the exporting tool (a Klippel export's): an overlay, never fitted.
+    references: Mapping[str, TransferFunction] = field(default_factory=dict)
 
 
 def import_curves(impedance: str | Path | None = None, *, hx: str | Path | None = None,
@@ -45,8 +50,12 @@ def import_curves(impedance: str | Path | None = None, *, hx: str | Path | None 
     if uiv is not None:
         read = read_uiv(uiv)
         return ImportedCurves(impedance=read.impedance, displacement=read.displacement, notes=(read.describe(),),
-                              fit_range=fit_range)
+                              fit_range=fit_range, files=(read.path,))
     z = read_curve(impedance, "impedance", phase)
     x = None if hx is None else read_curve(hx, "displacement", phase, "mm/V" if hx_mm_per_volt else None)
+    by_channel = {name: c for name, c in (("impedance", z), ("displacement", x)) if c is not None}
     return ImportedCurves(impedance=z.transfer, displacement=None if x is None else x.transfer,
-                          notes=tuple(c.describe() for c in (z, x) if c is not None), fit_range=fit_range)
+                          notes=tuple(c.describe() for c in by_channel.values()), fit_range=fit_range,
+                          files=tuple(c.path for c in by_channel.values()),
+                          references={name: c.reference for name, c in by_channel.items()
+                                      if c.reference is not None})

@@ -45,14 +45,15 @@ def wants_curves(args: argparse.Namespace) -> bool:
 
 
 def fit_range(args, hx_f_max=None):
+    """The range options of `linpar added-mass` (its curves are read by their own command)."""
     from analysis.curves.fitting import LINES_PER_DECADE, FitRange
     return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
 
 
-def load_curves(args: argparse.Namespace, references: dict | None = None):
-    """(Z, Hx or None, notes) from --impedance/--hx or --uiv, checked for conflicting options; `references`
-    (when given) receives each channel's fitted curve of the exporting tool (a Klippel export's)."""
-    from analysis.importers import read_curve, read_uiv
+def load_curves(args: argparse.Namespace):
+    """The curves --impedance/--hx or --uiv name, read by analysis.curves.imported.import_curves (as the library
+    and the GUI read them) with the range options, after the options' conflicts are said in their own words."""
+    from analysis.curves.imported import import_curves
     if args.path and not (args.impedance or args.uiv or args.hx):
         used = [f"--{n.replace('_', '-')}" for n in CURVE_ONLY if getattr(args, n)]
         raise CliError(f"{', '.join(used)}: for imported curves only (--impedance/--uiv), not for a recording")
@@ -65,36 +66,22 @@ def load_curves(args: argparse.Namespace, references: dict | None = None):
         raise CliError("--uiv carries both Z and Hx: do not add --impedance or --hx")
     if args.hx and not args.impedance:
         raise CliError("--hx needs --impedance: Hx alone cannot be fitted")
-    if args.uiv:
-        uiv = read_uiv(args.uiv)
-        z, hx, notes = uiv.impedance, uiv.displacement, [uiv.describe()]
-    else:
-        z_curve = read_curve(args.impedance, "impedance", args.phase)
-        notes = [z_curve.describe()]
-        z, hx = z_curve.transfer, None
-        refs = {"impedance": z_curve.reference}
-        if args.hx:
-            hx_curve = read_curve(args.hx, "displacement", args.phase, "mm/V" if args.mm_per_volt else None)
-            hx = hx_curve.transfer
-            notes.append(hx_curve.describe())
-            refs["displacement"] = hx_curve.reference
-        if references is not None:
-            references.update({k: v for k, v in refs.items() if v is not None})
-    return z, hx, notes
+    return import_curves(args.impedance, hx=args.hx, uiv=args.uiv, phase=args.phase,
+                         hx_mm_per_volt=args.mm_per_volt, f_min=args.fmin, f_max=args.fmax,
+                         hx_f_max=args.hx_fmax, all_lines=args.all_lines)
 
 
 def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
     from analysis.curves.reference import compare_with_reference, comparison_words
     from analysis.fit.model_uncertainty import model_uncertainty
-    references: dict = {}
-    z, hx, notes = load_curves(args, references)
+    curves = load_curves(args)
     # No --model, no --method: fit_curves chooses (magnitude-only curves have their own defaults).
     effects = None if args.model is None else model_effects(args.model)
-    fitted = fit_curves(z, hx, effects, args.sd, fit_range(args, args.hx_fmax), notes,
+    fitted = fit_curves(curves.impedance, curves.displacement, effects, args.sd, curves.fit_range, curves.notes,
                         method=getattr(args, "method", None))
     result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)
-    beside = compare_with_reference(result.fit, references)
+    beside = compare_with_reference(result.fit, curves.references)
     if args.json:
         doc = curve_json(result)
         if beside:

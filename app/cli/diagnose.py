@@ -33,10 +33,7 @@ def run_diagnosis(args: argparse.Namespace) -> DiagnosisResult:
     start = model_effects(args.start, "--from")     # a bad --from fails before the data are read
     source = args.path
     if curves.wants_curves(args):
-        from analysis.curves.imported import ImportedCurves
-        z, hx, notes = curves.load_curves(args)
-        source = ImportedCurves(impedance=z, displacement=hx, notes=tuple(notes),
-                                fit_range=curves.fit_range(args, args.hx_fmax))
+        source = curves.load_curves(args)
     return diagnose(source, start=start, sd_m2=args.sd)
 
 

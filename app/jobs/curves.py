@@ -1,6 +1,7 @@
 """Imported curves (File > Open curves…) analysed off the GUI thread: the files read, fitted as
-`linpar analyze --impedance Z --hx HX` fits them, with each channel's fitted curve of the exporting tool kept for
-the overlay (analysis.curves.reference). A file that cannot be read fails the job with the CLI's one line."""
+`linpar analyze --impedance Z --hx HX` fits them (both read them with analysis.curves.imported.import_curves), with
+each channel's fitted curve of the exporting tool kept for the overlay (analysis.curves.reference). A file that
+cannot be read fails the job with the CLI's one line."""
 from __future__ import annotations
 
 import dataclasses
@@ -24,15 +25,10 @@ class CurvesRequest:
 def analyse_curves(job: Job, request: CurvesRequest):
     """`request`'s curves fitted: an analysis.curves.fitting.CurveAnalysis with its files and references."""
     from analysis.curves.fitting import fit_curves
-    from analysis.importers import read_curve
+    from analysis.curves.imported import import_curves
     job.say(f"reading {request.name}")
-    z = read_curve(request.impedance, "impedance", None)
-    hx = None if request.hx is None else read_curve(request.hx, "displacement", None,
-                                                     "mm/V" if request.hx_mm_per_volt else None)
+    curves = import_curves(request.impedance, hx=request.hx, hx_mm_per_volt=request.hx_mm_per_volt)
     job.check()
     job.say(f"fitting {request.name}")
-    read = [c for c in (z, hx) if c is not None]
-    result = fit_curves(z.transfer, None if hx is None else hx.transfer, notes=[c.describe() for c in read])
-    references = {name: c.reference for name, c in zip(("impedance", "displacement"), read) if c.reference is not None}
-    files = tuple(p for p in (request.impedance, request.hx) if p is not None)
-    return dataclasses.replace(result, files=files, references=references)
+    result = fit_curves(curves.impedance, curves.displacement, f_range=curves.fit_range, notes=curves.notes)
+    return dataclasses.replace(result, files=curves.files, references=curves.references)
