@@ -35,12 +35,14 @@ def short_number(value: float, std: float | None = None, digits: int = SHORT_DIG
     if value == 0 or not math.isfinite(value):
         return f"{value:.{digits}g}"
     magnitude = math.floor(math.log10(abs(value)))
-    if std is not None and math.isfinite(std) and std > 0:
-        digits = max(1, min(digits, magnitude - math.floor(math.log10(std)) + 2))
     decimals = digits - 1 - magnitude
+    if std is not None and math.isfinite(std) and std > 0:
+        # Never finer than the sigma's second digit: a value far below its sigma (a parameter on its bound at
+        # 9e-9 mH, sigma 1.9 mH) reads "0.0", not "0.000000009".
+        decimals = min(decimals, 1 - math.floor(math.log10(std)))
     if abs(value) >= 1e6 or decimals > 9:
         return f"{value:.{digits}g}"
-    return f"{round(value, decimals):.{max(0, decimals)}f}"
+    return f"{round(value, decimals) + 0.0:.{max(0, decimals)}f}"      # + 0.0: no "-0.0"
 
 
 def plain_number(value: float, digits: int = 3) -> str:

@@ -28,6 +28,8 @@ def test_format_value_rounds_to_the_sigma(value, std, scale, expected):
     (12345.6, 230.0, ("12350", "230")),
     (0.0123456, None, ("0.01235", "–")),            # no sigma: four digits
     (5.0, 40.0, ("5", "40")),                       # the sigma swamps it: one digit
+    (9e-9, 1.9, ("0.0", "1.9")),                    # a value on its bound far below its sigma
+    (-9e-9, 1.9, ("0.0", "1.9")),
 ])
 def test_short_values_keep_what_the_sigma_supports_at_most_four_digits(value, std, expected):
     assert short_value(ParameterValue("x", value, std, "u", "u", 1.0)) == expected
