@@ -67,6 +67,9 @@ class AnalysisResult:
     # The lines fitted (the piston band when the model misses the whole band: analysis.fit.bands); None: every
     # usable line of the spectra.
     data: FitData | None = None
+    # When the parameters come from the piston band: the same model fitted over every usable line, where it
+    # fails (the Model lab starts from it, so that the physics the model lacks shows where it acts).
+    whole_band_fit: FitResult | None = None
 
     @property
     def model(self) -> Model:
@@ -161,6 +164,7 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
         spectra = corrected
         data = FitData.from_spectra(spectra)
         fit = fit_with(method, data, model, start=fit.values, cancel=cancel)
+    whole_band_fit, every_line = fit, data
     fit, data = in_the_piston_band(fit, data, method, cancel)
     parameters = parameter_table(fit, sd, unusable.displacement or NO_DISPLACEMENT)
     # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
@@ -171,7 +175,7 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     if heating is not None:
         judged["heating"] = heating.as_json()
     return AnalysisResult(spectra=spectra, fit=fit, parameters=parameters, sd_m2=sd, source=recording.source,
-                          validity=judged, data=data)
+                          validity=judged, data=data, whole_band_fit=None if data is every_line else whole_band_fit)
 
 
 def misses_the_band(fit: FitResult) -> bool:

@@ -104,7 +104,8 @@ def misfit_findings(fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS)
 
 def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS) -> dict:
     """A result's validity (as JSON) for another fit of the same recording: the old fit's misfit findings
-    replaced by the new one's, the lights redone (the Model lab's versions)."""
+    replaced by the new one's, the lights redone, the fit error and its band the new fit's (the Model lab's
+    versions, fitted over every line where the result may have come from the piston band)."""
     channels = {}
     for name, channel in (validity.get("channels") or {}).items():
         if channel.get("status") == ABSENT:
@@ -116,7 +117,9 @@ def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT
                           "status": str(worst(Severity(f["severity"]) for f in findings))}
     lights = [Severity(ch["status"]) for ch in channels.values() if ch.get("status") in set(Severity)]
     return {**validity, "channels": channels, "overall": str(worst(lights)) if channels else
-            validity.get("overall", "unknown"), "fit_error_percent": fit_error_percent(fit)}
+            validity.get("overall", "unknown"), "fit_error_percent": fit_error_percent(fit),
+            "fit_band_hz": {name: [float(ch.freqs[0]), float(ch.freqs[-1])] for name, ch in fit.channels.items()
+                            if len(ch.freqs)}}
 
 
 def red_findings_text(validity: Mapping) -> str:

@@ -18,6 +18,7 @@ from analysis.diagnosis.candidates import MAX_STEPS, Candidate, Diagnosis, Step,
 from analysis.diagnosis.sites import SiteResult
 from analysis.diagnosis.words import drift_from_validity, verdict_headline, verdict_text
 from analysis.effects import Effect
+from analysis.fit.error import band_text
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, fit_model
 from analysis.model.composed import Model
 from analysis.parallel import fit_executor
@@ -45,10 +46,22 @@ class LabFit:
 
 def lab_fit(base: AnalysisResult, fit: FitResult) -> LabFit:
     """`fit` dressed for display; milliseconds, but run in the worker with the fit it follows."""
-    # The validity goes with the fit: the base's misfit finding is the base model's, not this one's.
+    # The validity goes with the fit: the base's misfit finding is the base model's, not this one's. The lab
+    # fits every line (app.model_lab.session), whatever band the base's parameters came from.
     result = dataclasses.replace(base, fit=fit, parameters=parameter_table(fit, base.sd_m2),
-                                 validity=rejudged(base.validity, fit))
+                                 validity=rejudged(base.validity, fit), data=None, whole_band_fit=None)
     return LabFit(result, result_curves(result), residuals.describe(fit))
+
+
+def first_version(result: AnalysisResult) -> tuple[LabFit, str]:
+    """The lab's first version and how it came about: the result's fit, or, when its parameters come from the
+    piston band, the same model over every line the lab works on (its curves and the residual in words take
+    milliseconds: no worker needed)."""
+    if result.whole_band_fit is None:
+        return LabFit(result, result_curves(result), residuals.describe(result.fit)), "as fitted on the Results page"
+    band = band_text(result.validity, "displacement")
+    return (lab_fit(result, result.whole_band_fit),
+            f"over every line (the Results page's parameters come from the piston band{band})")
 
 
 @dataclass(frozen=True, slots=True)

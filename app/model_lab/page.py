@@ -16,14 +16,14 @@ from pathlib import Path
 from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout, QWidget
 
-from analysis.diagnosis import acceptance, residuals
+from analysis.diagnosis import acceptance
 from analysis.errors import LinparError
 from analysis.fit.least_squares import FitData
 from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
 from analysis.diagnosis.refit_words import refit_text
 from app.jobs.controls import JobControls
-from app.jobs.lab_worker import DiagnosisOutcome, LabFit, LabWorker
+from app.jobs.lab_worker import DiagnosisOutcome, LabFit, LabWorker, first_version
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
@@ -31,7 +31,6 @@ from app.model_lab.sites import SitePanel
 from app.model_lab.session import LabSession
 from app.model_lab.versions import LabVersion, changed_model, move_text
 from app.results.parameter_table import titled_parameter_table
-from app.results.curves import result_curves
 from app.jobs.workers import AnalysisOutcome
 
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
@@ -169,9 +168,7 @@ class ModelLab(QWidget):
         self.site_panel.set_sites(())
         self.views.setCurrentWidget(self.chart)
         self.catalogue.set_displacement_available(result.fit.model.with_displacement)
-        # Curves and the residual in words take well under a millisecond: no worker needed.
-        first = LabFit(result, result_curves(result), residuals.describe(result.fit))
-        self._add_version(first, "as fitted on the Results page", adopt=False)
+        self._add_version(*first_version(result), adopt=False)
         self.status_label.setText("")
         self.stack.setCurrentWidget(self.content)
 

@@ -40,9 +40,10 @@ class LabSession:
         fitted (a broken measurement) leaves the lab nothing to model."""
         fitted = result.fit is not None
         self.base = result if fitted else None
-        # The lines the result was fitted on (its piston band when the model missed the whole band): the lab's
-        # versions are compared with the result's fit on the same lines.
-        self.data = (result.data or FitData.from_spectra(result.spectra)) if fitted else None
+        # Every usable line, also when the result's parameters come from its piston band: the lab is where the
+        # user sees where the model fails (a cone mode above the band) and which physics would explain it, as
+        # `linpar diagnose` does. Its first version is then the model fitted over every line (first_version).
+        self.data = FitData.from_spectra(result.spectra) if fitted else None
         self.versions = []
         self.diagnosis, self.diagnosis_version = None, 0
 

@@ -79,3 +79,36 @@ def test_a_new_recording_restarts_and_a_broken_one_leaves_nothing(base):
     broken = dataclasses.replace(other, fit=None, not_fitted="the current is silent")
     session.restart(broken)
     assert session.base is None and session.data is None and session.current is None
+
+
+@pytest.fixture(scope="module")
+def band_fitted() -> AnalysisResult:
+    """A realistic woofer (a cone mode the laser's spot sees): its parameters come from the piston band."""
+    from tests.realistic_drivers import realistic_recording
+    result = analyze_recording(realistic_recording("woofer", 0))
+    assert result.whole_band_fit is not None, "the woofer's parameters should come from its piston band"
+    return result
+
+
+def test_a_band_fitted_result_is_modelled_over_every_line_where_the_cone_mode_shows(band_fitted):
+    from app.jobs.lab_worker import first_version as lab_first_version
+    session = LabSession()
+    session.restart(band_fitted)
+    band_lines = len(band_fitted.data.displacement.freqs)
+    assert len(session.data.displacement.freqs) > band_lines            # the lab sees above the band
+    first, how = lab_first_version(band_fitted)
+    assert "piston band" in how
+    fitted_lines = first.fit.channels["displacement"].freqs
+    assert len(fitted_lines) == len(session.data.displacement.freqs)
+    # Over every line the model misses the cone mode: the lab's starting point shows it (the band hides it).
+    assert first.result.validity["fit_error_percent"]["displacement"] > 10.0
+    assert band_fitted.validity["fit_error_percent"]["displacement"] < 10.0
+    assert first.result.validity["fit_band_hz"]["displacement"][1] == pytest.approx(float(fitted_lines[-1]))
+    assert first.result.data is None and first.result.whole_band_fit is None
+
+
+def test_a_result_fitted_over_every_line_starts_the_lab_as_it_is(base):
+    from app.jobs.lab_worker import first_version as lab_first_version
+    assert base.whole_band_fit is None
+    first, how = lab_first_version(base)
+    assert first.result is base and how == "as fitted on the Results page"
