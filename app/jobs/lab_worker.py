@@ -59,9 +59,9 @@ def first_version(result: AnalysisResult) -> tuple[LabFit, str]:
     milliseconds: no worker needed)."""
     if result.whole_band_fit is None:
         return LabFit(result, result_curves(result), residuals.describe(result.fit)), "as fitted on the Results page"
-    band = band_text(result.validity, "displacement")
+    band = band_text(result.validity, "displacement").strip(" ()")         # "14.6-144 Hz"; the page adds ()
     return (lab_fit(result, result.whole_band_fit),
-            f"over every line (the Results page's parameters come from the piston band{band})")
+            f"over every line; the Results page's parameters come from the piston band, {band} on Hx")
 
 
 @dataclass(frozen=True, slots=True)
