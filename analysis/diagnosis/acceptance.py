@@ -203,14 +203,6 @@ def assess(current: FitResult, fit: FitResult | None, effect: Effect, flags: tup
     return Assessment(True, ACCEPTED, gain, gap, message="it pays for its parameters and explains its site's misfit")
 
 
-CHANCE_SIGMAS = 3.0
-
-
-def within_chance(chi2: float, dof: float) -> bool:
-    """chi^2 with `dof` degrees of freedom no larger than chance allows (CHANCE_SIGMAS above its mean)."""
-    return chi2 <= dof + CHANCE_SIGMAS * math.sqrt(2.0 * max(dof, 1.0))
-
-
 def noise_flags(fit: FitResult) -> list[Flag]:
     """A reduced chi^2 far below 1: the noise estimate is inflated, e.g. by drift between periods."""
     return [Flag(NOISE_INFLATED, f"the reduced chi^2 of {CHANNEL_WORDS.get(name, name)} is {ch.chi2_red:.2g}, far "

@@ -23,7 +23,7 @@ for on a model already at its noise floor, and the words say so.
 """
 from __future__ import annotations
 
-from analysis.diagnosis.acceptance import CHANCE_SIGMAS, within_chance  # noqa: F401 (the tests use them here)
+from analysis.diagnosis.chance import CHANCE_SIGMAS, within_chance  # noqa: F401 (the tests use them here)
 from analysis.diagnosis.sites import SiteResult
 from analysis.fit.least_squares import FitResult
 

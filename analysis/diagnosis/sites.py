@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from analysis.diagnosis import acceptance
+from analysis.diagnosis.chance import within_chance
 from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, misfit_spans, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
@@ -281,7 +281,7 @@ def _log_shares_left(site: Site, current: FitResult, chi2_by_channel: dict[str, 
              for name, (c, m) in chi2_by_channel.items()]
     own = SENSED_CHANNEL.get(site)
     other = [(share, name) for name, share, _ in terms if name != own]
-    if own is None or len(terms) < 2 or acceptance.within_chance(*chi2_by_channel[other[0][1]]):
+    if own is None or len(terms) < 2 or within_chance(*chi2_by_channel[other[0][1]]):
         return terms
     return [(name, max(share, other[0][0]) if name == own else share, m) for name, share, m in terms]
 
