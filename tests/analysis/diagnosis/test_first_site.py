@@ -4,9 +4,10 @@ Issue 30's criterion: recordings of physics of another form than the catalogue's
 several at once (tests/site_cases.py); the site the verdict points at first should be one where the
 physics acts in at least 90 % of them. Main before issue 30 named a right site in 2 of the 12; with the
 sites ranked on both channels at their own scale, 10; with a sense site's own channel counted no more than
-the other channel's share, 11 (92 %). The one left wrong is the real-like woofer with the laser on the
-outer cone, which names the force-factor site: a factor g on Bl acts as the mechanical site's Zm / g^2 with
-the laser's factor 1 / g, so it follows the cone mode and the spot together better than either site alone.
+the other channel's share, 11 (92 %; 11 of 12 on seed 32 too). The one left wrong is the real-like woofer
+with the laser on the outer cone (on seed 32: with the laser on the coil), which names the force-factor
+site: a factor g on Bl acts as the mechanical site's Zm / g^2 with the laser's factor 1 / g, so it follows
+misfit at the mechanical site and in Hx together better than either site alone.
 The count asserted is what this branch reaches less a margin of one, so that a regression shows; every
 case is said in the failure message.
 """
