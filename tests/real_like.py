@@ -26,7 +26,7 @@ from analysis.synthesis import synthesize_recording
 from tests.builders import PAPER, TYPICAL_NOISE, multitone
 from tests.odd_physics import OddEffect
 
-__all__ = ["REAL_LIKE", "real_like_recording", "real_like_effects"]
+__all__ = ["REAL_LIKE", "real_like_recording", "real_like_effects", "structural_cone_mode"]
 
 RHO_C = 1.204 * 343.0            # air's characteristic impedance, kg/(m^2 s)
 SD = 0.0133                      # m^2, the paper driver's cone area
@@ -86,6 +86,18 @@ REAL_LIKE = {
     "eddy": _effect(Site.BLOCKED, "eddy", "eddy currents in the pole, a diffusion law", _eddy),
     "creep": _effect(Site.COMPLIANCE, "creep", "creep as a Cole-Cole relaxation", _cole_cole),
 }
+
+
+def structural_cone_mode(f2: float, eta: float, mu2: float, f_spot: float, eta_spot: float
+                         ) -> tuple[OddEffect, OddEffect]:
+    """A cone mode with structural damping (in Z and at the coil) and the laser spot's own mode above it."""
+    def cone(f, p):
+        return _cone_mode(f, p, f2=f2, eta=eta, mu2=mu2)
+
+    def spot(f, p):
+        return _spot(f, p, f2=f_spot, eta=eta_spot)
+    return (_effect(Site.MECHANICAL, "cone", f"a cone mode at {f2:g} Hz, structural damping {eta:g}", cone),
+            _effect(Site.DISPLACEMENT, "spot", f"the laser spot's own mode at {f_spot:g} Hz", spot))
 
 
 def real_like_effects(names=tuple(REAL_LIKE)) -> tuple[OddEffect, ...]:

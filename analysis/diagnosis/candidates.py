@@ -361,6 +361,11 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
             progress(f"trying every effect on {current.model.describe()}")
         ranked = rank_candidates(data, current, executor, cancel)
         ranked, best = choose(current, ranked, sites)
+        if best is None:    # the candidates rule 3 refused, tried with what acts on the channel they left
+            refused = pairs.rank_pairs(data, current, ranked, _refit, _run, executor, cancel, Candidate, refused=True)
+            if refused:
+                ranked, best = choose(current, tuple(sorted(ranked + tuple(refused), key=lambda c: c.delta_bic)),
+                                      sites)
         steps.append(Step(fit=current, candidates=ranked, residual=residuals.describe(current), chosen=best,
                           flags=_model_flags(current)))
         if best is None or not follow:

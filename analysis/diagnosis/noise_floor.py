@@ -23,21 +23,14 @@ for on a model already at its noise floor, and the words say so.
 """
 from __future__ import annotations
 
-import math
-
+from analysis.diagnosis.chance import CHANCE_SIGMAS, within_chance  # noqa: F401 (the tests use them here)
 from analysis.diagnosis.sites import SiteResult
 from analysis.fit.least_squares import FitResult
 
-CHANCE_SIGMAS = 3.0
 
 SKIPPED_WORDS = ("No candidate was refitted: the model meets the noise on every channel and no site's smooth "
                  "correction removes more than noise would, so no effect of the catalogue has anything to "
                  "explain (one whose whole effect is within the noise is not looked for).")
-
-
-def within_chance(chi2: float, dof: float) -> bool:
-    """chi^2 with `dof` degrees of freedom no larger than chance allows (CHANCE_SIGMAS above its mean)."""
-    return chi2 <= dof + CHANCE_SIGMAS * math.sqrt(2.0 * max(dof, 1.0))
 
 
 def channels_at_noise(fit: FitResult) -> bool:

@@ -47,6 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from analysis.diagnosis.chance import within_chance
 from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, misfit_spans, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
@@ -69,6 +70,8 @@ TOLERANCE = 1e-4             # relative change of chi^2 and of the parameters: a
 # effects there are held at the current fit (the correction can take on any change of theirs, and
 # left free they would trade against it with no end, which stalls the fit). The compliance's creep
 # law stays free: its correction is held constant above 2 fs, where the law goes on shaping it.
+# The channel each sense site's factor acts on alone.
+SENSED_CHANNEL = {Site.CURRENT: "impedance", Site.DISPLACEMENT: "displacement"}
 SITE_ELEMENTS = {Site.BLOCKED: ("RE", "LE"), Site.FORCE_FACTOR: ("Bl",), Site.MECHANICAL: ("RES",),
                  Site.COMPLIANCE: ("LCES",), Site.CURRENT: (), Site.DISPLACEMENT: ("Bl",)}
 
@@ -255,11 +258,32 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
     freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
     shown, unit, acts_as, scale = problem.correction.shown(freqs, p)
     std = scale * _h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
-    score = edf * np.log(n) + sum(m * np.log(max(c, 1e-300) / max(current.channels[name].chi2, 1e-300))
-                                  for name, (c, m) in chi2_by_channel.items())
+    score = edf * np.log(n) + sum(m * share for name, share, m in _log_shares_left(site, current, chi2_by_channel))
     return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
                       chi2 - current.chi2 + edf * np.log(n), edf, freqs, shown, unit, acts_as, bool(result.status > 0),
                       std, float(score))
+
+
+def _log_shares_left(site: Site, current: FitResult, chi2_by_channel: dict[str, tuple[float, int]]
+                     ) -> list[tuple[str, float, int]]:
+    """(channel, ln of the share of its chi^2 the correction leaves, its number of values): the ranking's terms.
+
+    A factor on one channel's sense (the current's for Z, the laser's for Hx) can reshape that channel into
+    anything, so how much of it the factor removes says nothing of whether the sense is at fault. What does
+    is the other channel: freed of the sensed channel's misfit, the model's parameters should explain it
+    too. So a sense site's own channel counts for no more than the other channel's share, unless the other
+    channel is then within chance of its noise (then the sense alone explains the recording).
+    Without this, a laser factor that took Hx to its noise and left Z at a reduced chi^2 of 1.4e5 outranked
+    the mechanical site on a damping bump with a DC block on the current sense (physics at the mechanical
+    and current sites).
+    """
+    terms = [(name, float(np.log(max(c, 1e-300) / max(current.channels[name].chi2, 1e-300))), m)
+             for name, (c, m) in chi2_by_channel.items()]
+    own = SENSED_CHANNEL.get(site)
+    other = [(share, name) for name, share, _ in terms if name != own]
+    if own is None or len(terms) < 2 or within_chance(*chi2_by_channel[other[0][1]]):
+        return terms
+    return [(name, max(share, other[0][0]) if name == own else share, m) for name, share, m in terms]
 
 
 def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:

@@ -16,7 +16,11 @@ from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData
 from analysis.model.composed import Model
 from analysis.spectra import estimate_spectra
+from analysis.diagnosis.words import first_site
+from analysis.effects.base import Site
+from analysis.synthesis import synthesize_recording
 from tests.builders import PAPER, TYPICAL_NOISE, recording
+from tests.real_like import structural_cone_mode
 
 START = "lr2,creep-log"
 
@@ -81,5 +85,45 @@ def test_a_cone_mode_in_the_impedance_and_at_the_spot_is_explained_by_both_effec
     for channel, chi2_red in result.final.chi2_red_by_channel().items():
         assert chi2_red <= 2.0, (channel, chi2_red)
     fitted, true = _mechanical(result.final.values), _mechanical(truth)
+    for name, value in true.items():
+        assert fitted[name] == pytest.approx(value, rel=0.01), name
+
+
+# A cone mode (f2 1.5 kHz, Q2 6, a tenth of Mms) whose outer cone, where the laser's spot is, has its own mode
+# above it (4 kHz, Q 3): breakup alone takes Z from a reduced chi^2 of 6.2e4 to 4.1e3 but Hx only from 2.3e5
+# to 1.4e5, and the mechanical site's correction (which reshapes Hx through Zm) removes more, so rule 3 refuses
+# it; breakup-spot alone leaves Z. Main before the pairs of refused candidates: unexplained, nothing taken.
+CONE_AND_SPOT = {"f2": 1500.0, "Q2": 6.0, "mu2": 0.1, "f2x": 4000.0, "Q2x": 3.0}
+
+
+@pytest.mark.parametrize("seed", [23, 24])
+def test_a_cone_mode_the_spot_sees_a_mode_of_its_own_above_is_accepted_as_a_pair(pool, mt, seed):
+    truth = {**PAPER.parameters, **CONE_AND_SPOT}
+    rec = recording(truth, "lr2,creep-log,breakup,breakup-spot", noise=TYPICAL_NOISE, n_periods=8, seed=seed, mt=mt)
+    result = diagnose(FitData.from_spectra(estimate_spectra(rec)), Model(parse_effects(START)), executor=pool)
+
+    taken = [step.chosen for step in result.steps if step.chosen is not None]
+    assert [c.label for c in taken] == ["breakup + breakup-spot"], [c.label for c in taken]
+    assert result.verdict == acceptance.EXPLAINED
+    for channel, chi2_red in result.final.chi2_red_by_channel().items():
+        assert chi2_red <= 2.0, (channel, chi2_red)
+    fitted, true = _mechanical(result.final.values), _mechanical(truth)
+    for name, value in true.items():
+        assert fitted[name] == pytest.approx(value, rel=0.01), name
+
+
+def test_a_cone_mode_with_structural_damping_is_not_claimed_explained(pool, mt):
+    """The same two modes with structural damping (a loss factor, not the catalogue's viscous Q): the pair
+    comes close (reduced chi^2 from 6e4 and 2e5 to some 5e2 and 3e3), not to the noise. Honest: partly
+    explained, the misfit left placed at a site where the physics acts, and the parameters kept."""
+    cone, spot = structural_cone_mode(1500.0, 1 / 6, 0.1, 4000.0, 1 / 3)
+    rec = synthesize_recording(Model(parse_effects(START) + (cone, spot)), dict(PAPER.parameters), mt.waveform,
+                               mt.excited_bins, mt.sample_rate, 8, 1, TYPICAL_NOISE, seed=23,
+                               driver={"name": "synthetic: structural cone mode", "sd_m2": 0.0133})
+    result = diagnose(FitData.from_spectra(estimate_spectra(rec)), Model(parse_effects(START)), executor=pool)
+
+    assert result.verdict == acceptance.PARTLY_EXPLAINED, result.verdict
+    assert first_site(result) in (Site.MECHANICAL, Site.DISPLACEMENT), first_site(result)
+    fitted, true = _mechanical(result.final.values), _mechanical(PAPER.parameters)
     for name, value in true.items():
         assert fitted[name] == pytest.approx(value, rel=0.01), name

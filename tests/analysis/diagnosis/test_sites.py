@@ -6,7 +6,7 @@ import pytest
 from scipy.optimize._numdiff import approx_derivative
 
 from analysis.diagnosis.site_correction import site_correction
-from analysis.diagnosis.sites import SITES, _band, _SiteProblem, localise
+from analysis.diagnosis.sites import SITES, _band, _log_shares_left, _SiteProblem, localise
 from analysis.diagnosis.words import tied_sites
 from analysis.effects import parse_effects
 from analysis.effects.base import Effect, Site
@@ -76,3 +76,29 @@ def test_with_the_impedance_alone_no_site_can_be_told_from_another():
     assert {s.site for s in sites} == set(SITES) - {Site.DISPLACEMENT}
     assert len(tied_sites(sites)) == len(sites) - 1
     assert all(s.delta_bic < -1000 for s in sites[:5])       # each of them can make Z anything
+
+
+@dataclass(frozen=True)
+class _Chi2:
+    chi2: float
+
+
+@dataclass(frozen=True)
+class _Current:
+    channels: dict
+
+
+def test_a_sense_site_counts_its_own_channel_no_more_than_the_other_unless_the_other_meets_the_noise():
+    """A factor on the laser takes Hx to its noise whatever the physics: what it leaves of Z is what counts."""
+    current = _Current({"impedance": _Chi2(8.3e7), "displacement": _Chi2(2.3e8)})
+    z_left = {"impedance": (2.0e7, 180), "displacement": (1128.0, 180)}
+    shares = {name: share for name, share, _ in _log_shares_left(Site.DISPLACEMENT, current, z_left)}
+    assert shares["displacement"] == pytest.approx(np.log(2.0e7 / 8.3e7))
+    assert shares["impedance"] == pytest.approx(np.log(2.0e7 / 8.3e7))
+    # The mechanical site acts on both channels: each counts by its own share.
+    shares = {name: share for name, share, _ in _log_shares_left(Site.MECHANICAL, current, z_left)}
+    assert shares["displacement"] == pytest.approx(np.log(1128.0 / 2.3e8))
+    # Z left within chance of its noise: the laser alone explains the recording, and gets its full share.
+    z_met = {"impedance": (190.0, 180), "displacement": (1128.0, 180)}
+    shares = {name: share for name, share, _ in _log_shares_left(Site.DISPLACEMENT, current, z_met)}
+    assert shares["displacement"] == pytest.approx(np.log(1128.0 / 2.3e8))
