@@ -33,11 +33,12 @@ RIG_UNIT = "the JACK rig's tests"
 _USES_RIG = re.compile(r"(?<![\w.])virtual_rig\b|\bmark\.rig\b")
 
 
-# Seconds of the longest units in an idle `make test` (the rig's: alone, 9 min 56 s wall); the order matters, not
-# the precision. Measured on main 0769005 (--durations=40, the tests of each file summed).
+# Seconds of the longest units; the order matters, not the precision. The rig's: run alone before one BLAS thread
+# per process (tests/conftest.py; 7 min 9 s after, at load ~14); test_large_signal.py: its CPU with one BLAS
+# thread (162 s before); the others: an idle `make test` on main 0769005 (--durations=40, each file's tests summed).
 UNIT_SECONDS = {
     RIG_UNIT: 596.0,
-    "tests/analysis/large_signal/test_large_signal.py": 162.0,
+    "tests/analysis/large_signal/test_large_signal.py": 45.0,
     "tests/reliability/test_fuzz_numbers.py": 127.0,
     "tests/analysis/diagnosis/test_first_site.py": 71.0,
     "tests/reliability/test_fuzz_archive.py": 60.0,
