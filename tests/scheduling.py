@@ -100,7 +100,8 @@ def make_scheduler(config, log):
 
         def _assign_work_unit(self, node) -> None:
             # xdist (3.8) hands out the first unit of self.workqueue; put the longest one there.
-            longest_first(self.workqueue)
+            if self.workqueue:
+                longest_first(self.workqueue)
             super()._assign_work_unit(node)
 
     return FilesAndTheRig(config, log)
