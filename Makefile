@@ -22,8 +22,9 @@ run: setup
 	@bash tools/run-gui.sh
 
 # Three worker processes (pytest-xdist): a test file stays in one worker, the JACK rig's tests all in one
-# (tests/scheduling.py). The rig's tests run in real time and keep their worker busy less than half the time
-# (87 tests: 9 min 56 s wall, 276 s CPU), so on two cores a third worker takes the CPU they leave.
+# (tests/scheduling.py), the longest units first. The rig's tests run in real time and keep their worker busy
+# less than half the time (90 tests: 7 min 9 s wall, 139 s CPU at load ~14, one BLAS thread per process as
+# tests/conftest.py sets), so on two cores a third worker takes the CPU they leave.
 # TEST_WORKERS=0 runs the tests in this process, one after another. The 40 slowest tests are listed at the
 # end: where the suite's time goes, run after run.
 TEST_WORKERS ?= 3

@@ -7,6 +7,14 @@ and their tests run one after another as in a serial run: two real-time rigs
 on the same two cores would each miss their deadlines, and one rig fixture
 per worker would start two JACK servers.
 
+The longest units go out first (longest-processing-time first): xdist hands the
+units out in order of their number of tests, which sent the rig's unit out
+fifth but a one-test file of 71 s last of 170, so that two workers sat idle
+at the end while the third ran it. UNIT_SECONDS names the long units with
+their seconds in an idle run of `make test` (its --durations list); a file
+not named costs 0 and keeps xdist's order after them. A name that no longer
+exists is caught by tests/test_scheduling.py.
+
 xdist's own way to keep tests together (`xdist_group` with `--dist
 loadgroup`) does nothing with pytest 9.2: it renames the tests' ids, which
 pytest no longer reads (pytest-xdist issue 1386). The controller, which
@@ -23,6 +31,36 @@ from pathlib import Path
 RIG_UNIT = "the JACK rig's tests"
 # The rig fixture as a test's argument, or the rig mark; find_virtual_rig and the like are other names.
 _USES_RIG = re.compile(r"(?<![\w.])virtual_rig\b|\bmark\.rig\b")
+
+
+# Seconds of the longest units; the order matters, not the precision. The rig's: run alone before one BLAS thread
+# per process (tests/conftest.py; 7 min 9 s after, at load ~14); test_large_signal.py: its CPU with one BLAS
+# thread (162 s before); the others: an idle `make test` on main 0769005 (--durations=40, each file's tests summed).
+UNIT_SECONDS = {
+    RIG_UNIT: 596.0,
+    "tests/analysis/large_signal/test_large_signal.py": 45.0,
+    "tests/reliability/test_fuzz_numbers.py": 127.0,
+    "tests/analysis/diagnosis/test_first_site.py": 71.0,
+    "tests/reliability/test_fuzz_archive.py": 60.0,
+    "tests/app/cli/test_large_signal.py": 41.0,
+    "tests/reliability/test_three_stations.py": 33.0,
+    "tests/app/wizard/test_wizard.py": 26.0,
+    "tests/app/test_feedback.py": 22.0,
+    "tests/instruments/measurement/test_laser_gaps.py": 19.0,
+    "tests/app/large_signal/test_page.py": 19.0,
+    "tests/app/cli/test_lpm_import.py": 19.0,
+    "tests/analysis/report/test_report.py": 19.0,
+    "tests/analysis/test_api.py": 14.0,
+    "tests/app/test_real_window.py": 10.0,
+    "tests/test_wheel.py": 10.0,
+}
+
+
+def longest_first(queue) -> None:
+    """Moves the unit of the most UNIT_SECONDS to the front of xdist's queue (an ordered dict, unit -> tests);
+    among units of equal seconds (those not named) the first stays first."""
+    unit = max(queue, key=lambda name: UNIT_SECONDS.get(name, 0.0))
+    queue.move_to_end(unit, last=False)
 
 
 @functools.cache
@@ -53,11 +91,17 @@ def unit_of(nodeid: str, rootpath: Path) -> str:
 
 
 def make_scheduler(config, log):
-    """xdist's loadfile, with every rig file in one unit."""
+    """xdist's loadfile, with every rig file in one unit and the longest units handed out first."""
     from xdist.scheduler import LoadFileScheduling
 
     class FilesAndTheRig(LoadFileScheduling):
         def _split_scope(self, nodeid: str) -> str:
             return unit_of(nodeid, Path(config.rootpath))
+
+        def _assign_work_unit(self, node) -> None:
+            # xdist (3.8) hands out the first unit of self.workqueue; put the longest one there.
+            if self.workqueue:
+                longest_first(self.workqueue)
+            super()._assign_work_unit(node)
 
     return FilesAndTheRig(config, log)
