@@ -46,6 +46,7 @@ DOT_HEIGHT = 0.015          # of the y range: ~2 pixels on a panel 150 pixels ta
 # the validity check compares band by band (analysis.validity.spectral). Noise alone puts the two on top of
 # each other; one product 30 dB over the floor among ten bins still stands 20 dB out.
 DISPLAY_BUCKETS = 300
+DB_TO_LN_POWER = np.log(10.0) / 10.0
 LEGEND = (f"<span style='color:{SIGNAL_COLOUR}'>●</span> signal lines &nbsp; "
           f"<span style='color:{DISTORTION_COLOUR}'>●</span> noise + distortion (lines not excited) &nbsp; "
           f"<span style='color:{NOISE_COLOUR}'>—</span> noise floor")
@@ -89,7 +90,8 @@ class LogBuckets:
     def power_mean_db(self, db: np.ndarray) -> np.ndarray:
         """10 log10 of the mean power of each bucket's finite values; NaN for a bucket without any."""
         finite = np.isfinite(db)
-        power = np.add.reduceat(np.where(finite, 10.0 ** (np.where(finite, db, 0.0) / 10.0), 0.0), self.starts)
+        # exp rather than 10 ** x: a third of the time on 13,500 bins, drawn every repaint; exp(-inf) = 0.
+        power = np.add.reduceat(np.exp(np.where(finite, db, -np.inf) * DB_TO_LN_POWER), self.starts)
         count = np.add.reduceat(finite.astype(np.int64), self.starts)
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(count > 0, 10.0 * np.log10(power / np.maximum(count, 1)), np.nan)
