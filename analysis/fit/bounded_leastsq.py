@@ -27,8 +27,9 @@ TINY = 1.0e-15
 # What MINPACK is asked, as lmfit asks it: no gradient test, a small step for the forward differences,
 # MINPACK's own step bound and scaling. Its evaluation limit is twice the fit's own, which ends it first.
 LMDIF_OPTIONS = dict(Dfun=None, full_output=1, col_deriv=0, gtol=0.0, epsfcn=1.0e-10, factor=100, diag=None)
-# Two evaluations before MINPACK starts (scipy's check of the residual's shape counts as one of them) and
-# the final one at the best point: lmfit's count leaves them out.
+# The count a fit reports is lmfit's: it starts at -2, loses one when MINPACK returns and gains the final
+# evaluation at the best point, so it is the evaluations made less three (scipy checks the residual's
+# shape with one before MINPACK starts).
 UNCOUNTED_EVALUATIONS = 2
 
 Residual = Callable[[dict[str, float]], np.ndarray]
