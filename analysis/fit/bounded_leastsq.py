@@ -118,8 +118,9 @@ def gradient_scale(u: float, bound: tuple[float, float]) -> float:
     return np.cos(u) * (hi - lo) / 2.0
 
 
-class _Ended(Exception):
-    """The fit ends here: its callback said so, or the evaluation limit was reached."""
+class _Cancelled(Exception):
+    """The fit is cancelled here (not an error: it returns where it was): its callback said so, or the
+    evaluation limit was reached."""
 
 
 class _Evaluations:
@@ -142,13 +143,13 @@ class _Evaluations:
         self.last_internal = internal
         if self.nfev > self.max_nfev:
             self.hit_limit = True
-            raise _Ended
+            raise _Cancelled
         values = dict(self.values)
         out = self.residual(values)
         if self.iter_cb is not None:
             self.by_callback = bool(self.iter_cb(values, out)) or self.by_callback
         if self.by_callback:
-            raise _Ended
+            raise _Cancelled
         return np.asarray(out, dtype=np.float64).ravel()
 
 
@@ -166,7 +167,7 @@ def bounded_leastsq(residual: Residual, start: Start, *, xtol: float, ftol: floa
     with np.errstate(all="ignore"):
         try:
             best, cov, _, _, ier = leastsq(evaluate, x0, xtol=xtol, ftol=ftol, maxfev=2 * max_nfev, **LMDIF_OPTIONS)
-        except _Ended:
+        except _Cancelled:
             best, cov, ier = evaluate.last_internal, None, -1
         aborted = ier == -1
         evaluate.nfev = min(evaluate.nfev - 1, max_nfev - 1)
@@ -174,7 +175,7 @@ def bounded_leastsq(residual: Residual, start: Start, *, xtol: float, ftol: floa
         try:
             final = evaluate(best)       # the values at `best`, evaluated once more (and counted, as lmfit does)
             chisqr = max(float((final ** 2).sum()), 1.0e-250 * len(final))
-        except _Ended:
+        except _Cancelled:
             pass
         message = _MESSAGES.get(ier, "Tolerance seems to be too small.")
         if ier == 5:
