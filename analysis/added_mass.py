@@ -31,7 +31,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping, Sequence
 
-import lmfit
 import numpy as np
 import uncertainties
 from scipy.optimize import minimize_scalar
@@ -41,6 +40,7 @@ from analysis.curves.fitting import (CurveFitError, FitRange, covariance_with_bo
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import Site
+from analysis.fit.bounded_leastsq import Start, bounded_leastsq
 from analysis.fit.least_squares import ASSUMED_RELATIVE_STD, ChannelFit, FitData, FitResult, fit_model
 from analysis.fit.startvalues import start_context
 from analysis.model.composed import BASE_PARAMS, BL_PARAM, Model, ModelError
@@ -191,19 +191,14 @@ def joint_added_mass(curves: Sequence[MassCurve], effects: Sequence[Effect] | st
         return np.concatenate([part for tf, m in zip(data, masses)
                                for part in relative_residual(curve_impedance(p, tf, m), tf)])
 
-    names = [s.name for s in model.param_specs]
-    params = lmfit.Parameters()
-    for spec in model.param_specs:
-        params.add(_lm(spec.name), value=float(np.clip(values[spec.name], spec.min, spec.max)),
-                   min=spec.min, max=spec.max)
+    start = Start.of({s.name: values[s.name] for s in model.param_specs},
+                     {s.name: (s.min, s.max) for s in model.param_specs})
 
-    def lm_residual(prm):
-        r = residual({n: prm[_lm(n)].value for n in names})
-        return np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
+    def bounded_residual(p):
+        return np.nan_to_num(residual(p), nan=1e12, posinf=1e12, neginf=-1e12)
 
-    result = lmfit.minimize(lm_residual, params, method="leastsq", xtol=1e-12, ftol=1e-12, max_nfev=20000)
-    best = {n: result.params[_lm(n)].value for n in names}
-    fit = _fit_result(model, best, data, masses, [c.name for c in curves], curve_impedance, result)
+    result = bounded_leastsq(bounded_residual, start, xtol=1e-12, ftol=1e-12, max_nfev=20000)
+    fit = _fit_result(model, dict(result.values), data, masses, [c.name for c in curves], curve_impedance, result)
     fit, held = covariance_with_bounds(fit, residual)
     notes = [f"{len(curves)} curves fitted jointly: shared electrical and mechanical parameters, known added "
              f"masses {', '.join(f'{m * 1e3:g} g' for m in masses if m)}"]
@@ -214,10 +209,6 @@ def joint_added_mass(curves: Sequence[MassCurve], effects: Sequence[Effect] | st
     notes.append(str(curve_validity(fit, ranges, data, [])["uncertainties"]))
     return AddedMassResult(f"joint fit of {len(curves)} curves", table, tuple(m for m in masses if m), fit,
                            tuple(notes))
-
-
-def _lm(name: str) -> str:
-    return name + "_" if name == "lambda" else name
 
 
 def _joint_start(model: Model, effects, data, masses) -> dict[str, float]:
@@ -235,7 +226,7 @@ def _joint_start(model: Model, effects, data, masses) -> dict[str, float]:
 
 def _fit_result(model, values, data, masses, labels, curve_impedance, result) -> FitResult:
     channels = {}
-    k = len(result.var_names)
+    k = len(result.varying)
     n_total = sum((2 if tf.has_phase else 1) * len(tf.freqs) for tf in data)
     for label, tf, m in zip(labels, data, masses):
         z = curve_impedance(values, tf, m)
@@ -246,8 +237,7 @@ def _fit_result(model, values, data, masses, labels, curve_impedance, result) ->
         std = ASSUMED_RELATIVE_STD * np.abs(tf.value)
         channels[label] = ChannelFit(label, tf.freqs, tf.value, z, std, chi2, n, chi2 / dof, tf.has_phase)
     chi2 = sum(c.chi2 for c in channels.values())
-    varying = tuple(n[:-1] if n == "lambda_" else n for n in result.var_names)
-    return FitResult(model=model, values=values, stderr={n: None for n in values}, varying=varying, covar=None,
+    return FitResult(model=model, values=values, stderr={n: None for n in values}, varying=result.varying, covar=None,
                      channels=channels, chi2=chi2, n_data=n_total, success=bool(result.success),
                      message=str(result.message), nfev=int(result.nfev), noise_known=False)
 

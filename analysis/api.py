@@ -11,6 +11,7 @@ gives. docs/library.md walks through them. Options are keyword-only: a call read
 """
 from __future__ import annotations
 
+import sys
 import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping, Sequence, Union
@@ -48,8 +49,10 @@ def _recording(source) -> Recording:
 
 
 def _is_curves(source) -> bool:
-    from analysis.curves.imported import ImportedCurves
-    return isinstance(source, ImportedCurves)
+    # Imported curves exist only once their module is loaded: a recording's analysis does not load the curves'
+    # fitting (scipy.ndimage) to find that out.
+    imported = sys.modules.get("analysis.curves.imported")
+    return imported is not None and isinstance(source, imported.ImportedCurves)
 
 
 def analyze(source: Source, *, sd_m2: float | None = None, effects: str | Sequence[str | Effect] | None = None,

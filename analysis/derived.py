@@ -22,7 +22,7 @@ from uncertainties import umath
 
 from analysis.model.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
 
-if TYPE_CHECKING:       # the fit needs lmfit (half a second to import): not for a table of units (`qa stats`)
+if TYPE_CHECKING:       # the fit needs scipy.optimize (half a second to import): not for a table of units (`qa stats`)
     from analysis.fit.least_squares import FitResult
 
 P_REF = 20e-6     # Pa

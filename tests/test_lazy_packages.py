@@ -3,7 +3,7 @@
 analysis.fit, analysis.validity, analysis.diagnosis, analysis.recording, analysis.model and
 app.model_lab each map their public names to the submodule that defines them (_HOME) and import
 it on first use (module-level __getattr__), so `from analysis.fit import FitResult` works and
-`import analysis.fit.words` does not drag in lmfit through the package.
+`import analysis.fit.words` does not drag in scipy.optimize through the package.
 """
 from __future__ import annotations
 

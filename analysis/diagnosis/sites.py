@@ -240,7 +240,7 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
     problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale, dense))
     x0 = np.zeros(problem.k + 2 * problem.n_basis)
     # MINPACK's Levenberg-Marquardt: its own QR, no threaded LAPACK call per step (on a busy machine
-    # OpenBLAS threads made 'trf' 15x slower), and like lmfit's fits it starts from the current fit.
+    # OpenBLAS threads made 'trf' 15x slower), and like the model's fits it starts from the current fit.
     result = least_squares(problem.residual, x0, jac=problem.jacobian, method="lm", x_scale="jac",
                            ftol=TOLERANCE, xtol=TOLERANCE, max_nfev=MAX_EVALUATIONS)
     p = problem.values(result.x)

@@ -22,8 +22,8 @@ from __future__ import annotations
 import threading
 from typing import Mapping
 
-from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _minimize, _params, _values,
-                                        fit_model, result_of)
+from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _minimize, _start, fit_model,
+                                        result_of)
 from analysis.fit.paper import _two_step_covariance, bl_from_hx, free_off_bounds, two_step_start
 from analysis.model.composed import Model
 
@@ -41,13 +41,13 @@ def fit_alternating(data: FitData, model: Model, start: Mapping[str, float] | No
     nfev, success, messages = 0, True, []
     for round_ in range(MAX_ROUNDS):
         before = dict(values)
-        z_step = _minimize(model, _params(model, values, second), data, False, sigmas, cancel, per_parameter)
-        values = _values(z_step.params)
+        z_step = _minimize(model, _start(model, values, second), data, False, sigmas, cancel, per_parameter)
+        values = dict(z_step.values)
         if round_ == 0 and "Bl" not in (start or {}):
             values["Bl"] = bl_from_hx(model, values, data, sigmas)
-        x_step = _minimize(model, _params(model, values, first), data, True, sigmas, cancel, per_parameter,
+        x_step = _minimize(model, _start(model, values, first), data, True, sigmas, cancel, per_parameter,
                            use_z=False)
-        values = _values(x_step.params)
+        values = dict(x_step.values)
         nfev += z_step.nfev + x_step.nfev
         success = bool(z_step.success and x_step.success)
         messages = [f"Z step: {z_step.message}", f"Hx step: {x_step.message}"]

@@ -13,23 +13,22 @@ models fitted to the same data are what the model lab ranks by. Curves
 imported without a noise estimate use the unknown-variance forms,
 n ln(chi^2/n) in place of chi^2.
 
-Standard errors come from the Jacobian at the optimum (lmfit/MINPACK),
+Standard errors come from the Jacobian at the optimum (MINPACK's, analysis.fit.bounded_leastsq),
 scaled by sqrt(max(1, reduced chi^2)) (the Birge ratio) so that a model
 that does not fit never claims the precision of one that does.
 """
 from __future__ import annotations
 
 import functools
-import keyword
 import threading
 from dataclasses import dataclass
 from typing import Callable, Mapping
 
-import lmfit
 import numpy as np
 
 from analysis.effects.base import Site
 from analysis.errors import LinparError
+from analysis.fit.bounded_leastsq import LeastSquaresResult, Start, bounded_leastsq
 from analysis.fit.covariance import jacobian, normal_inverse
 from analysis.fit.stall import StallWatch
 from analysis.fit.startvalues import linear_gain, start_context
@@ -194,59 +193,36 @@ def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x:
     return np.concatenate(parts)
 
 
-def _lm_name(name: str) -> str:
-    """lmfit names must be identifiers: 'lambda' is a Python keyword."""
-    return name + "_" if keyword.iskeyword(name) else name
+def _start(model: Model, values: Mapping[str, float], fixed: set[str]) -> Start:
+    """Every parameter of `model` from `values` (clipped into its bounds); all but `fixed` vary."""
+    return Start.of({spec.name: values[spec.name] for spec in model.param_specs},
+                    {spec.name: (spec.min, spec.max) for spec in model.param_specs}, fixed)
 
 
-@functools.lru_cache(maxsize=None)
-def _our_name(lm_name: str) -> str:
-    base = lm_name[:-1]
-    return base if lm_name.endswith("_") and keyword.iskeyword(base) else lm_name
-
-
-def _params(model: Model, values: Mapping[str, float], fixed: set[str]) -> lmfit.Parameters:
-    params = lmfit.Parameters()
-    for spec in model.param_specs:
-        value = float(np.clip(values[spec.name], spec.min, spec.max))
-        params.add(_lm_name(spec.name), value=value, min=spec.min, max=spec.max,
-                   vary=spec.name not in fixed)
-    return params
-
-
-def _values(params: lmfit.Parameters) -> dict[str, float]:
-    return {_our_name(name): p.value for name, p in params.items()}
-
-
-def _minimize(model, params, data, use_x, sigmas, cancel,
-              per_parameter: int = EVALUATIONS_PER_PARAMETER, use_z: bool = True) -> lmfit.minimizer.MinimizerResult:
-    names = [(lm_name, _our_name(lm_name)) for lm_name in params]    # worked out once, not per evaluation
-
-    def residual(prm):
-        r = _residual_vector(model, {ours: prm[lm_name].value for lm_name, ours in names}, data, use_x, sigmas,
-                             use_z)
+def _minimize(model, start: Start, data, use_x, sigmas, cancel,
+              per_parameter: int = EVALUATIONS_PER_PARAMETER, use_z: bool = True) -> LeastSquaresResult:
+    def residual(values):
+        r = _residual_vector(model, values, data, use_x, sigmas, use_z)
         # A parameter set where the model is undefined is simply very bad:
         # a fixed size keeps MINPACK's bookkeeping intact.
         return r if np.isfinite(r).all() else np.nan_to_num(r, nan=1e12, posinf=1e12, neginf=-1e12)
 
-    n_varying = sum(1 for p in params.values() if p.vary)
-    watch = StallWatch(n_varying)
+    watch = StallWatch(len(start.varying))
 
-    def iteration(prm, it, resid, *args, **kws):
+    def iteration(values, resid):
         if cancel is not None and cancel.is_set():
-            return True      # True aborts lmfit
-        return watch.seen(prm, resid)
+            return True      # ends the fit
+        return watch.seen(values, resid)
 
-    minimizer = lmfit.Minimizer(residual, params, iter_cb=iteration, scale_covar=False, nan_policy="propagate")
     # MINPACK's own default budget is 200*(k+1) evaluations; a well-posed fit
     # here needs far fewer. A candidate whose parameters are nearly degenerate
     # would otherwise wander for many thousands.
-    result = minimizer.minimize(method="leastsq", xtol=1e-12, ftol=1e-12,
-                                max_nfev=per_parameter * (n_varying + 1))
+    result = bounded_leastsq(residual, start, xtol=1e-12, ftol=1e-12,
+                             max_nfev=per_parameter * (len(start.varying) + 1), iter_cb=iteration)
     if cancel is not None and cancel.is_set():
         raise FitCancelled("fit cancelled")
     # Stopped where it had stopped improving (analysis.fit.stall): polished from its best point.
-    return watch.polished(residual, params, result)
+    return watch.polished(residual, start, result)
 
 
 def start_values(model: Model, data: FitData) -> dict[str, float]:
@@ -275,7 +251,7 @@ def screen_fit(data: FitData, model: Model, start: Mapping[str, float], vary: se
     sigmas = channel_sigmas(data, use_x)
     values = {**start_values(model, data), **{k: v for k, v in start.items()}}
     values = {spec.name: values[spec.name] for spec in model.param_specs}
-    result = _minimize(model, _params(model, values, set(values) - vary), data, use_x, sigmas, None, per_parameter)
+    result = _minimize(model, _start(model, values, set(values) - vary), data, use_x, sigmas, None, per_parameter)
     return _result(model, result, data, use_x, sigmas, result.nfev)
 
 
@@ -300,13 +276,13 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
     # Stage 1: Z alone. Creep barely shows in Z: hold it until Hx joins in.
     fixed = {"Bl"} | displacement_only | (compliance & cold if use_x else set())
     if cold - fixed:
-        r = _minimize(model, _params(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel,
+        r = _minimize(model, _start(model, values, fixed | (set(values) - cold)), data, False, sigmas, cancel,
                       per_parameter)
-        values = _values(r.params)
+        values = dict(r.values)
         nfev += r.nfev
         if compliance & cold and not use_x:
-            r = _minimize(model, _params(model, values, set()), data, False, sigmas, cancel, per_parameter)
-            values = _values(r.params)
+            r = _minimize(model, _start(model, values, set()), data, False, sigmas, cancel, per_parameter)
+            values = dict(r.values)
             nfev += r.nfev
     # Stage 2: Bl is a pure gain on Hx: solve for it linearly.
     if use_x and "Bl" in cold:
@@ -315,24 +291,24 @@ def fit_model(data: FitData, model: Model, start: Mapping[str, float] | None = N
         inv_bl = linear_gain(g if x.has_phase else np.abs(g), x.value, sigmas["displacement"])
         values["Bl"] = abs(1.0 / inv_bl) if inv_bl != 0 else 1.0
     # Stage 3: everything together.
-    result = _minimize(model, _params(model, values, set()), data, use_x, sigmas, cancel, per_parameter)
+    result = _minimize(model, _start(model, values, set()), data, use_x, sigmas, cancel, per_parameter)
     if result.covar is None:
-        # lmfit gives no covariance when a parameter ends on a bound (its bound
+        # MINPACK gives no covariance when a parameter ends on a bound (the bound
         # transform has zero slope there): hold those at the bound, refit the rest.
-        held = _at_bounds(model, result.params)
+        held = _at_bounds(model, result)
         if held:
             nfev += result.nfev
-            result = _minimize(model, _params(model, _values(result.params), held), data, use_x, sigmas, cancel,
+            result = _minimize(model, _start(model, result.values, held), data, use_x, sigmas, cancel,
                                per_parameter)
     if result.covar is None:        # MINPACK stopped without one ("tolerance too small"): from the Jacobian
         return _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev + result.nfev)
     return _result(model, result, data, use_x, sigmas, nfev + result.nfev)
 
 
-def _with_jacobian_covariance(model, result, data, use_x, sigmas, nfev) -> FitResult:
-    values = _values(result.params)
+def _with_jacobian_covariance(model, result: LeastSquaresResult, data, use_x, sigmas, nfev) -> FitResult:
+    values = result.values
     specs = {s.name: s for s in model.param_specs}
-    free = tuple(n for n in (_our_name(v) for v in result.var_names) if not specs[n].on_bound(values[n]))
+    free = tuple(n for n in result.varying if not specs[n].on_bound(values[n]))
     J = jacobian(lambda p: _residual_vector(model, p, data, use_x, sigmas), values, free, specs)
     return result_of(model, values, free, normal_inverse(J), data, use_x, sigmas, bool(result.success),
                      str(result.message), int(nfev))
@@ -346,20 +322,20 @@ def _check_effects(model: Model, data: FitData, values: Mapping[str, float]) -> 
         effect.check_finite(s, values, "the fitted lines")
 
 
-def _at_bounds(model: Model, params: lmfit.Parameters) -> set[str]:
+def _at_bounds(model: Model, result: LeastSquaresResult) -> set[str]:
     held = set()
-    for lm_name, p in params.items():
-        name = _our_name(lm_name)
-        scale = max(abs(p.value), abs(model.spec(name).default), 1e-30)
-        if p.vary and min(p.value - p.min, p.max - p.value) <= 1e-6 * scale:
+    for name in result.varying:
+        value, spec = result.values[name], model.spec(name)
+        scale = max(abs(value), abs(spec.default), 1e-30)
+        if min(value - spec.min, spec.max - value) <= 1e-6 * scale:
             held.add(name)
     return held
 
 
-def _result(model, result, data, use_x, sigmas, nfev) -> FitResult:
+def _result(model, result: LeastSquaresResult, data, use_x, sigmas, nfev) -> FitResult:
     covar = None if result.covar is None else np.asarray(result.covar)
-    return result_of(model, _values(result.params), tuple(_our_name(n) for n in result.var_names), covar, data,
-                     use_x, sigmas, bool(result.success), str(result.message), int(nfev))
+    return result_of(model, dict(result.values), result.varying, covar, data, use_x, sigmas, bool(result.success),
+                     str(result.message), int(nfev))
 
 
 def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], covar: np.ndarray | None,

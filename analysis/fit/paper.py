@@ -28,9 +28,8 @@ import numpy as np
 
 from analysis.effects.base import Site
 from analysis.fit.covariance import jacobian, normal_inverse
-from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _lm_name,
-                                        _minimize, _params, _residual_vector, _values, channel_sigmas, fit_model,
-                                        result_of, start_values)
+from analysis.fit.least_squares import (EVALUATIONS_PER_PARAMETER, FitData, FitResult, _check_effects, _minimize,
+                                        _residual_vector, _start, channel_sigmas, fit_model, result_of, start_values)
 from analysis.fit.startvalues import linear_gain
 from analysis.model.composed import Model
 
@@ -75,18 +74,18 @@ def fit_paper(data: FitData, model: Model, start: Mapping[str, float] | None = N
     sigmas, values, first, second = two_step_start(data, model, start)
     creep = {s.name for e in model.effects if e.site is Site.COMPLIANCE for s in e.params}
     # Step 1, Z alone: the creep held at its start first (it barely shows in Z), then free with the rest.
-    r0 = _minimize(model, _params(model, values, second), data, False, sigmas, cancel, per_parameter)
-    r1 = _minimize(model, _params(model, _values(r0.params), second - creep), data, False, sigmas, cancel,
+    r0 = _minimize(model, _start(model, values, second), data, False, sigmas, cancel, per_parameter)
+    r1 = _minimize(model, _start(model, r0.values, second - creep), data, False, sigmas, cancel,
                    per_parameter) if creep else r0
-    values = _values(r1.params)
+    values = dict(r1.values)
     if "Bl" not in (start or {}):
         values["Bl"] = bl_from_hx(model, values, data, sigmas)
     # Step 2, Hx alone: Bl and the creep, what Z gave held.
-    r2 = _minimize(model, _params(model, values, first), data, True, sigmas, cancel, per_parameter, use_z=False)
-    values = _values(r2.params)
+    r2 = _minimize(model, _start(model, values, first), data, True, sigmas, cancel, per_parameter, use_z=False)
+    values = dict(r2.values)
     nfev = r0.nfev + (r1.nfev if creep else 0) + r2.nfev
     free1, free2 = free_off_bounds(model, values, first), free_off_bounds(model, values, second)
-    z_values = {**values, **{n: r1.params[_lm_name(n)].value for n in creep}}
+    z_values = {**values, **{n: r1.values[n] for n in creep}}
     covar = _two_step_covariance(model, values, z_values, data, sigmas, free1, free2, creep)
     return result_of(model, values, tuple(free1 + free2), covar, data, True, sigmas,
                      bool(r1.success and r2.success), f"Z step: {r1.message}; Hx step: {r2.message}", int(nfev),

@@ -4,12 +4,17 @@ A fit whose chi^2 has not dropped by more than STALL_CHI2 (in noise units) and S
 over STALL_ITERATIONS iterations has stopped: it wanders along a direction the data do not determine
 (an effect that is not there) or crawls along a parameter held at its bound, which MINPACK's own tests
 can follow for thousands of evaluations. At that pace halving chi^2 would take 10^5 iterations.
-analysis.fit.least_squares ends such a fit through lmfit's iteration callback and polishes it from its best point.
+analysis.fit.least_squares ends such a fit through its iteration callback (analysis.fit.bounded_leastsq) and polishes
+it from its best point.
 """
 from __future__ import annotations
 
-import lmfit
+import dataclasses
+from typing import Callable, Mapping
+
 import numpy as np
+
+from analysis.fit.bounded_leastsq import LeastSquaresResult, Start, bounded_leastsq
 
 STALL_CHI2 = 1e-3
 STALL_RELATIVE = 1e-5
@@ -25,36 +30,29 @@ class StallWatch:
         self.n_varying = n_varying
         self.window = STALL_ITERATIONS * (n_varying + 1)      # an iteration costs a Jacobian: n + 1 evaluations
         self.best = np.inf
-        self.best_values: dict[str, float] | None = None      # plain floats: copying Parameters costs a fit
+        self.best_values: dict[str, float] | None = None
         self.since = 0
         self.stalled = False
 
-    def seen(self, params: lmfit.Parameters, residual: np.ndarray) -> bool:
-        """Record one evaluation; True (lmfit's "abort") once the fit has stalled."""
+    def seen(self, values: Mapping[str, float], residual: np.ndarray) -> bool:
+        """Record one evaluation; True (end the fit) once the fit has stalled."""
         chi2 = float(np.dot(residual, residual))
         if chi2 < self.best - max(STALL_CHI2, STALL_RELATIVE * self.best):
             self.since = 0
         else:
             self.since += 1
         if chi2 < self.best:
-            self.best, self.best_values = chi2, {name: p.value for name, p in params.items()}
+            self.best, self.best_values = chi2, dict(values)
         self.stalled = self.since > self.window
         return self.stalled
 
-    def best_params(self, params: lmfit.Parameters) -> lmfit.Parameters:
-        best = params.copy()
-        for name, value in self.best_values.items():
-            best[name].value = value
-        return best
-
-    def polished(self, residual, params: lmfit.Parameters,
-                 result: lmfit.minimizer.MinimizerResult) -> lmfit.minimizer.MinimizerResult:
+    def polished(self, residual: Callable[[dict[str, float]], np.ndarray], start: Start,
+                 result: LeastSquaresResult) -> LeastSquaresResult:
         """After a stalled fit, a short fit from its best point, which gives the covariance; `result` when
         the fit did not stall, or when the polish neither gets a covariance nor keeps the best chi^2."""
         if not self.stalled or self.best_values is None:
             return result
-        polish = lmfit.Minimizer(residual, self.best_params(params), scale_covar=False, nan_policy="propagate")
-        polished = polish.minimize(method="leastsq", xtol=POLISH_TOLERANCE, ftol=POLISH_TOLERANCE,
-                                   max_nfev=POLISH_PER_PARAMETER * (self.n_varying + 1))
-        polished.nfev += result.nfev
+        polished = bounded_leastsq(residual, start.moved_to(self.best_values), xtol=POLISH_TOLERANCE,
+                                   ftol=POLISH_TOLERANCE, max_nfev=POLISH_PER_PARAMETER * (self.n_varying + 1))
+        polished = dataclasses.replace(polished, nfev=polished.nfev + result.nfev)
         return polished if polished.covar is not None or polished.chisqr <= self.best else result

@@ -36,7 +36,6 @@ from dataclasses import dataclass
 from typing import Mapping
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import ValidityThresholds
@@ -123,6 +122,7 @@ def interpolated_transfer(line_freqs: np.ndarray, h: np.ndarray, freqs: np.ndarr
     """H at `freqs` from its values at the excited lines: cubic spline of Re and Im in log f."""
     if line_freqs.size < 4:
         return np.interp(freqs, line_freqs, h.real) + 1j * np.interp(freqs, line_freqs, h.imag)
+    from scipy.interpolate import CubicSpline      # 0.1 s to import: only when the voltage carries off its lines
     return CubicSpline(np.log(line_freqs), h, extrapolate=True)(np.log(freqs))
 
 

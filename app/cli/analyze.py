@@ -34,8 +34,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def analyze_recording(args: argparse.Namespace) -> int:
-    from analysis import limits as qa
     from analysis.api import analyze
+    if args.limits:
+        from analysis import limits as qa
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
     # With the model part of each uncertainty (refits when the model misses the data by more than its noise).
     result = analyze(args.path, sd_m2=args.sd, effects=model_effects(args.model), method=args.method or "joint")

@@ -24,6 +24,30 @@ class CliError(LinparError):
 
 
 class Parser(argparse.ArgumentParser):
+    """linpar's parsers. `fill(parser)`, if given, adds the options that cost imports (a registry's) when this
+    parser is first used, to parse its command or show its help: not for every other command."""
+
+    def __init__(self, *args, fill: Callable[["Parser"], None] | None = None, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._fill = fill
+
+    def _filled(self) -> None:
+        fill, self._fill = self._fill, None
+        if fill is not None:
+            fill(self)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self._filled()
+        return super().parse_known_args(args, namespace)
+
+    def format_usage(self) -> str:
+        self._filled()
+        return super().format_usage()
+
+    def format_help(self) -> str:
+        self._filled()
+        return super().format_help()
+
     def error(self, message: str):  # one line, no usage dump: scripts read stderr
         raise CliError(f"{message} (see '{self.prog} --help')")
 

@@ -19,7 +19,7 @@ from analysis.session import software
 
 GUIDE = "guide.md"
 # The libraries linpar is built on (pyproject.toml's dependencies), for About.
-DEPENDENCIES = ("PySide6-Essentials", "pyqtgraph", "numpy", "scipy", "lmfit", "uncertainties", "matplotlib",
+DEPENDENCIES = ("PySide6-Essentials", "pyqtgraph", "numpy", "scipy", "uncertainties", "matplotlib",
                 "sounddevice", "pyserial", "JACK-Client")
 
 

@@ -6,7 +6,7 @@ clocks.py for how the laser's clock is put on the audio's, raw_stream.py
 for the raw laser file beside each recording.
 
 Names are loaded on first use (PEP 562), as in instruments.audio: the CLI
-builds its parser from TEMPLATES without loading the runner (and lmfit).
+builds its parser from TEMPLATES without loading the runner (and the fit's scipy.optimize).
 """
 from importlib import import_module
 

@@ -97,14 +97,14 @@ def test_linear_grids_are_thinned_log_grids_are_not():
 
 
 def test_a_parameter_on_its_bound_is_held_and_the_others_get_uncertainties():
-    # lmfit gives no covariance when a parameter ends on a bound (its transform has zero slope there).
+    # MINPACK gives no covariance when a parameter ends on a bound (the bound transform has zero slope there).
     values = dict(PAPER.parameters)
     z, x = curve(values, "impedance", noise=0.005), curve(values, "displacement", noise=0.005, seed=1)
     fit = fit_curves(z, x, "lr2,creep-log", None, FitRange(hx_f_max=1e5)).fit
     data, _ = curve_data(z, x, FitRange(hx_f_max=1e5))          # the lines and noise the fit saw
     residual = lambda v: weighted_residual(fit.model, v, data)    # noqa: E731
     no_covar = dataclasses.replace(fit, covar=None, stderr={n: None for n in fit.values})
-    again, held = covariance_with_bounds(no_covar, residual)      # the Jacobian's covariance is lmfit's
+    again, held = covariance_with_bounds(no_covar, residual)      # the Jacobian's covariance is MINPACK's
     assert held == []
     for name in ("Bl", "CMES", "RE", "lambda"):
         assert again.stderr[name] == pytest.approx(fit.stderr[name], rel=0.02), name

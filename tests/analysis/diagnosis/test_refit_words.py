@@ -45,7 +45,8 @@ def test_a_parameter_on_its_bound_is_named_with_what_to_try(fitted):
                    if spec.name == "lambda" else spec for spec in creep.params)
     model = Model((lr2, dataclasses.replace(creep, params=narrow)))
     pinned = fit_model(data, model, start=fit.values)
-    # lmfit's bound transform leaves it a hair inside (2e-5 of itself): the words are tested on it held there.
+    # The bound transform (analysis.fit.bounded_leastsq) leaves it a hair inside (2e-5 of itself): the words are
+    # tested on it held there.
     assert pinned.values["lambda"] > 0.99 * model.spec("lambda").max
     pinned = dataclasses.replace(pinned, values={**pinned.values, "lambda": model.spec("lambda").max})
     text = refit_text(fit, pinned)

@@ -1,4 +1,5 @@
-"""FitResult.report(): lmfit's fit report for our fits, the same in the CLI, the Model lab and the reports."""
+"""FitResult.report(): a report in the form of lmfit's fit_report for our fits, the same in the CLI, the Model lab
+and the reports."""
 from __future__ import annotations
 
 import dataclasses

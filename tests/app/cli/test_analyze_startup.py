@@ -1,0 +1,53 @@
+"""`linpar analyze REC --json` imports what it uses: its start-up is most of its time (bench/analysis_bench.py's
+startup rows), and every library it loads without calling is paid on every run."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+import analysis
+from analysis.recording.format import write_recording
+from app.cli.boundary import main
+from tests.fresh_import import REPO
+from tests.pace import paced
+
+# Loaded by other commands, never called by the analysis of a recording: the imported curves' fitting
+# (scipy.ndimage), the export formats (the parser offers them to `linpar export` only), the limits (--limits
+# only), the cubic spline (validity, only when the voltage carries off its lines: not on a clean recording),
+# the statistics, the plots, Qt, and lmfit (no longer used).
+NOT_LOADED = ("analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
+              "scipy.stats", "matplotlib", "PySide6", "pyqtgraph", "lmfit")
+
+RUN_AND_LIST = ("import contextlib, io, sys\n"
+                "from app.cli.boundary import main\n"
+                "out = io.StringIO()\n"
+                "with contextlib.redirect_stdout(out):\n"
+                "    code = main(['analyze', sys.argv[1], '--json'])\n"
+                "print(code)\n"
+                "print(','.join(sorted(sys.modules)))\n"
+                "print(out.getvalue())\n")
+
+
+def test_analyze_of_a_recording_loads_no_module_it_does_not_call(tmp_path):
+    path = tmp_path / "clean"
+    write_recording(path, analysis.synthesize(noise=analysis.TYPICAL_NOISE))
+    out = subprocess.run([sys.executable, "-c", RUN_AND_LIST, str(path)], cwd=REPO, capture_output=True, text=True,
+                         timeout=paced(300))
+    assert out.returncode == 0, out.stderr
+    code, modules, doc = out.stdout.split("\n", 2)
+    assert code == "0" and json.loads(doc)["parameters"]["Bl"]["value"] > 0      # it did analyse
+    loaded = [m for m in modules.split(",") if m.startswith(NOT_LOADED) or m.split(".")[0] in NOT_LOADED]
+    assert loaded == []
+
+
+def test_export_still_offers_every_format_of_the_registry(capsys):
+    from app.cli.report import export_options
+    with pytest.raises(SystemExit) as help_shown:
+        main(["export", "--help"])
+    assert help_shown.value.code == 0
+    shown = " ".join(capsys.readouterr().out.split())      # argparse wraps at the terminal's width
+    for kind, what in export_options():
+        assert f"--{kind.replace('_', '-')} FILE" in shown and what in shown
