@@ -60,5 +60,10 @@ def piston_band(data: FitData, fs: float) -> FitData | None:
 
 def bands_hz(data: FitData) -> dict[str, list[float]]:
     """channel -> [lowest, highest] line fitted, in Hz (JSON-ready)."""
-    return {tf.name: [float(tf.freqs[0]), float(tf.freqs[-1])]
-            for tf in (data.impedance, data.displacement) if tf is not None and len(tf.freqs)}
+    return curves_band_hz((data.impedance, data.displacement))
+
+
+def curves_band_hz(curves) -> dict[str, list[float]]:
+    """name -> [lowest, highest] line of each curve with lines (anything with `name` and `freqs`: a
+    TransferFunction, a fit's ChannelFit), in Hz (JSON-ready)."""
+    return {c.name: [float(c.freqs[0]), float(c.freqs[-1])] for c in curves if c is not None and len(c.freqs)}

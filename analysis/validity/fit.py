@@ -32,6 +32,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
+from analysis.fit.bands import curves_band_hz
 from analysis.fit.error import FIT_ERROR_DEFAULTS, fit_error_percent
 from analysis.fit.least_squares import FitResult
 from analysis.qa_interval import FAIL, PASS, UNCERTAIN
@@ -118,8 +119,7 @@ def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT
     lights = [Severity(ch["status"]) for ch in channels.values() if ch.get("status") in set(Severity)]
     return {**validity, "channels": channels, "overall": str(worst(lights)) if channels else
             validity.get("overall", "unknown"), "fit_error_percent": fit_error_percent(fit),
-            "fit_band_hz": {name: [float(ch.freqs[0]), float(ch.freqs[-1])] for name, ch in fit.channels.items()
-                            if len(ch.freqs)}}
+            "fit_band_hz": curves_band_hz(fit.channels.values())}
 
 
 def red_findings_text(validity: Mapping) -> str:
