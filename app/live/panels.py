@@ -40,13 +40,9 @@ NOISE_COLOUR = "#606060"
 GRID_COLOUR = "#d9d9d9"
 RANGE_STEP_DB = 10.0
 DOT_HEIGHT = 0.015          # of the y range: ~2 pixels on a panel 150 pixels tall, plus the pen's width
-# Thousands of unexcited bins per channel cost ~100 ms a repaint (with the GIL held: the audio thread waits);
-# a plot ~1000 pixels wide cannot show more than a few hundred columns anyway. So the noise floor and the
-# noise + distortion are reduced to DISPLAY_BUCKETS log-spaced buckets, each the power mean of its bins: what
-# the validity check compares band by band (analysis.validity.spectral). Noise alone puts the two on top of
-# each other; one product 30 dB over the floor among ten bins still stands 20 dB out.
-DISPLAY_BUCKETS = 300
-DB_TO_LN_POWER = np.log(10.0) / 10.0
+# The noise floor and the noise + distortion come in a few hundred log-spaced buckets, worked out with the
+# frame in the measurement thread (analysis.live, analysis.log_buckets): thousands of bins per channel drawn
+# here cost ~100 ms a repaint, with the GIL held (the audio thread waits).
 LEGEND = (f"<span style='color:{SIGNAL_COLOUR}'>●</span> signal lines &nbsp; "
           f"<span style='color:{DISTORTION_COLOUR}'>●</span> noise + distortion (lines not excited) &nbsp; "
           f"<span style='color:{NOISE_COLOUR}'>—</span> noise floor")
@@ -74,27 +70,6 @@ class CompactPlotWidget(pg.PlotWidget):
 
     def sizeHint(self) -> QSize:
         return QSize(400, 80)
-
-
-class LogBuckets:
-    """Sorted frequencies grouped into log-spaced buckets: starts of the groups and their centre frequencies."""
-
-    def __init__(self, freqs: np.ndarray, n_buckets: int = DISPLAY_BUCKETS):
-        log_f = np.log10(freqs)
-        edges = np.linspace(log_f[0], log_f[-1], n_buckets + 1)
-        index = np.clip(np.searchsorted(edges, log_f, side="right") - 1, 0, n_buckets - 1)
-        self.starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
-        counts = np.diff(np.r_[self.starts, freqs.size])
-        self.freqs = 10.0 ** (np.add.reduceat(log_f, self.starts) / counts)
-
-    def power_mean_db(self, db: np.ndarray) -> np.ndarray:
-        """10 log10 of the mean power of each bucket's finite values; NaN for a bucket without any."""
-        finite = np.isfinite(db)
-        # exp rather than 10 ** x: a third of the time on 13,500 bins, drawn every repaint; exp(-inf) = 0.
-        power = np.add.reduceat(np.exp(np.where(finite, db, -np.inf) * DB_TO_LN_POWER), self.starts)
-        count = np.add.reduceat(finite.astype(np.int64), self.starts)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(count > 0, 10.0 * np.log10(power / np.maximum(count, 1)), np.nan)
 
 
 def _visible(db: np.ndarray) -> np.ndarray:
@@ -143,9 +118,6 @@ class LiveChannelPanel(QWidget):
             plot.addItem(item)
         self._freqs_key: tuple | None = None
         self._x_span = (1.0, 10.0)
-        self._order: np.ndarray | None = None
-        self._merged: LogBuckets | None = None
-        self._others: LogBuckets | None = None
         self._y_range: tuple[float, float] | None = None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -167,17 +139,14 @@ class LiveChannelPanel(QWidget):
             self._unit = ch.unit
             self.plot.setLabel("left", UNIT_WORDS.get(ch.unit, f"dB re 1 {ch.unit}"))
         self._set_frequencies(frame)
-        line_db, other_db = _visible(ch.line_db), _visible(ch.other_db)
-        noise = np.concatenate([_visible(ch.line_noise_db), _visible(ch.other_noise_db)])[self._order]
-        other_db = self._others.power_mean_db(other_db)
-        noise = self._merged.power_mean_db(noise)
+        line_db, other_db, noise = _visible(ch.line_db), ch.other_db, ch.noise_db      # buckets: NaN for none
         offset = UNIT_OFFSET_DB.get(ch.unit, 0.0)
         if offset:
             line_db, other_db, noise = line_db + offset, other_db + offset, noise + offset
         self._set_y_range(line_db, other_db, noise)
         self._dots(self.lines, frame.line_freqs, line_db, DOT_HEIGHT)
-        self._dots(self.distortion, self._others.freqs, other_db, DOT_HEIGHT * 0.5)
-        self.noise.setData(self._merged.freqs, noise)
+        self._dots(self.distortion, frame.other_freqs, other_db, DOT_HEIGHT * 0.5)
+        self.noise.setData(frame.noise_freqs, noise)
 
     def _dots(self, item: pg.PlotDataItem, freqs: np.ndarray, db: np.ndarray, height: float) -> None:
         """Each point a vertical segment `height` of the y range tall (with the pen's width: a dot)."""
@@ -187,16 +156,13 @@ class LiveChannelPanel(QWidget):
         item.setData(np.repeat(freqs[shown], 2), np.column_stack([y - half, y + half]).ravel())
 
     def _set_frequencies(self, frame: LiveFrame) -> None:
-        key = (frame.line_freqs.size, frame.other_freqs.size, float(frame.line_freqs[0]),
-               float(frame.line_freqs[-1]))
+        """The frequency axis spans the band, first to last excited line; set when the lines change."""
+        key = (frame.line_freqs.size, float(frame.line_freqs[0]), float(frame.line_freqs[-1]),
+               frame.noise_freqs.size)
         if key == self._freqs_key:
             return
         self._freqs_key = key
-        merged = np.concatenate([frame.line_freqs, frame.other_freqs])
-        self._order = np.argsort(merged, kind="stable")
-        self._merged = LogBuckets(merged[self._order])
-        self._others = LogBuckets(frame.other_freqs)        # sorted already (analysis.live)
-        lo, hi = np.log10(merged.min()), np.log10(merged.max())
+        lo, hi = np.log10(frame.line_freqs[0]), np.log10(frame.line_freqs[-1])
         self.plot.setXRange(lo, hi, padding=0.02)
         self._x_span = (10 ** (lo - 0.05), 10 ** (hi + 0.05))
         self._y_range = None               # new lines: the grid is redrawn with the next range
