@@ -13,15 +13,18 @@ advises: drawing every frame of a fast simulator would starve the event loop.
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QSize, Qt, QTimer, Signal
-from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
+from PySide6.QtGui import QTextDocument
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from analysis.live import DB_FLOOR, LiveFrame
 from analysis.recording.format import UNITS
+from app.jobs.next_turn import in_a_later_turn
 from app.widgets import style
 from app.widgets.grid_axis import show_grid
 from app.widgets.plot_placeholder import PlotPlaceholder
@@ -30,9 +33,10 @@ from app.widgets.traffic_light import CHANNELS, ChannelLight
 
 REPAINT_HZ = 30
 REPAINT_INTERVAL_MS = 1000 // REPAINT_HZ + 1      # 34 ms: never above 30 repaints a second
-# Qt lets a late timer catch up with its schedule (a tick 18 ms after a late one): a repaint that soon waits.
-# Not a whole 1/30 s: a tick a millisecond early would then be skipped, halving the rate.
-MIN_REPAINT_GAP_S = 0.9 / REPAINT_HZ
+# Qt lets a late timer catch up with its schedule (a tick soon after a late one), never more than one tick per
+# interval on average: a repaint closer than this to the last one waits. Half an interval: with 0.9 of one,
+# every tick more than 3 ms late (common on a busy machine) cost the next tick too, ~22 instead of 29 a second.
+MIN_REPAINT_GAP_S = 0.5 / REPAINT_HZ
 IDLE_TICKS = 30                                   # stop the timer after ~1 s without a new frame
 SIGNAL_COLOUR = style.MEASURED
 DISTORTION_COLOUR = "#e08a00"
@@ -206,12 +210,23 @@ class LivePanels(QWidget):
         for panel in self.panels.values():
             panel.empty_text = empty_text
             panel.placeholder.show_text(empty_text)
-        self.status = QLabel("No measurement running: the spectra appear here period by period.")
-        self.status.setWordWrap(True)
+        # What changes with each frame (periods averaged, peak excursion) in a label of a fixed size, grown
+        # when a text needs more: a label that may change size re-lays the page out at every text, 5-7 ms
+        # of the GUI thread a repaint. The colours' legend beside it does not change.
+        self.status = QLabel()
         self.status.setTextFormat(Qt.RichText)
+        self.legend = QLabel(LEGEND)
+        self.legend.setWordWrap(True)
+        self.legend.setTextFormat(Qt.RichText)
+        self.legend.setVisible(False)
+        top = QHBoxLayout()
+        top.setContentsMargins(0, 0, 0, 0)
+        top.addWidget(self.status, 0, Qt.AlignLeft)          # at the left also while the legend is hidden
+        top.addWidget(self.legend, 1)
+        self._set_status("No measurement running: the spectra appear here period by period.", fit=True)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.status)
+        layout.addLayout(top)
         for panel in self.panels.values():
             layout.addWidget(panel, 1)
         self.timer = QTimer(self)
@@ -262,13 +277,25 @@ class LivePanels(QWidget):
             return
         panels[0].show_frame(frame)
         if len(panels) > 1:
-            QTimer.singleShot(0, self, lambda: self._draw_channel(drawing, frame, panels[1:]))
+            in_a_later_turn(self, lambda: self._draw_channel(drawing, frame, panels[1:]))
             return
         peak = frame.peak_displacement_m
         peak_text = f", peak excursion {peak * 1e3:.3f} mm" if peak is not None else ""
-        self.status.setText(f"<b>{frame.n_periods} period{'s' if frame.n_periods != 1 else ''} averaged</b>"
-                            f"{peak_text}. {LEGEND}")
+        self._set_status(f"<b>{frame.n_periods} period{'s' if frame.n_periods != 1 else ''} averaged</b>"
+                         f"{peak_text}.")
         self.repainted.emit(frame.n_periods)
+
+    def _set_status(self, text: str, fit: bool = False) -> None:
+        """The status text; its label's size follows it when `fit`, else it only grows (see __init__)."""
+        self.status.setText(text)
+        # The text's own size: a fixed-size rich-text label's sizeHint answers its current width.
+        document = QTextDocument()
+        document.setDocumentMargin(0)
+        document.setDefaultFont(self.status.font())
+        document.setHtml(text)
+        width, height = math.ceil(document.idealWidth()) + 2, math.ceil(document.size().height())
+        if fit or width > self.status.width() or height > self.status.height():
+            self.status.setFixedSize(width, height)
 
     def clear(self, text: str = "Waiting for the first period…", band_hz: tuple[float, float] | None = None) -> None:
         """Empty panels; `band_hz`, when known, sets the frequency axis already."""
@@ -276,7 +303,8 @@ class LivePanels(QWidget):
         self.frame = None
         self._drawing += 1
         self.timer.stop()
-        self.status.setText(f"{text} {LEGEND}")
+        self._set_status(text, fit=True)
+        self.legend.setVisible(True)
         for panel in self.panels.values():       # until the first period, say so where the lines will be
             panel.empty_text = text
         self._clear_channel(self._drawing, list(self.panels.values()), band_hz)
@@ -287,4 +315,4 @@ class LivePanels(QWidget):
             return
         panels[0].clear(band_hz=band_hz)
         if len(panels) > 1:
-            QTimer.singleShot(0, self, lambda: self._clear_channel(drawing, panels[1:], band_hz))
+            in_a_later_turn(self, lambda: self._clear_channel(drawing, panels[1:], band_hz))
