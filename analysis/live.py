@@ -101,6 +101,7 @@ class LiveAccumulator:
         self._mean = np.zeros((len(self.signals), span.size), dtype=np.complex128)
         self._m2 = np.zeros((len(self.signals), span.size))
         self._x_mean = np.zeros(self.period_samples)
+        self._data = np.empty((len(self.signals), self.period_samples))
         self._spectrum = np.empty((len(self.signals), self.period_samples // 2 + 1), dtype=np.complex128)
         self._n = 0
 
@@ -123,7 +124,7 @@ class LiveAccumulator:
     def add_period(self, period: Mapping[str, np.ndarray] | np.ndarray) -> LiveFrame:
         """One period of every signal (a mapping by name, or rows in `signals` order) -> the new frame."""
         data = self._stacked(period)
-        # Into the accumulator's own buffer: a fresh 1.5 MB array per period costs its pages' faults each time.
+        # Into the accumulator's own buffer, as the samples (_stacked).
         delta = np.fft.rfft(data, axis=-1, out=self._spectrum)[:, self._lo:self._hi]
         delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
         self._n += 1
@@ -135,7 +136,7 @@ class LiveAccumulator:
         self._mean += delta
         if self._x_row is not None:
             x = data[self._x_row]
-            x -= self._x_mean                          # data is our own copy
+            x -= self._x_mean                          # data is our own buffer
             x *= 1.0 / n
             self._x_mean += x
         return self._frame()
@@ -143,17 +144,23 @@ class LiveAccumulator:
     # --- internals ----------------------------------------------------------------------------
 
     def _stacked(self, period) -> np.ndarray:
+        """The period's rows copied into the accumulator's own buffer (add_period works in it; a fresh 1.5 MB
+        array per period would cost its pages' faults each time)."""
         if isinstance(period, Mapping):
             missing = [s for s in self.signals if s not in period]
             if missing:
                 raise ValueError(f"the period lacks {', '.join(missing)}")
-            data = np.stack([np.asarray(period[s], dtype=np.float64) for s in self.signals])
+            rows = [np.asarray(period[s], dtype=np.float64) for s in self.signals]
+            shape = (len(rows), *rows[0].shape) if len({row.shape for row in rows}) == 1 else "ragged"
         else:
-            data = np.array(period, dtype=np.float64)       # a copy: add_period works in it
-        if data.shape != (len(self.signals), self.period_samples):
+            rows = np.asarray(period, dtype=np.float64)
+            shape = rows.shape
+        if shape != self._data.shape:
             raise ValueError(f"expected {len(self.signals)} signals of {self.period_samples} samples, "
-                             f"got shape {data.shape}")
-        return data
+                             f"got shape {shape}")
+        for index, row in enumerate(rows):          # row by row: a list would first be stacked into a new array
+            self._data[index] = row
+        return self._data
 
     def _var_mean(self) -> np.ndarray:
         if self._n < 2:
