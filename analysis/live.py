@@ -11,14 +11,17 @@ number of periods):
 
 Spectra are one-sided peak amplitudes (analysis.spectra.period_spectra), so
 after the last period `mean` and `var_mean` equal estimate_spectra's on the
-same periods. A frame shows, in dB re 1 V, 1 A or 1 m (20 log10 of the
-amplitude, DB_FLOOR for zero): the signal lines (excited bins), the noise floor
-at every bin (sqrt(var_mean)), and the noise + distortion lines (|mean| at the
-unexcited bins). Its traffic lights are the validity rules that apply to one
-frame (analysis.validity.spectral: no signal, SNR, distortion, displacement
-band); drift and the capture's counts are judged on the whole recording.
-Before the second period there is no noise estimate: noise is NaN and the
-lights are "unknown".
+same periods. A frame shows, in dB re 1 V, 1 A or 1 m (10 log10 of the power,
+DB_FLOOR for zero): the signal lines (|mean| at the excited bins), and, in
+DISPLAY_BUCKETS log-spaced buckets of the band (analysis.log_buckets, the power
+mean of each bucket's bins), the noise floor (var_mean at every bin) and the
+noise + distortion lines (|mean| at the unexcited bins): arrays ready to draw,
+worked out here in the measurement thread rather than in the GUI's. Its traffic
+lights are the validity rules that apply to one frame
+(analysis.validity.spectral: no signal, SNR, distortion, displacement band);
+drift and the capture's counts are judged on the whole recording. Before the
+second period there is no noise estimate: noise is NaN and the lights are
+"unknown".
 
 Feed only analysed periods (after settling); `reset()` starts over.
 """
@@ -29,9 +32,9 @@ from types import MappingProxyType
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.fft
 
 from analysis.excursion import peak_of_period
+from analysis.log_buckets import LogBuckets
 from analysis.recording.format import UNITS
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
@@ -40,6 +43,7 @@ from analysis.validity.spectral import SIGNALS, distortion_bands, spectral_check
 
 UNKNOWN = "unknown"
 DB_FLOOR = -400.0
+DISPLAY_BUCKETS = 300           # a few hundred columns: what a panel ~1000 pixels wide can show
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -47,9 +51,8 @@ class LiveChannel:
     signal: str
     unit: str
     line_db: np.ndarray             # |mean| at the excited lines, dB re 1 unit
-    line_noise_db: np.ndarray       # noise floor at the excited lines, dB (NaN before 2 periods)
-    other_db: np.ndarray            # noise + distortion: |mean| at the unexcited lines, dB
-    other_noise_db: np.ndarray      # noise floor at the unexcited lines, dB
+    other_db: np.ndarray            # noise + distortion: |mean| at the unexcited lines, dB, per bucket (other_freqs)
+    noise_db: np.ndarray            # noise floor at every bin, dB, per bucket (noise_freqs; NaN before 2 periods)
     status: str                     # "green" | "yellow" | "red" | "unknown"
     findings: tuple[Finding, ...]
     measures: Mapping[str, float]
@@ -58,8 +61,9 @@ class LiveChannel:
 @dataclass(frozen=True, slots=True, eq=False)
 class LiveFrame:
     n_periods: int
-    line_freqs: np.ndarray          # Hz, the excited lines (shared by the channels)
-    other_freqs: np.ndarray         # Hz, the unexcited lines of the band
+    line_freqs: np.ndarray          # Hz, the excited lines (shared by the channels); the band is first to last
+    other_freqs: np.ndarray         # Hz, the centres of the buckets of the band's unexcited lines
+    noise_freqs: np.ndarray         # Hz, the centres of the buckets of the band's bins
     channels: Mapping[str, LiveChannel]
     status: str                     # the worst channel's
     peak_displacement_m: float | None
@@ -69,7 +73,8 @@ class LiveAccumulator:
     """Running per-bin mean and variance of the periods fed so far (see the module doc)."""
 
     def __init__(self, sample_rate: float, period_samples: int, excited_bins: Sequence[int],
-                 signals: Sequence[str] = SIGNALS, thresholds: ValidityThresholds = DEFAULT_THRESHOLDS):
+                 signals: Sequence[str] = SIGNALS, thresholds: ValidityThresholds = DEFAULT_THRESHOLDS,
+                 display_buckets: int = DISPLAY_BUCKETS):
         excited = np.unique(np.asarray(excited_bins, dtype=np.int64))
         if excited.size == 0 or excited[0] < 1 or excited[-1] > period_samples // 2 - 1:
             raise ValueError(f"excited_bins must be non-empty and within 1 .. {period_samples // 2 - 1}")
@@ -87,13 +92,17 @@ class LiveAccumulator:
         bin_width = self.sample_rate / self.period_samples
         self._bin_width = bin_width
         self._line_freqs = _frozen(excited * bin_width)
-        self._other_freqs = _frozen((self._unexcited + self._lo) * bin_width)
-        self._bands = distortion_bands(self._other_freqs, thresholds.distortion_band_octaves,
+        other_freqs = (self._unexcited + self._lo) * bin_width
+        self._bands = distortion_bands(other_freqs, thresholds.distortion_band_octaves,
                                        thresholds.distortion_min_bins)
+        self._other_buckets = LogBuckets(other_freqs, display_buckets) if other_freqs.size else None
+        self._noise_buckets = LogBuckets(span * bin_width, display_buckets)
         self._x_row = self.signals.index("displacement") if "displacement" in self.signals else None
         self._mean = np.zeros((len(self.signals), span.size), dtype=np.complex128)
         self._m2 = np.zeros((len(self.signals), span.size))
         self._x_mean = np.zeros(self.period_samples)
+        self._data = np.empty((len(self.signals), self.period_samples))
+        self._spectrum = np.empty((len(self.signals), self.period_samples // 2 + 1), dtype=np.complex128)
         self._n = 0
 
     @property
@@ -115,7 +124,8 @@ class LiveAccumulator:
     def add_period(self, period: Mapping[str, np.ndarray] | np.ndarray) -> LiveFrame:
         """One period of every signal (a mapping by name, or rows in `signals` order) -> the new frame."""
         data = self._stacked(period)
-        delta = scipy.fft.rfft(data, axis=-1)[:, self._lo:self._hi]
+        # Into the accumulator's own buffer, as the samples (_stacked).
+        delta = np.fft.rfft(data, axis=-1, out=self._spectrum)[:, self._lo:self._hi]
         delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
         self._n += 1
         n = self._n
@@ -126,7 +136,7 @@ class LiveAccumulator:
         self._mean += delta
         if self._x_row is not None:
             x = data[self._x_row]
-            x -= self._x_mean                          # data is our own copy
+            x -= self._x_mean                          # data is our own buffer
             x *= 1.0 / n
             self._x_mean += x
         return self._frame()
@@ -134,17 +144,23 @@ class LiveAccumulator:
     # --- internals ----------------------------------------------------------------------------
 
     def _stacked(self, period) -> np.ndarray:
+        """The period's rows copied into the accumulator's own buffer (add_period works in it; a fresh 1.5 MB
+        array per period would cost its pages' faults each time)."""
         if isinstance(period, Mapping):
             missing = [s for s in self.signals if s not in period]
             if missing:
                 raise ValueError(f"the period lacks {', '.join(missing)}")
-            data = np.stack([np.asarray(period[s], dtype=np.float64) for s in self.signals])
+            rows = [np.asarray(period[s], dtype=np.float64) for s in self.signals]
+            shape = (len(rows), *rows[0].shape) if len({row.shape for row in rows}) == 1 else "ragged"
         else:
-            data = np.array(period, dtype=np.float64)       # a copy: add_period works in it
-        if data.shape != (len(self.signals), self.period_samples):
+            rows = np.asarray(period, dtype=np.float64)
+            shape = rows.shape
+        if shape != self._data.shape:
             raise ValueError(f"expected {len(self.signals)} signals of {self.period_samples} samples, "
-                             f"got shape {data.shape}")
-        return data
+                             f"got shape {shape}")
+        for index, row in enumerate(rows):          # row by row: a list would first be stacked into a new array
+            self._data[index] = row
+        return self._data
 
     def _var_mean(self) -> np.ndarray:
         if self._n < 2:
@@ -153,8 +169,16 @@ class LiveAccumulator:
 
     def _frame(self) -> LiveFrame:
         var = self._var_mean()
-        amplitude_db = _db_of_power(self._mean.real**2 + self._mean.imag**2)
-        noise_db = _db_of_power(var) if self._n >= 2 else var
+        power = self._mean.real**2 + self._mean.imag**2
+        line_db = _db_of_power(power[:, self._excited])
+        if self._other_buckets is not None:
+            other_db = self._other_buckets.power_mean_db(power[:, self._unexcited])
+        else:
+            other_db = np.zeros((len(self.signals), 0))
+        if self._n >= 2:
+            noise_db = self._noise_buckets.power_mean_db(var)
+        else:
+            noise_db = np.full((len(self.signals), self._noise_buckets.starts.size), np.nan)
         checks = {}
         if self._n >= 2:
             spectra = {name: ChannelSpectrum(name, UNITS[name], self._mean[row], var[row])
@@ -165,15 +189,16 @@ class LiveAccumulator:
         for row, name in enumerate(self.signals):
             findings, measures = checks.get(name, ([], {}))
             status = str(worst(f.severity for f in findings)) if name in checks else UNKNOWN
-            channels[name] = LiveChannel(
-                name, UNITS[name], _frozen(amplitude_db[row, self._excited]), _frozen(noise_db[row, self._excited]),
-                _frozen(amplitude_db[row, self._unexcited]), _frozen(noise_db[row, self._unexcited]),
-                status, tuple(findings), MappingProxyType(dict(measures)))
+            channels[name] = LiveChannel(name, UNITS[name], _frozen(line_db[row]), _frozen(other_db[row]),
+                                         _frozen(noise_db[row]), status, tuple(findings),
+                                         MappingProxyType(dict(measures)))
         statuses = [ch.status for ch in channels.values()]
         overall = UNKNOWN if UNKNOWN in statuses else str(worst(f.severity for ch in channels.values()
                                                                  for f in ch.findings))
         peak = peak_of_period(self._x_mean) if self._x_row is not None else None
-        return LiveFrame(self._n, self._line_freqs, self._other_freqs, MappingProxyType(channels), overall, peak)
+        other_freqs = self._other_buckets.freqs if self._other_buckets is not None else _frozen(np.zeros(0))
+        return LiveFrame(self._n, self._line_freqs, other_freqs, self._noise_buckets.freqs,
+                         MappingProxyType(channels), overall, peak)
 
 
 def _db_of_power(power: np.ndarray) -> np.ndarray:

@@ -3,7 +3,9 @@ from __future__ import annotations
 
 from typing import Callable
 
-from PySide6.QtCore import QObject, QTimer
+from PySide6.QtCore import QObject
+
+from app.jobs.next_turn import in_a_later_turn
 
 
 class StagedFanOut(QObject):
@@ -12,7 +14,8 @@ class StagedFanOut(QObject):
     A new result reaches the Results page, the Model lab and the QA view. One
     after the other in a single turn they held the GUI thread for 60-80 ms (the
     lab alone takes 30 ms to set up its plots); one per turn, the event loop
-    runs, and the pages paint, in between. `then` callbacks run after the last
+    runs, and the pages paint, in between (app/jobs/next_turn.py: not with zero
+    timers, which let two receivers run back to back before anything due). `then` callbacks run after the last
     receiver, so "shown" signals still mean every page has the value.
 
     A value sent while an earlier one is still on its way replaces it: the
@@ -49,7 +52,7 @@ class StagedFanOut(QObject):
             callback()
 
     def _schedule(self, round_: int) -> None:
-        QTimer.singleShot(0, self, lambda: self._next(round_))
+        in_a_later_turn(self, lambda: self._next(round_))
 
     def _next(self, round_: int) -> None:
         if round_ != self._round:

@@ -13,15 +13,18 @@ advises: drawing every frame of a fast simulator would starve the event loop.
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 import pyqtgraph as pg
 from PySide6.QtCore import QSize, Qt, QTimer, Signal
-from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
+from PySide6.QtGui import QTextDocument
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from analysis.live import DB_FLOOR, LiveFrame
 from analysis.recording.format import UNITS
+from app.jobs.next_turn import in_a_later_turn
 from app.widgets import style
 from app.widgets.grid_axis import show_grid
 from app.widgets.plot_placeholder import PlotPlaceholder
@@ -30,9 +33,10 @@ from app.widgets.traffic_light import CHANNELS, ChannelLight
 
 REPAINT_HZ = 30
 REPAINT_INTERVAL_MS = 1000 // REPAINT_HZ + 1      # 34 ms: never above 30 repaints a second
-# Qt lets a late timer catch up with its schedule (a tick 18 ms after a late one): a repaint that soon waits.
-# Not a whole 1/30 s: a tick a millisecond early would then be skipped, halving the rate.
-MIN_REPAINT_GAP_S = 0.9 / REPAINT_HZ
+# Qt lets a late timer catch up with its schedule (a tick soon after a late one), never more than one tick per
+# interval on average: a repaint closer than this to the last one waits. Half an interval: with 0.9 of one,
+# every tick more than 3 ms late (common on a busy machine) cost the next tick too, ~22 instead of 29 a second.
+MIN_REPAINT_GAP_S = 0.5 / REPAINT_HZ
 IDLE_TICKS = 30                                   # stop the timer after ~1 s without a new frame
 SIGNAL_COLOUR = style.MEASURED
 DISTORTION_COLOUR = "#e08a00"
@@ -40,13 +44,9 @@ NOISE_COLOUR = "#606060"
 GRID_COLOUR = "#d9d9d9"
 RANGE_STEP_DB = 10.0
 DOT_HEIGHT = 0.015          # of the y range: ~2 pixels on a panel 150 pixels tall, plus the pen's width
-# Thousands of unexcited bins per channel cost ~100 ms a repaint (with the GIL held: the audio thread waits);
-# a plot ~1000 pixels wide cannot show more than a few hundred columns anyway. So the noise floor and the
-# noise + distortion are reduced to DISPLAY_BUCKETS log-spaced buckets, each the power mean of its bins: what
-# the validity check compares band by band (analysis.validity.spectral). Noise alone puts the two on top of
-# each other; one product 30 dB over the floor among ten bins still stands 20 dB out.
-DISPLAY_BUCKETS = 300
-DB_TO_LN_POWER = np.log(10.0) / 10.0
+# The noise floor and the noise + distortion come in a few hundred log-spaced buckets, worked out with the
+# frame in the measurement thread (analysis.live, analysis.log_buckets): thousands of bins per channel drawn
+# here cost ~100 ms a repaint, with the GIL held (the audio thread waits).
 LEGEND = (f"<span style='color:{SIGNAL_COLOUR}'>●</span> signal lines &nbsp; "
           f"<span style='color:{DISTORTION_COLOUR}'>●</span> noise + distortion (lines not excited) &nbsp; "
           f"<span style='color:{NOISE_COLOUR}'>—</span> noise floor")
@@ -74,27 +74,6 @@ class CompactPlotWidget(pg.PlotWidget):
 
     def sizeHint(self) -> QSize:
         return QSize(400, 80)
-
-
-class LogBuckets:
-    """Sorted frequencies grouped into log-spaced buckets: starts of the groups and their centre frequencies."""
-
-    def __init__(self, freqs: np.ndarray, n_buckets: int = DISPLAY_BUCKETS):
-        log_f = np.log10(freqs)
-        edges = np.linspace(log_f[0], log_f[-1], n_buckets + 1)
-        index = np.clip(np.searchsorted(edges, log_f, side="right") - 1, 0, n_buckets - 1)
-        self.starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
-        counts = np.diff(np.r_[self.starts, freqs.size])
-        self.freqs = 10.0 ** (np.add.reduceat(log_f, self.starts) / counts)
-
-    def power_mean_db(self, db: np.ndarray) -> np.ndarray:
-        """10 log10 of the mean power of each bucket's finite values; NaN for a bucket without any."""
-        finite = np.isfinite(db)
-        # exp rather than 10 ** x: a third of the time on 13,500 bins, drawn every repaint; exp(-inf) = 0.
-        power = np.add.reduceat(np.exp(np.where(finite, db, -np.inf) * DB_TO_LN_POWER), self.starts)
-        count = np.add.reduceat(finite.astype(np.int64), self.starts)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(count > 0, 10.0 * np.log10(power / np.maximum(count, 1)), np.nan)
 
 
 def _visible(db: np.ndarray) -> np.ndarray:
@@ -143,9 +122,6 @@ class LiveChannelPanel(QWidget):
             plot.addItem(item)
         self._freqs_key: tuple | None = None
         self._x_span = (1.0, 10.0)
-        self._order: np.ndarray | None = None
-        self._merged: LogBuckets | None = None
-        self._others: LogBuckets | None = None
         self._y_range: tuple[float, float] | None = None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -167,17 +143,14 @@ class LiveChannelPanel(QWidget):
             self._unit = ch.unit
             self.plot.setLabel("left", UNIT_WORDS.get(ch.unit, f"dB re 1 {ch.unit}"))
         self._set_frequencies(frame)
-        line_db, other_db = _visible(ch.line_db), _visible(ch.other_db)
-        noise = np.concatenate([_visible(ch.line_noise_db), _visible(ch.other_noise_db)])[self._order]
-        other_db = self._others.power_mean_db(other_db)
-        noise = self._merged.power_mean_db(noise)
+        line_db, other_db, noise = _visible(ch.line_db), ch.other_db, ch.noise_db      # buckets: NaN for none
         offset = UNIT_OFFSET_DB.get(ch.unit, 0.0)
         if offset:
             line_db, other_db, noise = line_db + offset, other_db + offset, noise + offset
         self._set_y_range(line_db, other_db, noise)
         self._dots(self.lines, frame.line_freqs, line_db, DOT_HEIGHT)
-        self._dots(self.distortion, self._others.freqs, other_db, DOT_HEIGHT * 0.5)
-        self.noise.setData(self._merged.freqs, noise)
+        self._dots(self.distortion, frame.other_freqs, other_db, DOT_HEIGHT * 0.5)
+        self.noise.setData(frame.noise_freqs, noise)
 
     def _dots(self, item: pg.PlotDataItem, freqs: np.ndarray, db: np.ndarray, height: float) -> None:
         """Each point a vertical segment `height` of the y range tall (with the pen's width: a dot)."""
@@ -187,16 +160,13 @@ class LiveChannelPanel(QWidget):
         item.setData(np.repeat(freqs[shown], 2), np.column_stack([y - half, y + half]).ravel())
 
     def _set_frequencies(self, frame: LiveFrame) -> None:
-        key = (frame.line_freqs.size, frame.other_freqs.size, float(frame.line_freqs[0]),
-               float(frame.line_freqs[-1]))
+        """The frequency axis spans the band, first to last excited line; set when the lines change."""
+        key = (frame.line_freqs.size, float(frame.line_freqs[0]), float(frame.line_freqs[-1]),
+               frame.noise_freqs.size)
         if key == self._freqs_key:
             return
         self._freqs_key = key
-        merged = np.concatenate([frame.line_freqs, frame.other_freqs])
-        self._order = np.argsort(merged, kind="stable")
-        self._merged = LogBuckets(merged[self._order])
-        self._others = LogBuckets(frame.other_freqs)        # sorted already (analysis.live)
-        lo, hi = np.log10(merged.min()), np.log10(merged.max())
+        lo, hi = np.log10(frame.line_freqs[0]), np.log10(frame.line_freqs[-1])
         self.plot.setXRange(lo, hi, padding=0.02)
         self._x_span = (10 ** (lo - 0.05), 10 ** (hi + 0.05))
         self._y_range = None               # new lines: the grid is redrawn with the next range
@@ -240,12 +210,23 @@ class LivePanels(QWidget):
         for panel in self.panels.values():
             panel.empty_text = empty_text
             panel.placeholder.show_text(empty_text)
-        self.status = QLabel("No measurement running: the spectra appear here period by period.")
-        self.status.setWordWrap(True)
+        # What changes with each frame (periods averaged, peak excursion) in a label of a fixed size, grown
+        # when a text needs more: a label that may change size re-lays the page out at every text, 5-7 ms
+        # of the GUI thread a repaint. The colours' legend beside it does not change.
+        self.status = QLabel()
         self.status.setTextFormat(Qt.RichText)
+        self.legend = QLabel(LEGEND)
+        self.legend.setWordWrap(True)
+        self.legend.setTextFormat(Qt.RichText)
+        self.legend.setVisible(False)
+        top = QHBoxLayout()
+        top.setContentsMargins(0, 0, 0, 0)
+        top.addWidget(self.status, 0, Qt.AlignLeft)          # at the left also while the legend is hidden
+        top.addWidget(self.legend, 1)
+        self._set_status("No measurement running: the spectra appear here period by period.", fit=True)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.status)
+        layout.addLayout(top)
         for panel in self.panels.values():
             layout.addWidget(panel, 1)
         self.timer = QTimer(self)
@@ -296,13 +277,25 @@ class LivePanels(QWidget):
             return
         panels[0].show_frame(frame)
         if len(panels) > 1:
-            QTimer.singleShot(0, self, lambda: self._draw_channel(drawing, frame, panels[1:]))
+            in_a_later_turn(self, lambda: self._draw_channel(drawing, frame, panels[1:]))
             return
         peak = frame.peak_displacement_m
         peak_text = f", peak excursion {peak * 1e3:.3f} mm" if peak is not None else ""
-        self.status.setText(f"<b>{frame.n_periods} period{'s' if frame.n_periods != 1 else ''} averaged</b>"
-                            f"{peak_text}. {LEGEND}")
+        self._set_status(f"<b>{frame.n_periods} period{'s' if frame.n_periods != 1 else ''} averaged</b>"
+                         f"{peak_text}.")
         self.repainted.emit(frame.n_periods)
+
+    def _set_status(self, text: str, fit: bool = False) -> None:
+        """The status text; its label's size follows it when `fit`, else it only grows (see __init__)."""
+        self.status.setText(text)
+        # The text's own size: a fixed-size rich-text label's sizeHint answers its current width.
+        document = QTextDocument()
+        document.setDocumentMargin(0)
+        document.setDefaultFont(self.status.font())
+        document.setHtml(text)
+        width, height = math.ceil(document.idealWidth()) + 2, math.ceil(document.size().height())
+        if fit or width > self.status.width() or height > self.status.height():
+            self.status.setFixedSize(width, height)
 
     def clear(self, text: str = "Waiting for the first period…", band_hz: tuple[float, float] | None = None) -> None:
         """Empty panels; `band_hz`, when known, sets the frequency axis already."""
@@ -310,7 +303,8 @@ class LivePanels(QWidget):
         self.frame = None
         self._drawing += 1
         self.timer.stop()
-        self.status.setText(f"{text} {LEGEND}")
+        self._set_status(text, fit=True)
+        self.legend.setVisible(True)
         for panel in self.panels.values():       # until the first period, say so where the lines will be
             panel.empty_text = text
         self._clear_channel(self._drawing, list(self.panels.values()), band_hz)
@@ -321,4 +315,4 @@ class LivePanels(QWidget):
             return
         panels[0].clear(band_hz=band_hz)
         if len(panels) > 1:
-            QTimer.singleShot(0, self, lambda: self._clear_channel(drawing, panels[1:], band_hz))
+            in_a_later_turn(self, lambda: self._clear_channel(drawing, panels[1:], band_hz))

@@ -5,7 +5,7 @@ import dataclasses
 import time
 from pathlib import Path
 
-from PySide6.QtCore import Qt, QTimer, Signal, Slot
+from PySide6.QtCore import Qt, Signal, Slot
 from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTabWidget
 
 from app.widgets import style
@@ -20,6 +20,7 @@ from app.results.view import ResultsView
 from app.live.series_page import SeriesPage
 from app.window.settings import Settings
 from app.window.unfinished import ask_unfinished, offer_unfinished
+from app.jobs.next_turn import in_a_later_turn
 from app.jobs.staged_fanout import StagedFanOut
 from app.window.window_fit import fit_window
 from app.wizard import MeasureWizard
@@ -284,7 +285,7 @@ class MainWindow(QMainWindow):
         up to one long stall of the GUI (the Results page takes ~30 ms to show it, the lab as much again).
         """
         self.jobs.drop()                    # an opened file still being analysed would replace it: drop that
-        QTimer.singleShot(0, lambda: self._show_measured(outcome))
+        in_a_later_turn(self, lambda: self._show_measured(outcome))
 
     def _show_measured(self, outcome) -> None:
         self.results.show_outcome(outcome.analysis)

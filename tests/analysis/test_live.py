@@ -36,7 +36,7 @@ def test_the_first_frame_has_levels_but_no_noise_and_unknown_lights():
     frame = acc.add_period(_periods(rec, 0))
     assert frame.n_periods == 1 and frame.status == UNKNOWN
     voltage = frame.channels["voltage"]
-    assert voltage.status == UNKNOWN and np.all(np.isnan(voltage.line_noise_db))
+    assert voltage.status == UNKNOWN and np.all(np.isnan(voltage.noise_db))
     expected = 20 * np.log10(np.abs(np.fft.rfft(rec.periods("voltage")[0])[MT.excited_bins]) * 2 / MT.period_samples)
     np.testing.assert_allclose(voltage.line_db, expected, atol=1e-9)
     np.testing.assert_allclose(frame.line_freqs, MT.frequencies)
@@ -47,15 +47,35 @@ def test_frames_turn_green_and_the_noise_floor_falls_with_periods():
     acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
     frames = [acc.add_period(_periods(rec, p)) for p in range(rec.n_periods)]
     assert all(f.status == "green" for f in frames[1:])
-    floor = [np.mean(f.channels["current"].other_noise_db) for f in (frames[3], frames[15])]
+    floor = [np.mean(f.channels["current"].noise_db) for f in (frames[3], frames[15])]
     assert floor[0] - floor[1] == pytest.approx(10 * np.log10(16 / 4), abs=1.0)   # sqrt(P) in amplitude
     last = frames[-1]
     assert last.peak_displacement_m == pytest.approx(
         np.ptp(rec.periods("displacement").mean(axis=0)) / 2, rel=0.05)
     assert last.other_freqs.size == last.channels["voltage"].other_db.size > 0
+    assert last.noise_freqs.size == last.channels["voltage"].noise_db.size > 0
     for ch in last.channels.values():
-        for array in (ch.line_db, ch.line_noise_db, ch.other_db, ch.other_noise_db):
+        for array in (ch.line_db, ch.other_db, ch.noise_db):
             assert not array.flags.writeable
+
+
+def test_the_noise_floor_buckets_stand_at_the_injected_white_noise():
+    """White noise of rms s per sample gives every bin of the peak-amplitude spectrum a variance of the mean
+    4 s^2 / (N P) after P periods; the buckets, power means of their bins, stand there across the band, and
+    the noise + distortion buckets (|mean|^2 at the unexcited bins: noise alone) with them."""
+    periods = 16
+    rec = recording(mt=MT, noise=NOISE, n_periods=periods)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, MT.excited_bins)
+    frame = [acc.add_period(_periods(rec, p)) for p in range(periods)][-1]
+    assert frame.noise_freqs[0] >= MT.frequencies[0] and frame.noise_freqs[-1] <= MT.frequencies[-1]
+    assert np.all(np.diff(frame.noise_freqs) > 0) and np.all(np.diff(frame.other_freqs) > 0)
+    for name in SIGNALS:
+        rms = getattr(NOISE, name)
+        expected = 10 * np.log10(4 * rms**2 / (MT.period_samples * periods))
+        ch = frame.channels[name]
+        # A bucket of one bin scatters by ~1 dB (a variance from 16 periods); the many-bin buckets far less.
+        assert np.median(ch.noise_db) == pytest.approx(expected, abs=0.5)
+        assert np.median(ch.other_db) == pytest.approx(expected, abs=1.0)
 
 
 def test_a_disconnected_current_turns_its_light_red_per_frame():

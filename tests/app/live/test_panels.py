@@ -6,7 +6,7 @@ import pytest
 from PySide6.QtCore import QTimer
 
 from analysis.live import LiveAccumulator
-from app.live.panels import MIN_REPAINT_GAP_S, LivePanels, LogBuckets
+from app.live.panels import MIN_REPAINT_GAP_S, LivePanels
 from instruments.simulation import faults
 
 from tests.app.wizard.test_wizard_helpers import plain
@@ -105,14 +105,3 @@ def test_a_measurement_without_displacement_shows_that_channel_absent(qtbot, pan
         panels.set_frame(frames[-1])
     assert panels.panels["displacement"].light.light.status == "absent"
     assert len(panels.panels["displacement"].lines.getData()[0] or []) == 0
-
-
-def test_buckets_keep_the_power_of_the_bins():
-    freqs = np.geomspace(10, 10000, 3000)
-    buckets = LogBuckets(freqs, 100)
-    db = np.full(freqs.size, -100.0)
-    assert np.allclose(buckets.power_mean_db(db), -100.0)
-    db[1500] = -60.0                                # one product 40 dB over the floor in its bucket
-    peak = buckets.power_mean_db(db)
-    assert peak.max() > -100.0 + 20.0
-    assert buckets.freqs.size <= 100 and np.all(np.diff(buckets.freqs) > 0)
