@@ -120,7 +120,7 @@ class ChannelLight(QWidget):
 
 
 class ValiditySummary(QWidget):
-    """The overall light, what it means, and a ChannelLight per channel (result.validity's JSON)."""
+    """The overall light, what it means, and a ChannelLight per channel (a result's validity)."""
 
     def __init__(self, overall_diameter: int = 28, channel_diameter: int = 16, parent=None):
         super().__init__(parent)
@@ -140,16 +140,17 @@ class ValiditySummary(QWidget):
             layout.addWidget(light)
         self.set_validity(None)
 
-    def set_validity(self, validity: Mapping | None) -> None:
-        validity = validity or {"overall": "unknown"}
-        overall = str(validity.get("overall", "unknown"))
+    def set_validity(self, validity) -> None:
+        """validity: an analysis.validity.result.ResultValidity, or None (not judged yet)."""
+        overall = "unknown" if validity is None else str(validity.overall)
         self.overall_light.set_status(overall)
         meaning = style.VALIDITY_TEXT.get(overall, "a state this version does not know")
-        peak = validity.get("peak_displacement_m")
-        peak_text = f" Peak excursion {peak * 1e3:.3g} mm." if isinstance(peak, (int, float)) else ""
+        peak = None if validity is None else validity.peak_displacement_m
+        peak_text = f" Peak excursion {peak * 1e3:.3g} mm." if peak is not None else ""
         self.overall_text.setText(f"<b>Measurement {html.escape(STATE_WORDS.get(overall, overall))}</b> "
                                   f"({html.escape(overall)}): {html.escape(meaning)}.{peak_text}")
-        channels = validity.get("channels") or {}
+        channels = {} if validity is None else validity.channels
         for name, light in self.channels.items():
-            entry = channels.get(name) or {}
-            light.set_state(str(entry.get("status", "unknown")), entry.get("findings") or ())
+            entry = channels.get(name)
+            light.set_state("unknown" if entry is None else str(entry.status or "unknown"),
+                            () if entry is None else entry.findings)
