@@ -222,7 +222,7 @@ def _object(doc: Mapping, key: str, where: str) -> dict:
     return dict(value)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class StoredResult:
     parameters: dict[str, ParameterValue]
     effects: tuple[str, ...]
@@ -283,11 +283,13 @@ class StoredResult:
                                  arr["measured_re"] + 1j * arr["measured_im"], arr["std"],
                                  arr["model_re"] + 1j * arr["model_im"], bool(c.get("has_phase", True)))
         sd = doc.get("sd_m2")
-        return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
-                   dict(model), _validity(doc),
-                   None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
-                   curves, _user_effects(model), _session(doc), _reference_curves(doc),
-                   _object(doc, "reference_fit", ""))
+        return cls(parameters=parameters, effects=effects,
+                   with_displacement=bool(model.get("with_displacement", "displacement" in curves)), values=values,
+                   model_info=dict(model), validity=_validity(doc),
+                   sd_m2=None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError),
+                   settings=_object(doc, "settings", ""), curves=curves, user_effects=_user_effects(model),
+                   session=_session(doc), reference_curves=_reference_curves(doc),
+                   reference_fit=_object(doc, "reference_fit", ""))
 
     def model(self):
         """The analysis.model.composed.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
