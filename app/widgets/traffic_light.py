@@ -7,7 +7,7 @@ meaning: the text next to it names the state too).
 from __future__ import annotations
 
 import html
-from typing import Iterable, Mapping
+from typing import Iterable
 
 from PySide6.QtCore import QRectF, QSize, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPen
@@ -54,21 +54,15 @@ class TrafficLight(QWidget):
         painter.drawEllipse(QRectF((self.width() - d) / 2, (self.height() - d) / 2, d, d))
 
 
-def finding_parts(finding) -> tuple[str, str, str]:
-    """(severity, message, remedy) of an analysis Finding or of its JSON form."""
-    if isinstance(finding, Mapping):
-        return str(finding.get("severity", "")), str(finding.get("message", "")), str(finding.get("remedy", ""))
-    return str(finding.severity), finding.message, finding.remedy
-
-
 def findings_html(findings: Iterable, empty: str = "") -> str:
-    """Each finding's message, and its remedy in italics (what to do matters as much as what is wrong)."""
+    """Each finding's (analysis.validity.findings.Finding) message, and its remedy in italics (what to do matters
+    as much as what is wrong)."""
     items = []
     for finding in findings:
-        severity, message, remedy = finding_parts(finding)
+        severity, message, remedy = str(finding.severity), finding.message, finding.remedy
         colour = style.validity_colours(severity)[1]
         text = f"<span style='color:{colour}'>●</span> {html.escape(message)}"
-        code = finding.get("code") if isinstance(finding, Mapping) else getattr(finding, "code", "")
+        code = finding.code
         if code:        # the stable code: the user guide, the report and the CLI's JSON name it too
             text += f" <span style='color:#666666'>[{html.escape(str(code))}]</span>"
         if remedy:
