@@ -61,6 +61,10 @@ class ChannelValidity:
     def __post_init__(self) -> None:
         object.__setattr__(self, "measures", MappingProxyType(dict(self.measures)))
 
+    def __reduce__(self):
+        # A mapping proxy cannot be pickled (nor deep-copied): the measures as a dict, made read-only again.
+        return ChannelValidity, (self.signal, self.status, self.findings, dict(self.measures))
+
     def as_json(self) -> dict:
         findings = [f.as_json() for f in self.findings]
         return {"findings": findings} if self.status is None else {"status": self.status, "findings": findings}

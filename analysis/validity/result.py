@@ -72,6 +72,9 @@ class ImportedCurves:
         for name in ("rms_relative_residual", "magnitude_only", "ranges_hz", "notes"):
             object.__setattr__(self, name, frozen(getattr(self, name)))
 
+    def __reduce__(self):
+        return _rebuilt, (type(self), {f.name: thawed(getattr(self, f.name)) for f in dataclasses.fields(self)})
+
 
 # The keys a ResultValidity knows; any other key of a stored document is kept in `other`.
 _RECORDING_KEYS = ("overall", "channels", "peak_displacement_m", "fit_error_percent", "fit_band_hz", "heating",
@@ -103,6 +106,14 @@ class ResultValidity:
                            else None)
         for name in ("fit_error_percent", "fit_band_hz", "heating", "laser_delay", "model_part", "other"):
             object.__setattr__(self, name, frozen(getattr(self, name)))
+
+    def __reduce__(self):
+        # Mapping proxies cannot be pickled (nor deep-copied): the fields as plain values, frozen again on the
+        # way in, so that a result can still go to another process or be copied.
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        plain = {name: dict(value) if name == "channels" else value if name == "imported" else thawed(value)
+                 for name, value in fields.items()}
+        return _rebuilt, (type(self), plain)
 
     @classmethod
     def checked(cls, validity: Validity, **fit: Any) -> "ResultValidity":
@@ -179,6 +190,10 @@ class ResultValidity:
                    **{name: _optional_mapping(doc, name)
                       for name in ("fit_error_percent", "fit_band_hz", "heating", "laser_delay", "model_part")},
                    imported=imported, other={k: v for k, v in doc.items() if k not in known})
+
+
+def _rebuilt(cls: type, fields: dict) -> Any:
+    return cls(**fields)
 
 
 def _light(overall: Any) -> str:

@@ -1,9 +1,11 @@
 """analysis.validity.result: a result's validity, typed; its JSON as before, and stored documents read back."""
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 import math
+import pickle
 import re
 from pathlib import Path
 
@@ -112,6 +114,14 @@ def test_an_analysis_validity_survives_the_archive_s_round_trip(fault):
     assert ResultValidity.from_json(doc) == validity.replace(channels={
         name: dataclasses.replace(ch, measures={}) for name, ch in validity.channels.items()})
     assert ResultValidity.from_json(doc).as_json() == doc
+
+
+def test_a_result_with_its_validity_can_still_be_pickled_and_copied():
+    result = analyze_recording(faults.clean())
+    again = pickle.loads(pickle.dumps(result))
+    assert again.validity == result.validity and again.validity.channels["current"].measures["snr_db"] > 0
+    assert copy.deepcopy(ResultValidity.from_json(CURVES)) == ResultValidity.from_json(CURVES)
+    assert pickle.loads(pickle.dumps(ResultValidity.from_json(NOT_A_DRIVER))).as_json() == NOT_A_DRIVER
 
 
 # A validity read by string key (`validity.get("overall")`, `result.validity["channels"]`): the typed fields instead.
