@@ -35,8 +35,8 @@ import numpy as np
 import uncertainties
 from scipy.optimize import minimize_scalar
 
-from analysis.curves.fitting import (CurveFitError, FitRange, covariance_with_bounds, curve_validity, fit_curves,
-                                relative_residual)
+from analysis.curves.fitting import (UNCERTAINTY_NOTE, CurveFitError, FitRange, covariance_with_bounds, fit_curves,
+                                     relative_residual)
 from analysis.derived import C_SOUND, DERIVED, RHO, ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import Site
@@ -205,8 +205,7 @@ def joint_added_mass(curves: Sequence[MassCurve], effects: Sequence[Effect] | st
     if held:
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     table = parameter_table(fit, sd_m2)
-    ranges = {c.name: (float(tf.freqs[0]), float(tf.freqs[-1])) for c, tf in zip(curves, data)}
-    notes.append(str(curve_validity(fit, ranges, data, [])["uncertainties"]))
+    notes.append(UNCERTAINTY_NOTE)
     return AddedMassResult(f"joint fit of {len(curves)} curves", table, tuple(m for m in masses if m), fit,
                            tuple(notes))
 

@@ -32,6 +32,7 @@ from analysis.errors import LinparError
 from analysis.pipeline import AnalysisResult, analyze_path, analyze_recording, require_fit
 from analysis.recording.format import Recording
 from analysis.validity.findings import DISTORTION_HIGH
+from analysis.validity.result import ResultValidity
 
 # The columns of the paper's Table II (and this module's), in order.
 TABLE_PARAMETERS = ("fs", "Mms", "Cms", "Kms", "Bl", "Rms", "RE", "Qts", "lambda")
@@ -140,17 +141,16 @@ def drive_rms(result: AnalysisResult) -> float:
     return float(math.sqrt(power))
 
 
-def small_signal_reasons(validity: Mapping) -> tuple[str, ...]:
+def small_signal_reasons(validity: ResultValidity) -> tuple[str, ...]:
     """Why a result's validity (AnalysisResult.validity) says it is not small-signal; () when it is."""
     reasons = []
-    for name, channel in (validity.get("channels") or {}).items():
-        for f in channel.get("findings", ()):
-            if f.get("code") == DISTORTION_HIGH:
-                reasons.append(f"{DISTORTION_HIGH} on {name} ({f.get('severity')})")
-    overall = validity.get("overall", "unknown")
+    for name, channel in validity.channels.items():
+        for f in channel.findings:
+            if f.code == DISTORTION_HIGH:
+                reasons.append(f"{DISTORTION_HIGH} on {name} ({f.severity})")
+    overall = validity.overall
     if overall != GREEN:
-        others = sorted({f.get("code") for ch in (validity.get("channels") or {}).values()
-                         for f in ch.get("findings", ()) if f.get("code") != DISTORTION_HIGH})
+        others = sorted({f.code for f in validity.findings if f.code != DISTORTION_HIGH})
         if others or not reasons:
             reasons.append(f"validity {overall}" + (f": {', '.join(others)}" if others else ""))
     return tuple(reasons)
@@ -169,14 +169,14 @@ def _analysed(item, sd_m2: float | None, effects: Sequence[Effect] | None) -> An
 
 def _level(result: AnalysisResult, index: int) -> Level:
     name = str(result.source) if result.source else None
-    peak = result.validity.get("peak_displacement_m")
+    peak = result.validity.peak_displacement_m
     if peak is None or not math.isfinite(peak):
         label = result.source.name if result.source else f"result {index + 1}"
         raise LevelSeriesError(f"{label}: no displacement channel: a level series is sorted by the peak "
                                f"excursion, which needs the laser")
     parameters = {n: result.parameters[n] for n in TABLE_PARAMETERS if n in result.parameters}
     reasons = small_signal_reasons(result.validity)
-    return Level(name, drive_rms(result), float(peak), parameters, str(result.validity.get("overall", "unknown")),
+    return Level(name, drive_rms(result), float(peak), parameters, str(result.validity.overall),
                  not reasons, reasons)
 
 

@@ -46,6 +46,7 @@ from analysis.text_boundary import control_found
 
 if TYPE_CHECKING:       # analysis.derived is imported where limits judge parameters, not to read a limits file
     from analysis.derived import ParameterValue
+    from analysis.validity.result import ResultValidity
 
 FORMAT = "linpar-limits/1"
 FIT_ERROR_CHANNELS = ("impedance", "displacement")
@@ -295,7 +296,7 @@ def _fit_error_tolerance(entry, text: str, path: Path) -> dict[str, float]:
             raise LimitsError(f"{where}.{channel}: found {str(value)[:40]!r}, expected a positive number of %")
         tolerance[channel] = float(value)
     return tolerance
-def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> dict:
+def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], validity: ResultValidity | str) -> dict:
     """The QA verdict as JSON (analysis.qa_verdict): "pass", "fail", "uncertain", "invalid" (the measurement
     itself is red) or "not judged" (the model misses a curve by more than the file's fit-error tolerance);
     `validity`: the result's validity, or its overall light alone.
@@ -310,13 +311,13 @@ def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], valid
            "parameters": [v.as_json() for v in judgement.verdicts]}
     if judgement.fit_error_percent:
         doc["fit_error_percent"] = dict(judgement.fit_error_percent)
-        bands = validity.get("fit_band_hz") if isinstance(validity, Mapping) else None
+        bands = None if isinstance(validity, str) else validity.fit_band_hz
         if bands:
-            doc["fit_band_hz"] = dict(bands)
+            doc["fit_band_hz"] = {name: list(band) for name, band in bands.items()}
     return doc
 
 
-def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> str:
+def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity: ResultValidity | str) -> str:
     """A table for the terminal: each limit in its file's unit, the measured interval, pass, FAIL or uncertain."""
     from analysis.qa_verdict import judge, outcome_word
     judgement = judge(limits, parameters, validity)
@@ -331,7 +332,7 @@ def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], va
                      + (f"  ({v.note})" if v.note else ""))
     if judgement.fit_error_percent:
         from analysis.fit.error import band_text
-        shown = validity if isinstance(validity, Mapping) else {}
+        shown = None if isinstance(validity, str) else validity
         lines.append("  fit error: " + ", ".join(
             f"{name} {err:.2g} %{band_text(shown, name)} (tolerance {limits.fit_error_percent.get(name, float('nan')):g} %)"
             for name, err in judgement.fit_error_percent.items()))

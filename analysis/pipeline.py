@@ -38,6 +38,7 @@ from analysis.validity.plausibility import plausibility_findings
 from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
 from analysis.validity.fit import UnusableChannels, misfit_findings, unusable_channels
+from analysis.validity.result import ResultValidity
 
 
 # Displacement lines below which Hx carries too little to fit Bl (and a delay) from.
@@ -60,7 +61,7 @@ class AnalysisResult:
     parameters: dict[str, ParameterValue]
     sd_m2: float | None
     source: Path | None = None
-    validity: dict = field(default_factory=lambda: {"overall": "unknown"})
+    validity: ResultValidity = field(default_factory=ResultValidity)
     not_fitted: str | None = None
     # The model part of the uncertainties (analysis.fit.model_uncertainty.ModelPart): None until estimated.
     model_part: object | None = None
@@ -153,7 +154,7 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     if unusable.impedance is not None:
         model = Model(effects, with_displacement=False)
         return AnalysisResult(spectra=spectra, fit=None, parameters=unmeasured_table(model, unusable.impedance),
-                              sd_m2=sd, source=recording.source, validity=validity.as_json(),
+                              sd_m2=sd, source=recording.source, validity=ResultValidity.checked(validity),
                               not_fitted=unusable.impedance)
     data = FitData.from_spectra(spectra)
     model = Model(effects, with_displacement=data.displacement is not None)
@@ -169,11 +170,10 @@ def _analyzed(recording: Recording, spectra: Spectra, sd_m2: float | None, effec
     parameters = parameter_table(fit, sd, unusable.displacement or NO_DISPLACEMENT)
     # Numbers no loudspeaker can have are judged like broken signals: red, with the likely cause.
     implausible = plausibility_findings(recording, spectra, parameters, sd, validity.peak_displacement_m)
-    judged = validity.with_findings(merged(misfit_findings(fit), implausible)).as_json()
-    judged["fit_error_percent"] = fit_error_percent(fit)       # what QA judges the model's misfit by
-    judged["fit_band_hz"] = bands_hz(data)                      # ... over these bands
-    if heating is not None:
-        judged["heating"] = heating.as_json()
+    judged = ResultValidity.checked(validity.with_findings(merged(misfit_findings(fit), implausible)),
+                                    fit_error_percent=fit_error_percent(fit),   # what QA judges the misfit by
+                                    fit_band_hz=bands_hz(data),                 # ... over these bands
+                                    heating=None if heating is None else heating.as_json())
     return AnalysisResult(spectra=spectra, fit=fit, parameters=parameters, sd_m2=sd, source=recording.source,
                           validity=judged, data=data, whole_band_fit=None if data is every_line else whole_band_fit)
 
@@ -236,21 +236,21 @@ def _judged(recording: Recording, spectra: Spectra) -> tuple[Validity, UnusableC
     return validity, unusable, spectra
 
 
-def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, dict]:
-    """The lines a fit of the recording may use and its judged channels as JSON (module doc), the coil's
-    heating taken out of the noise (and said under "heating") when the current drifts; NotAnalysable
+def judged_fit_data(recording: Recording, doing: str) -> tuple[FitData, ResultValidity]:
+    """The lines a fit of the recording may use and its judged channels (module doc), the coil's
+    heating taken out of the noise (and said in its `heating`) when the current drifts; NotAnalysable
     naming the file and `doing` when the impedance has none."""
     with naming_the_file(recording):
         validity, unusable, spectra = _judged(recording, estimate_spectra(recording))
     if unusable.impedance is not None:
         where = f"{recording.source}: " if recording.source is not None else ""
         raise NotAnalysable(f"{where}cannot {doing}: {unusable.impedance}")
-    judged = validity.as_json()
+    judged = ResultValidity.checked(validity)
     if any(f.code == DRIFT for f in validity.channels["current"].findings):
         # RE for the words only (the correction does not need it): the lowest real part of Z, as the fit starts
         spectra, heating = without_coil_heating(recording, spectra, validity, start_context(spectra.impedance).RE)
         if heating is not None:
-            judged["heating"] = heating.as_json()
+            judged = judged.replace(heating=heating.as_json())
     return FitData.from_spectra(spectra), judged
 
 
@@ -277,7 +277,7 @@ def result_json(result: AnalysisResult) -> dict:
         "parameters": {name: p.as_json() for name, p in result.parameters.items()},
         "model": model_json(result.fit) if result.fit is not None else
         {"effects": [], "converged": False, "not_fitted": result.not_fitted},
-        "validity": result.validity,
+        "validity": result.validity.as_json(),
     }
 
 

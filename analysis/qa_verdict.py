@@ -16,6 +16,8 @@ from typing import Mapping
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN, verdict_of
 from analysis.report.numbers import plain_number, pretty_unit
 from analysis.validity.fit import VERDICT_HEADLINES, qa_blocker
+from analysis.validity.findings import Severity
+from analysis.validity.result import ResultValidity
 
 
 @dataclass(frozen=True)
@@ -59,13 +61,13 @@ def _straddle_text(verdict) -> str:
     return f"{verdict.limit.name} {lo / scale:.4g} .. {hi / scale:.4g} {unit}".rstrip() + f" across {verdict.limit.text}"
 
 
-def judge(limits, parameters: Mapping, validity: Mapping | str) -> QAJudgement:
-    """The verdict of `parameters` (name -> analysis.derived.ParameterValue) with their `validity` (as JSON, or
-    the overall light alone) against `limits` (analysis.limits.Limits, which imports this module: not imported
+def judge(limits, parameters: Mapping, validity: ResultValidity | str) -> QAJudgement:
+    """The verdict of `parameters` (name -> analysis.derived.ParameterValue) with their `validity` (or the
+    overall light alone) against `limits` (analysis.limits.Limits, which imports this module: not imported
     here)."""
-    validity = {"overall": validity} if isinstance(validity, str) else validity
+    validity = ResultValidity(overall=validity) if isinstance(validity, str) else validity
     verdicts = limits.judge(parameters)
-    errors = dict(validity.get("fit_error_percent") or {})
+    errors = dict(validity.fit_error_percent or {})
     blocker = qa_blocker(validity, limits.fit_error_percent)
     if blocker is not None:
         return QAJudgement(blocker[0], blocker[1], verdicts, False, errors)
@@ -81,6 +83,6 @@ def judge(limits, parameters: Mapping, validity: Mapping | str) -> QAJudgement:
                "straddles the limit; measure again (more periods narrow it)")
     else:
         why = f"all {len(verdicts)} parameters within their limits (value ± {INTERVAL_K:g} σ)"
-        if validity.get("overall") == "yellow":
+        if validity.overall == Severity.YELLOW:
             why += "; the measurement is doubtful: read the yellow findings"
     return QAJudgement(verdict, why, verdicts, True, errors)

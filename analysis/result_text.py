@@ -50,8 +50,7 @@ def format_result(result) -> str:
         chi = ", ".join(f"{k} {v:.3g}" for k, v in fit.chi2_red_by_channel().items())
         lines += ["", f"model: {fit.model.describe()} ({fit.method} fit)   reduced chi^2: {chi}   AIC {fit.aic:.1f}   "
                       f"BIC {fit.bic:.1f}   ({fit.n_data} data, {fit.n_varying} parameters)"]
-        errors = (result.validity or {}).get("fit_error_percent") or {}
-        if errors:
+        if result.validity.fit_error_percent:
             from analysis.fit.error import fit_error_text
             lines.append("fit error: " + fit_error_text(result.validity) + " (rms misfit of each curve in its fitted band)")
         from analysis.fit.model_uncertainty import model_part_words
@@ -62,10 +61,9 @@ def format_result(result) -> str:
         report = fit.report()
     if notes:
         lines += ["", "not reported:"] + notes
-    lines.append(f"validity: {result.validity.get('overall', 'unknown')}")
-    for channel in (result.validity.get("channels") or {}).values():
-        for f in channel.get("findings") or ():
-            lines.append(f"  {f['severity']}: {f['message']}; {f['remedy']}")
+    lines.append(f"validity: {result.validity.overall}")
+    for f in result.validity.findings:
+        lines.append(f"  {f.severity}: {f.message}; {f.remedy}")
     if fit is not None:
         lines += ["", report]           # the fit's own report (analysis.fit.report): correlations, bounds
     return "\n".join(lines)
@@ -76,8 +74,9 @@ def format_curve_result(result) -> str:
     text, then the band each curve was fitted over, the fit errors and the notes on the curves (how far to
     trust numbers no validity check has judged)."""
     ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
-    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity["fit_error_percent"].items())
+    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity.fit_error_percent.items())
+    imported = result.validity.imported
     lines = [format_result(result), f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)",
-             f"note: {result.validity['note']}; {result.validity['uncertainties']}"]
+             f"note: {imported.note}; {imported.uncertainties}"]
     lines += [f"  {note}" for note in result.notes]
     return "\n".join(lines)

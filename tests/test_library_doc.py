@@ -39,7 +39,7 @@ def test_every_line_shown_is_printed(notebook):
 
 def test_the_example_reproduces_the_drivers_parameters(notebook):
     ns, _ = notebook
-    assert ns["first"].validity["overall"] == "yellow"        # the default model misses the second stage
+    assert ns["first"].validity.overall == "yellow"        # the default model misses the second stage
     assert "lr3" in ns["effects"]
     result, given = ns["result"], ns["given"]
     for name in ("RE", "Bl", "Mms", "Kms", "fs", "Qts", "Vas"):

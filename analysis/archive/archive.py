@@ -139,6 +139,15 @@ def _jsonable(value):
     raise TypeError(f"{type(value).__name__} cannot be stored as JSON")
 
 
+def overall_of(validity: Mapping) -> str:
+    """The overall light of a results document's "validity" (ArchiveError when the object cannot be read)."""
+    from analysis.validity.result import ResultValidity, ResultValidityError
+    try:
+        return str(ResultValidity.from_json(validity).overall)
+    except ResultValidityError as exc:
+        raise ArchiveError(f"result: {exc}") from None
+
+
 def _iso(text: str | None, field_name: str, naive_is_utc: bool = False) -> str | None:
     """The date as the archive writes it (UTC, seconds, 'Z'); ArchiveError when it is none.
 
@@ -267,7 +276,7 @@ class Archive(FolderQA):
             "measured_at": measured_at or stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
             "stored_at": stored_at.isoformat(timespec="seconds").replace("+00:00", "Z"),
             **text, "notes": clean_text(meta.notes, "notes", 2000),
-            "validity": str(doc["validity"].get("overall", "unknown")),
+            "validity": overall_of(doc["validity"]),
             "effects": list(doc["model"].get("effects", [])), "sd_m2": doc.get("sd_m2"),
             "key_parameters": {k: {"value": params[k].get("value"), "std": params[k].get("std"),
                                    "unit": params[k].get("unit", "")} for k in KEY_PARAMETERS if k in params},

@@ -93,9 +93,9 @@ def judged(results_document: Mapping, version: LimitsVersion | None) -> dict | N
         return None
     from analysis.archive.results import StoredResult
     from analysis.limits import judge_result
-    parameters = StoredResult.from_json(results_document).parameters
+    stored = StoredResult.from_json(results_document)
     from analysis.validity.fit import STORED_VERDICT
-    verdict = judge_result(version.limits(), parameters, results_document.get("validity") or {})["verdict"]
+    verdict = judge_result(version.limits(), stored.parameters, stored.validity)["verdict"]
     # An uncertain unit (an interval across a limit) is stored as "not judged": measured again, in no yield.
     return {"verdict": STORED_VERDICT.get(verdict, verdict), "limits_version": version.version,
             "limits_name": version.name}

@@ -25,6 +25,7 @@ from analysis.errors import LinparError
 from analysis.fit.report import fit_report_json
 from analysis.json_finite import finite
 from analysis.session import session_of
+from analysis.validity.result import ResultValidity, ResultValidityError
 
 FORMAT = "linpar-results/1"
 CHANNELS = ("impedance", "displacement")
@@ -90,7 +91,7 @@ def results_document(result, recording=None) -> dict:
         "format": FORMAT,
         "parameters": parameters,
         "model": _model_json(fit) if fit is not None else not_fitted_model(result.not_fitted),
-        "validity": result.validity,
+        "validity": result.validity.as_json(),
         "sd_m2": _num(result.sd_m2),
         # Imported curves (analysis.curves.stored) have no spectra: their settings are their fitted bands.
         "settings": _settings_of(recording, result) if hasattr(result, "spectra") else {},
@@ -221,14 +222,14 @@ def _object(doc: Mapping, key: str, where: str) -> dict:
     return dict(value)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class StoredResult:
     parameters: dict[str, ParameterValue]
     effects: tuple[str, ...]
     with_displacement: bool
     values: dict[str, float]
     model_info: dict[str, Any]
-    validity: dict
+    validity: ResultValidity
     sd_m2: float | None
     settings: dict
     curves: dict[str, Curve] = field(default_factory=dict)
@@ -282,11 +283,13 @@ class StoredResult:
                                  arr["measured_re"] + 1j * arr["measured_im"], arr["std"],
                                  arr["model_re"] + 1j * arr["model_im"], bool(c.get("has_phase", True)))
         sd = doc.get("sd_m2")
-        return cls(parameters, effects, bool(model.get("with_displacement", "displacement" in curves)), values,
-                   dict(model), _object(doc, "validity", "") or {"overall": "unknown"},
-                   None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError), _object(doc, "settings", ""),
-                   curves, _user_effects(model), _session(doc), _reference_curves(doc),
-                   _object(doc, "reference_fit", ""))
+        return cls(parameters=parameters, effects=effects,
+                   with_displacement=bool(model.get("with_displacement", "displacement" in curves)), values=values,
+                   model_info=dict(model), validity=_validity(doc),
+                   sd_m2=None if sd is None else SD.check(sd, "sd_m2", ResultsFormatError),
+                   settings=_object(doc, "settings", ""), curves=curves, user_effects=_user_effects(model),
+                   session=_session(doc), reference_curves=_reference_curves(doc),
+                   reference_fit=_object(doc, "reference_fit", ""))
 
     def model(self):
         """The analysis.model.composed.Model the values belong to (rebuilt from the effect ids and the stored effect files)."""
@@ -302,13 +305,20 @@ class StoredResult:
 
     @property
     def overall(self) -> str:
-        return str(self.validity.get("overall", "unknown"))
+        return str(self.validity.overall)
 
     @property
     def not_fitted(self) -> str | None:
         """Why nothing was fitted (a broken measurement), or None for a fitted result."""
         why = self.model_info.get("not_fitted")
         return str(why) if why else None
+
+
+def _validity(doc: Mapping) -> ResultValidity:
+    try:
+        return ResultValidity.from_json(_object(doc, "validity", ""))
+    except ResultValidityError as exc:
+        raise ResultsFormatError(str(exc)) from None
 
 
 def _reference_curves(doc: Mapping) -> dict[str, tuple[np.ndarray, np.ndarray]]:

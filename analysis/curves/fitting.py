@@ -56,6 +56,7 @@ from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
+from analysis.validity.result import ImportedCurves, ResultValidity
 
 Z_MAX_OVER_FS = 5.0
 # The other Z bands whose fits the model part of magnitude-only curves spans (analysis.fit.model_uncertainty):
@@ -132,7 +133,7 @@ class CurveAnalysis:
     parameters: dict[str, ParameterValue]
     sd_m2: float | None
     ranges: dict[str, tuple[float, float]]       # the band each channel was fitted over
-    validity: dict
+    validity: ResultValidity
     notes: tuple[str, ...] = ()
     data: FitData | None = None                  # what was fitted (the model part's refits fit it again)
     # Magnitude-only curves: a model part even when the misfit is small (no phase to show what the model misses),
@@ -287,18 +288,11 @@ def _with_noise(tf: TransferFunction, notes: list[str]) -> TransferFunction:
 
 
 def curve_validity(fit: FitResult, ranges: Mapping[str, tuple[float, float]],
-                   curves: Sequence[TransferFunction], notes: Sequence[str]) -> dict:
-    """The 'validity' object for imported curves: nothing checked, and how far to trust the numbers."""
-    return {
-        "overall": "unknown",
-        "note": VALIDITY_NOTE,
-        "uncertainties": UNCERTAINTY_NOTE,
-        "rms_relative_residual": rms_relative_residual(fit),
-        "fit_error_percent": fit_error_percent(fit),
-        "magnitude_only": [tf.name for tf in curves if not tf.has_phase],
-        "ranges_hz": {name: list(r) for name, r in ranges.items()},
-        "notes": list(notes),
-    }
+                   curves: Sequence[TransferFunction], notes: Sequence[str]) -> ResultValidity:
+    """The validity of imported curves: nothing checked, and how far to trust the numbers."""
+    return ResultValidity(fit_error_percent=fit_error_percent(fit), imported=ImportedCurves(
+        note=VALIDITY_NOTE, uncertainties=UNCERTAINTY_NOTE, rms_relative_residual=rms_relative_residual(fit),
+        magnitude_only=tuple(tf.name for tf in curves if not tf.has_phase), ranges_hz=ranges, notes=tuple(notes)))
 
 
 def curve_json(result: CurveAnalysis) -> dict:
@@ -306,7 +300,7 @@ def curve_json(result: CurveAnalysis) -> dict:
     return {
         "parameters": {name: p.as_json() for name, p in result.parameters.items()},
         "model": model_json(result.fit),
-        "validity": result.validity,
+        "validity": result.validity.as_json(),
     }
 
 

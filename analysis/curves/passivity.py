@@ -27,7 +27,9 @@ import numpy as np
 
 from analysis.derived import ParameterValue
 from analysis.spectra import TransferFunction
+from analysis.validity.assessment import ChannelValidity
 from analysis.validity.findings import Finding, Severity
+from analysis.validity.result import ResultValidity
 
 NOT_PASSIVE = "not-passive"
 NO_RESONANCE = "no-resonance"
@@ -103,12 +105,13 @@ def passivity_findings(impedance: TransferFunction) -> list[Finding]:
     return [f for f in (_not_passive(impedance), _no_resonance(impedance)) if f is not None]
 
 
-def judged_not_a_driver(validity: dict, parameters: Mapping[str, ParameterValue], found: list[Finding]
-                        ) -> tuple[dict, dict[str, ParameterValue]]:
+def judged_not_a_driver(validity: ResultValidity, parameters: Mapping[str, ParameterValue], found: list[Finding]
+                        ) -> tuple[ResultValidity, dict[str, ParameterValue]]:
     """The curves' validity red with `found` on the impedance, and every parameter withheld with their words:
     a resistor's fs or a non-passive curve's Qms is no driver's, and is not reported as one."""
     why = "the curve is no driver's: " + "; ".join(f.message.split(":")[0] for f in found) + " (see validity)"
-    validity = {**validity, "overall": "red",
-                "channels": {"impedance": {"findings": [f.as_json() for f in found]}}}
+    # The impedance channel has findings but no light of its own (nothing else of the curves was checked).
+    validity = validity.replace(overall=Severity.RED,
+                                channels={"impedance": ChannelValidity("impedance", None, tuple(found))})
     return validity, {name: dataclasses.replace(p, value=None, std=None, std_noise=None, std_model=None, reason=why)
                       for name, p in parameters.items()}

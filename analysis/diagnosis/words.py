@@ -11,6 +11,7 @@ from analysis.diagnosis import acceptance, noise_floor, residuals
 from analysis.diagnosis.candidates import Diagnosis
 from analysis.diagnosis.sites import TIE_CHI2, SiteResult, tied_sites  # noqa: F401 (said from here too)
 from analysis.effects.base import Site
+from analysis.validity.findings import DRIFT
 from analysis.fit.least_squares import FitResult
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
@@ -63,14 +64,15 @@ def _site_sentence(fit: FitResult, sites: tuple[SiteResult, ...]) -> str:
     return text
 
 
-def drift_from_validity(validity: dict | None) -> str | None:
-    """The validity check's drift findings (its JSON form), in one sentence; None when there are none."""
-    channels = (validity or {}).get("channels") or {}
-    found = [f"{name}: {f['message']}" for name, ch in channels.items() for f in (ch or {}).get("findings", [])
-             if f.get("code") == "drift"]
-    heating = (validity or {}).get("heating") or {}
-    if heating.get("significant"):
-        found.append(heating["text"])
+def drift_from_validity(validity) -> str | None:
+    """The validity check's drift findings (an analysis.validity.result.ResultValidity's, or None), in one sentence;
+    None when there are none."""
+    if validity is None:
+        return None
+    found = [f"{name}: {f.message}" for name, ch in validity.channels.items() for f in ch.findings
+             if f.code == DRIFT]
+    if validity.heating_words:
+        found.append(validity.heating_words)
     return "; ".join(found) or None
 
 

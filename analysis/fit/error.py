@@ -48,8 +48,9 @@ def fit_error_percent(fit) -> dict[str, float]:
 
 
 def band_text(validity, channel: str) -> str:
-    """" (14.6-915 Hz)": the band a channel's fit error was measured over, from a result's validity (as JSON), or ""."""
-    band = ((validity or {}).get("fit_band_hz") or {}).get(channel)
+    """" (14.6-915 Hz)": the band a channel's fit error was measured over, from a result's validity
+    (analysis.validity.result.ResultValidity; None: no band), or ""."""
+    band = ((validity.fit_band_hz if validity is not None else None) or {}).get(channel)
     return f" ({_hz(band[0])}-{_hz(band[1])} Hz)" if band else ""
 
 
@@ -59,5 +60,5 @@ def _hz(f: float) -> str:
 
 def fit_error_text(validity) -> str:
     """"impedance 2.8 % (14.6-915 Hz), displacement 1.8 % (14.6-138 Hz)": each curve's fit error and its band."""
-    errors = (validity or {}).get("fit_error_percent") or {}
+    errors = (validity.fit_error_percent if validity is not None else None) or {}
     return ", ".join(f"{name} {value:.2g} %{band_text(validity, name)}" for name, value in errors.items())

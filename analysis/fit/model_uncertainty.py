@@ -281,7 +281,7 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
 def with_estimated(result, part: ModelPart):
     """`result` with `part`'s spread in its parameters' std, and `part` kept on it and in its validity."""
     changes = {"parameters": with_model_part(result.parameters, part.spread(result.fit.values, result.sd_m2)),
-               "validity": {**result.validity, "model_part": part.as_json()}}
+               "validity": result.validity.replace(model_part=part.as_json())}
     if "model_part" in {f.name for f in dataclasses.fields(result)}:
         changes["model_part"] = part
     return dataclasses.replace(result, **changes)
@@ -295,9 +295,10 @@ def with_sd(result, parameters: Mapping[str, ParameterValue], sd_m2: float | Non
     return dataclasses.replace(result, sd_m2=sd_m2, parameters=with_model_part(parameters, spread))
 
 
-def model_part_words(validity: Mapping | None) -> str:
-    """What a result's model part came to, in one sentence (its validity's "model_part"); "" before it is estimated."""
-    entry = (validity or {}).get("model_part") or {}
+def model_part_words(validity) -> str:
+    """What a result's model part came to, in one sentence (its analysis.validity.result.ResultValidity's
+    model_part, ModelPart.as_json()); "" before it is estimated."""
+    entry = (validity.model_part if validity is not None else None) or {}
     state = entry.get("state")
     if state == ESTIMATED:
         n = len(entry.get("models") or ())

@@ -20,6 +20,7 @@ from analysis.report.customer import (calibration_rows, file_name, model_title, 
                                       split_parameters)
 from analysis.report.numbers import format_number, format_std, pretty_unit, readable_number
 from analysis.report.qa import LimitRow, QASection, qa_section
+from analysis.validity.result import ResultValidity
 
 CHANNEL_TITLES = {"voltage": "Voltage", "current": "Current", "displacement": "Displacement"}
 HEADER_FIELDS = (("driver", "Driver"), ("serial", "Serial number"), ("measured_at", "Date"),
@@ -93,13 +94,11 @@ class ReportContent:
         return "displacement" in self.result.curves
 
 
-def _lights(validity: Mapping) -> tuple[Light, ...]:
+def _lights(validity: ResultValidity) -> tuple[Light, ...]:
     lights = []
-    for name, channel in (validity.get("channels") or {}).items():
-        findings = tuple(Finding(name, str(f.get("severity", "")), str(f.get("code", "")),
-                                 str(f.get("message", "")), str(f.get("remedy", "")))
-                         for f in channel.get("findings", []))
-        lights.append(Light(name, str(channel.get("status", "unknown")), findings))
+    for name, channel in validity.channels.items():
+        findings = tuple(Finding(name, str(f.severity), f.code, f.message, f.remedy) for f in channel.findings)
+        lights.append(Light(name, str(channel.status or "unknown"), findings))
     return tuple(lights)
 
 
@@ -147,7 +146,7 @@ def _model_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
     titles = [e.title if e else effect_id for effect_id, e in ((i, _effect(i, result)) for i in result.effects)]
     info = result.model_info
     rows = [("Model", model_title(titles, result.with_displacement))]
-    for channel, value in (result.validity.get("fit_error_percent") or {}).items():
+    for channel, value in (result.validity.fit_error_percent or {}).items():
         band = band_text(result.validity, channel).strip(" ()")
         rows.append((f"Fit error ({channel})", (f"over {band}: " if band else "")
                      + f"{readable_number(value)} % (rms misfit in its fitted band)"))
@@ -243,7 +242,7 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
     head = tuple((label, str(header.get(key) or "–")) for key, label in HEADER_FIELDS
                  if header.get(key) or key in ALWAYS_SHOWN)
     customer, internal = split_parameters(result.parameters, result.sd_m2)
-    peak = result.validity.get("peak_displacement_m")
+    peak = result.validity.peak_displacement_m
     peak_text = f"{peak * 1e3:.3g} mm" if isinstance(peak, (int, float)) else "not measured"
     cal: list[tuple[str, str]] = []
     _flatten("", dict(calibration or {}), cal)

@@ -20,6 +20,7 @@ from analysis.derived import ParameterValue
 from analysis.parameter_names import display_name
 from analysis.report.numbers import pretty_unit, readable_number, short_number
 from analysis.validity.fit import FAIL, INVALID, NOT_JUDGED, PASS, UNCERTAIN, VERDICT_HEADLINES
+from analysis.validity.result import ResultValidity
 
 # (background, text) of the verdict banner, also the QA page's. INVALID has its own colour (violet), not FAIL's
 # red: a broken measurement says nothing of the unit, and an operator reads the colour first.
@@ -72,14 +73,14 @@ def _row(verdict, parameter: ParameterValue | None, judged: bool) -> LimitRow:
                     outcome, "")
 
 
-def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: Mapping | str) -> QASection:
-    """limits: analysis.limits.Limits; parameters in SI as the result has them; validity: the result's (as
-    JSON), or its overall light alone."""
+def qa_section(limits, parameters: Mapping[str, ParameterValue], validity: ResultValidity | str) -> QASection:
+    """limits: analysis.limits.Limits; parameters in SI as the result has them; validity: the result's, or its
+    overall light alone."""
     from analysis.qa_verdict import judge
     judgement = judge(limits, parameters, validity)
     rows = tuple(_row(v, parameters.get(v.limit.name), judgement.judged) for v in judgement.verdicts)
     from analysis.fit.error import band_text
-    shown = validity if isinstance(validity, Mapping) else {}
+    shown = None if isinstance(validity, str) else validity
     fit_error = ", ".join(f"{name} {readable_number(err)} %{band_text(shown, name)} (tolerance "
                           f"{limits.fit_error_percent.get(name, float('nan')):g} %)"
                           for name, err in judgement.fit_error_percent.items())

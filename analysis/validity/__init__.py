@@ -1,7 +1,8 @@
 """Whether a measurement can be trusted, channel by channel: the checks of the spectra, the wiring, the drift, the capture and the fit, and their findings.
 
-The public names of analysis.validity.assessment (assess, Validity, ...) are importable from
-the package itself; each is loaded on first use.
+The public names of analysis.validity.assessment (assess, Validity, ...) and of
+analysis.validity.result (ResultValidity: a result's validity, with its JSON) are importable
+from the package itself; each is loaded on first use.
 """
 from __future__ import annotations
 
@@ -15,6 +16,9 @@ _HOME = {
     "CaptureInfoError": "assessment",
     "ChannelValidity": "assessment",
     "Finding": "assessment",
+    "ImportedCurves": "result",
+    "ResultValidity": "result",
+    "ResultValidityError": "result",
     "Severity": "assessment",
     "Validity": "assessment",
     "assess": "assessment",

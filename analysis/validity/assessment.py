@@ -15,8 +15,9 @@
 Each channel's status is its worst finding (green when it has none); the
 overall light is the worst channel's. A recording without displacement has
 the displacement status "absent", which does not count towards the overall
-light. `Validity.as_json()` is what `linpar analyze --json` prints under
-"validity":
+light. `Validity.as_json()` is the checks' part of what `linpar analyze
+--json` prints under "validity" (a result carries an
+analysis.validity.result.ResultValidity, which adds what the fit found):
 
     {"overall": "green" | "yellow" | "red",
      "channels": {"voltage": {"status": ..., "findings": [{"code", "severity", "message", "remedy", "value"}]},
@@ -51,7 +52,8 @@ CAPTURE_KEY = "capture"
 @dataclass(frozen=True, slots=True)
 class ChannelValidity:
     signal: str
-    status: str                                  # "green" | "yellow" | "red" | "absent"
+    # "green" | "yellow" | "red" | "absent"; None for imported curves' channel, which carries findings alone
+    status: str | None
     findings: tuple[Finding, ...] = ()
     # The numbers the checks measured (snr_db, distortion_db, x_band_hz, drift, ...): for the GUI, not the JSON.
     measures: Mapping[str, float] = field(default_factory=dict)
@@ -59,8 +61,13 @@ class ChannelValidity:
     def __post_init__(self) -> None:
         object.__setattr__(self, "measures", MappingProxyType(dict(self.measures)))
 
+    def __reduce__(self):
+        # A mapping proxy cannot be pickled (nor deep-copied): the measures as a dict, made read-only again.
+        return ChannelValidity, (self.signal, self.status, self.findings, dict(self.measures))
+
     def as_json(self) -> dict:
-        return {"status": self.status, "findings": [f.as_json() for f in self.findings]}
+        findings = [f.as_json() for f in self.findings]
+        return {"findings": findings} if self.status is None else {"status": self.status, "findings": findings}
 
 
 @dataclass(frozen=True, slots=True)

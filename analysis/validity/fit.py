@@ -37,8 +37,9 @@ from analysis.fit.error import FIT_ERROR_DEFAULTS, fit_error_percent
 from analysis.fit.least_squares import FitResult
 from analysis.qa_interval import FAIL, PASS, UNCERTAIN
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity.assessment import ABSENT, Validity
+from analysis.validity.assessment import ABSENT, ChannelValidity, Validity
 from analysis.validity.findings import CHANNEL_COPY, MODEL_MISFIT, NO_SIGNAL, Finding, Severity, worst
+from analysis.validity.result import ResultValidity
 
 # Findings after which a channel carries nothing a fit could use.
 UNUSABLE = (NO_SIGNAL, CHANNEL_COPY)
@@ -103,46 +104,45 @@ def misfit_findings(fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS)
     return found
 
 
-def rejudged(validity: Mapping, fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS) -> dict:
-    """A result's validity (as JSON) for another fit of the same recording: the old fit's misfit findings
-    replaced by the new one's, the lights redone, the fit error and its band the new fit's (the Model lab's
-    versions, fitted over every line where the result may have come from the piston band)."""
+def rejudged(validity: ResultValidity, fit: FitResult, th: ValidityThresholds = DEFAULT_THRESHOLDS
+             ) -> ResultValidity:
+    """A result's validity for another fit of the same recording: the old fit's misfit findings replaced by the
+    new one's, the lights redone, the fit error and its band the new fit's (the Model lab's versions, fitted
+    over every line where the result may have come from the piston band)."""
+    misfits = misfit_findings(fit, th)
     channels = {}
-    for name, channel in (validity.get("channels") or {}).items():
-        if channel.get("status") == ABSENT:
+    for name, channel in validity.channels.items():
+        if channel.status == ABSENT:
             channels[name] = channel
             continue
-        findings = [f for f in channel.get("findings") or () if f.get("code") != MODEL_MISFIT]
-        findings += [f.as_json() for f in misfit_findings(fit, th).get(name, ())]
-        channels[name] = {**channel, "findings": findings,
-                          "status": str(worst(Severity(f["severity"]) for f in findings))}
-    lights = [Severity(ch["status"]) for ch in channels.values() if ch.get("status") in set(Severity)]
-    return {**validity, "channels": channels, "overall": str(worst(lights)) if channels else
-            validity.get("overall", "unknown"), "fit_error_percent": fit_error_percent(fit),
-            "fit_band_hz": curves_band_hz(fit.channels.values())}
+        findings = tuple(f for f in channel.findings if f.code != MODEL_MISFIT) + tuple(misfits.get(name, ()))
+        channels[name] = ChannelValidity(name, str(worst(f.severity for f in findings)), findings, channel.measures)
+    lights = [Severity(ch.status) for ch in channels.values() if ch.status in set(Severity)]
+    return validity.replace(channels=channels, overall=worst(lights) if channels else validity.overall,
+                            fit_error_percent=fit_error_percent(fit),
+                            fit_band_hz=curves_band_hz(fit.channels.values()))
 
 
-def red_findings_text(validity: Mapping) -> str:
-    """The first red finding of a validity (as JSON) in words, with its code and remedy, and how many more."""
-    red = [f for channel in (validity.get("channels") or {}).values() for f in channel.get("findings") or ()
-           if f.get("severity") == "red"]
+def red_findings_text(validity: ResultValidity) -> str:
+    """The first red finding of a validity in words, with its code and remedy, and how many more."""
+    red = [f for f in validity.findings if f.severity == Severity.RED]
     if not red:
         return "a channel is red: read its light"
     first = red[0]
     more = f" (and {len(red) - 1} more red finding{'s' if len(red) > 2 else ''})" if len(red) > 1 else ""
-    return f"{first.get('message')} [{first.get('code')}]{more}: {first.get('remedy')}"
+    return f"{first.message} [{first.code}]{more}: {first.remedy}"
 
 
-def qa_blocker(validity: Mapping, tolerance: Mapping[str, float] | None = None) -> tuple[str, str] | None:
-    """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result (validity as JSON); else None.
+def qa_blocker(validity: ResultValidity, tolerance: Mapping[str, float] | None = None) -> tuple[str, str] | None:
+    """(INVALID or NOT_JUDGED, why) when QA limits must not judge this result; else None.
 
     tolerance: channel -> the largest fit error in % at which the model is taken to describe the measurement
     (analysis.fit.error.FIT_ERROR_DEFAULTS when None). A result stored before the fit error was computed (no
     "fit_error_percent") is judged by its model-misfit finding, as it was then."""
-    if validity.get("overall") == "red":
+    if validity.overall == Severity.RED:
         return INVALID, (f"measurement invalid: {red_findings_text(validity)}, and measure again; the unit "
                          "itself was not judged")
-    errors = validity.get("fit_error_percent")
+    errors = validity.fit_error_percent
     if errors is not None:
         tolerance = FIT_ERROR_DEFAULTS if tolerance is None else tolerance
         over = [(name, err, tolerance[name]) for name, err in errors.items()
@@ -152,9 +152,8 @@ def qa_blocker(validity: Mapping, tolerance: Mapping[str, float] | None = None) 
         said = "; ".join(f"the {name} by {err:.3g} % rms (tolerance {limit:g} %)" for name, err, limit in over)
         return NOT_JUDGED, (f"the model does not describe this measurement: it misses {said}; its parameters "
                             f"judge nothing; {MISFIT_REMEDY}")
-    for channel in (validity.get("channels") or {}).values():
-        for finding in channel.get("findings") or ():
-            if finding.get("code") == MODEL_MISFIT:
-                return NOT_JUDGED, (f"the model does not describe this measurement ({finding.get('message')}): its "
-                                    f"parameters judge nothing; {finding.get('remedy')}")
+    for finding in validity.findings:
+        if finding.code == MODEL_MISFIT:
+            return NOT_JUDGED, (f"the model does not describe this measurement ({finding.message}): its "
+                                f"parameters judge nothing; {finding.remedy}")
     return None

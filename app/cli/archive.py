@@ -146,9 +146,9 @@ def _store(archive, args) -> int:
     say_notes(archive)
     queued = archive.pending > 0
     if args.json:
-        print_json({"id": mid, "validity": result.validity.get("overall"), **({"queued": True} if queued else {})})
+        print_json({"id": mid, "validity": str(result.validity.overall), **({"queued": True} if queued else {})})
     else:
-        print(f"{'queued' if queued else 'stored'} {mid} (validity {result.validity.get('overall')})"
+        print(f"{'queued' if queued else 'stored'} {mid} (validity {result.validity.overall})"
               + (": it waits in this station's queue until the server can be reached" if queued else ""))
     return 0
 

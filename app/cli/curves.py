@@ -90,9 +90,9 @@ def analyze_curves(args: argparse.Namespace) -> int:
         return 0
     print(format_result(result))
     ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
-    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity["fit_error_percent"].items())
+    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity.fit_error_percent.items())
     print(f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)")
-    print(f"note: {result.validity['note']}; {result.validity['uncertainties']}")
+    print(f"note: {result.validity.imported.note}; {result.validity.imported.uncertainties}")
     for name, c in beside.items():
         print(comparison_words(name, c))
     for note in result.notes:

@@ -240,7 +240,7 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     if archive.pending:
         say(f"measured as {mid}; it waits in this station's queue until the server {root} can be reached")
         return {"id": mid, "root": str(root), "queued": True}
-    judged = "" if outcome.result.fit is not None else f" (judged {outcome.result.validity.get('overall')}: nothing " \
+    judged = "" if outcome.result.fit is not None else f" (judged {outcome.result.validity.overall}: nothing " \
                                                        "could be fitted)"
     say(f"stored in the archive {root} as {mid}{judged}")
     return {"id": mid, "root": str(root)}

@@ -18,7 +18,6 @@ from __future__ import annotations
 import html
 import importlib.util
 from pathlib import Path
-from typing import Mapping
 
 from PySide6.QtCore import QSettings, Qt, Signal
 from PySide6.QtGui import QColor
@@ -26,6 +25,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxL
                                QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.pipeline import AnalysisResult
+from analysis.validity.result import ResultValidity
 from app.results.fit_quality import model_words
 from app.jobs.book import Job, JobRunner
 from app.jobs.controls import JobControls
@@ -60,10 +60,10 @@ def display(value: float | None, parameter) -> str:
     return value_with_unit(parameter)
 
 
-def qa_verdict(validity: Mapping | str) -> tuple[str, str]:
+def qa_verdict(validity: ResultValidity | str) -> tuple[str, str]:
     """(verdict, why) without limits loaded: the measurement's validity alone (analysis.validity.fit.qa_blocker)."""
     from analysis.validity.fit import qa_blocker
-    validity = {"overall": validity} if isinstance(validity, str) else validity
+    validity = ResultValidity(overall=validity) if isinstance(validity, str) else validity
     blocker = qa_blocker(validity)
     if blocker is not None:
         return blocker
@@ -226,18 +226,17 @@ class QAView(QWidget):
     # -- showing -----------------------------------------------------------------
     def refresh(self, keep_limits_text: bool = False) -> None:
         result = self.result
-        validity = result.validity if result is not None else {"overall": "unknown"}
-        overall = str(validity.get("overall", "unknown"))
+        validity = result.validity if result is not None else ResultValidity()
+        overall = str(validity.overall)
         self.overall_light.set_status(overall)
         from app.widgets.style import VALIDITY_TEXT
         from app.widgets.traffic_light import STATE_WORDS
         self.overall_text.setText(f"<h2>Measurement {html.escape(STATE_WORDS.get(overall, overall))}</h2>"
                                   f"{html.escape(VALIDITY_TEXT.get(overall, ''))}")
-        channels = validity.get("channels") or {}
         for name, light in self.channels.items():
-            entry = channels.get(name) or {}
-            light.set_state(str(entry.get("status", "unknown" if result is None else "absent")),
-                            entry.get("findings") or ())
+            entry = validity.channels.get(name)
+            light.set_state(("unknown" if result is None else "absent") if entry is None else
+                            str(entry.status or "unknown"), () if entry is None else entry.findings)
         if result is not None:
             model = f"fitted with {model_words(result)}" if result.fit is not None else "nothing fitted"
             self.source.setText(f"Result of {result.source.name if result.source else 'an unsaved measurement'}"

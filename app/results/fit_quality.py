@@ -28,7 +28,7 @@ def model_words(result: AnalysisResult) -> str:
 
 def fit_error_words(result: AnalysisResult) -> str:
     """"impedance 2.1 %, displacement 3.4 % (rms misfit)": each curve's fit error, what QA judges the model by."""
-    errors = (result.validity or {}).get("fit_error_percent") or {}
+    errors = result.validity.fit_error_percent or {}
     if not errors:
         return ""
     return ", ".join(f"{name} {value:.2g} %" for name, value in errors.items()) + " (rms misfit of each curve)"

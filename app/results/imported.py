@@ -19,7 +19,7 @@ def is_imported(result) -> bool:
 def source_html(result) -> str:
     """The files, the band each channel was fitted over, and the comparison with the export's own fit."""
     names = " + ".join(f"<b>{html.escape(path.name)}</b>" for path in result.files) or "<b>imported curves</b>"
-    magnitude_only = set(result.validity.get("magnitude_only") or ())
+    magnitude_only = set(result.validity.imported.magnitude_only if result.validity.imported else ())
     bands = ", ".join(f"{CHANNEL_WORDS.get(name, name)} {lo:.3g}–{hi:.4g} Hz"
                       + (" (magnitude only)" if name in magnitude_only else "")
                       for name, (lo, hi) in result.ranges.items())

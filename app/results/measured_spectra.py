@@ -21,14 +21,13 @@ NOISE = "#9e9e9e"
 
 def valid_channels(result) -> list[str]:
     """The recording's channels the validity did not mark red, in CHANNEL_AXES's order."""
-    judged = (result.validity or {}).get("channels") or {}
+    judged = result.validity.channels
     return [name for name in CHANNEL_AXES if name in result.spectra.channels
-            and (judged.get(name) or {}).get("status") != "red"]
+            and (name not in judged or judged[name].status != "red")]
 
 
 def broken_channels(result) -> list[str]:
-    judged = (result.validity or {}).get("channels") or {}
-    return [name for name, channel in judged.items() if (channel or {}).get("status") == "red"]
+    return [name for name, channel in result.validity.channels.items() if channel.status == "red"]
 
 
 class MeasuredSpectraView(pg.GraphicsLayoutWidget):

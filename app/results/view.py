@@ -23,7 +23,7 @@ EMPTY_TEXT = ("No recording loaded.\n\nOpen one with File ▸ Open recording… 
 
 
 class ValidityBox(QLabel):
-    """result.validity["overall"] in its colour, with what the state means."""
+    """result.validity.overall in its colour, with what the state means."""
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -145,8 +145,8 @@ class ResultsView(QWidget):
         imported = is_imported(result)
         self.source_label.setText(source_html(result) if imported else
                                   source_text(result) + self._re_remark(result, outcome.nominal_ohm))
-        self.validity_box.set_state(str(result.validity.get("overall", "unknown")),
-                                    result.validity.get("note") if imported else None)
+        self.validity_box.set_state(str(result.validity.overall),
+                                    result.validity.imported.note if result.validity.imported else None)
         self.fit_quality.set_result(result)
         self._show_parameters(result)
         if curves is None:          # a broken measurement: judged (validity, reasons), nothing fitted

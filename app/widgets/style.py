@@ -19,7 +19,7 @@ RESIDUAL_BEYOND = "#8e1b1b"  # residuals beyond the strip's range, pinned at its
 GUIDE = "#8c8c8c"
 MISSING_TEXT = "#8c8c8c"
 
-# Validity lights (result.validity["overall"], analysis/validity/assessment.py) -> (background, text) colours.
+# Validity lights (result.validity.overall, analysis/validity/assessment.py) -> (background, text) colours.
 VALIDITY_COLOURS = {
     "green": ("#d8f0d8", "#1b5e20"),
     "yellow": ("#fff1c9", "#7a5300"),

@@ -7,7 +7,7 @@ meaning: the text next to it names the state too).
 from __future__ import annotations
 
 import html
-from typing import Iterable, Mapping
+from typing import Iterable
 
 from PySide6.QtCore import QRectF, QSize, Qt
 from PySide6.QtGui import QBrush, QColor, QPainter, QPen
@@ -54,21 +54,15 @@ class TrafficLight(QWidget):
         painter.drawEllipse(QRectF((self.width() - d) / 2, (self.height() - d) / 2, d, d))
 
 
-def finding_parts(finding) -> tuple[str, str, str]:
-    """(severity, message, remedy) of an analysis Finding or of its JSON form."""
-    if isinstance(finding, Mapping):
-        return str(finding.get("severity", "")), str(finding.get("message", "")), str(finding.get("remedy", ""))
-    return str(finding.severity), finding.message, finding.remedy
-
-
 def findings_html(findings: Iterable, empty: str = "") -> str:
-    """Each finding's message, and its remedy in italics (what to do matters as much as what is wrong)."""
+    """Each finding's (analysis.validity.findings.Finding) message, and its remedy in italics (what to do matters
+    as much as what is wrong)."""
     items = []
     for finding in findings:
-        severity, message, remedy = finding_parts(finding)
+        severity, message, remedy = str(finding.severity), finding.message, finding.remedy
         colour = style.validity_colours(severity)[1]
         text = f"<span style='color:{colour}'>●</span> {html.escape(message)}"
-        code = finding.get("code") if isinstance(finding, Mapping) else getattr(finding, "code", "")
+        code = finding.code
         if code:        # the stable code: the user guide, the report and the CLI's JSON name it too
             text += f" <span style='color:#666666'>[{html.escape(str(code))}]</span>"
         if remedy:
@@ -120,7 +114,7 @@ class ChannelLight(QWidget):
 
 
 class ValiditySummary(QWidget):
-    """The overall light, what it means, and a ChannelLight per channel (result.validity's JSON)."""
+    """The overall light, what it means, and a ChannelLight per channel (a result's validity)."""
 
     def __init__(self, overall_diameter: int = 28, channel_diameter: int = 16, parent=None):
         super().__init__(parent)
@@ -140,16 +134,17 @@ class ValiditySummary(QWidget):
             layout.addWidget(light)
         self.set_validity(None)
 
-    def set_validity(self, validity: Mapping | None) -> None:
-        validity = validity or {"overall": "unknown"}
-        overall = str(validity.get("overall", "unknown"))
+    def set_validity(self, validity) -> None:
+        """validity: an analysis.validity.result.ResultValidity, or None (not judged yet)."""
+        overall = "unknown" if validity is None else str(validity.overall)
         self.overall_light.set_status(overall)
         meaning = style.VALIDITY_TEXT.get(overall, "a state this version does not know")
-        peak = validity.get("peak_displacement_m")
-        peak_text = f" Peak excursion {peak * 1e3:.3g} mm." if isinstance(peak, (int, float)) else ""
+        peak = None if validity is None else validity.peak_displacement_m
+        peak_text = f" Peak excursion {peak * 1e3:.3g} mm." if peak is not None else ""
         self.overall_text.setText(f"<b>Measurement {html.escape(STATE_WORDS.get(overall, overall))}</b> "
                                   f"({html.escape(overall)}): {html.escape(meaning)}.{peak_text}")
-        channels = validity.get("channels") or {}
+        channels = {} if validity is None else validity.channels
         for name, light in self.channels.items():
-            entry = channels.get(name) or {}
-            light.set_state(str(entry.get("status", "unknown")), entry.get("findings") or ())
+            entry = channels.get(name)
+            light.set_state("unknown" if entry is None else str(entry.status or "unknown"),
+                            () if entry is None else entry.findings)

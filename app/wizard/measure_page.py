@@ -159,7 +159,7 @@ class MeasurePage(WizardPage):
 
     def on_measured(self, outcome) -> None:
         self.state.outcome = outcome
-        overall = outcome.analysis.result.validity.get("overall", "unknown")
+        overall = outcome.analysis.result.validity.overall
         self.result.setText(coloured(f"Written {outcome.path} and analysed (validity {overall}). ", OK_COLOUR)
                             + "Next shows the parameters.")
         self.measured.emit(outcome)

@@ -17,7 +17,6 @@ recording weighs the empty lines, and `linpar measure` analyses through here.
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
 import functools
 import threading
@@ -96,16 +95,17 @@ def analyse_measurement(recording: Recording, sd_m2: float | None = None, effect
 
 def with_delay_verdict(result: AnalysisResult, search: DelaySearch) -> AnalysisResult:
     """The result with the delay search in its validity, and a red displacement when the data cannot place it."""
-    validity = copy.deepcopy(result.validity)
-    validity["laser_delay"] = search.as_json()
-    channel = validity.get("channels", {}).get("displacement")
-    if not search.placed and channel is not None and channel.get("status") != ABSENT:
-        channel.setdefault("findings", []).append(Finding(
+    validity = result.validity.replace(laser_delay=search.as_json())
+    channel = validity.channels.get("displacement")
+    if not search.placed and channel is not None and channel.status != ABSENT:
+        lost = Finding(
             "displacement", LASER_DELAY_NOT_FOUND, Severity.RED,
             f"the laser's delay cannot be placed from the data (searched {SEARCH_S[0] * 1e3:g} to "
             f"{SEARCH_S[1] * 1e3:g} ms: best {search.delay_s * 1e3:.3f} ms, the lines agree {search.score:.2f}, "
             f"the next peak only {search.chi2_margin:.3g} chi^2 worse)",
             "Bl, Mms and Kms are not to be trusted; check the laser's link (a USB adapter's latency) and that "
-            "the displacement stands well above its noise, then measure again", search.chi2_margin).as_json())
-        channel["status"] = validity["overall"] = str(Severity.RED)
+            "the displacement stands well above its noise, then measure again", search.chi2_margin)
+        channels = {**validity.channels, "displacement": dataclasses.replace(
+            channel, status=str(Severity.RED), findings=channel.findings + (lost,))}
+        validity = validity.replace(channels=channels, overall=Severity.RED)
     return dataclasses.replace(result, validity=validity)

@@ -40,7 +40,7 @@ def variant(rec, **signals):
 
 
 def codes(result, channel):
-    return [f["code"] for f in result.validity["channels"][channel]["findings"]]
+    return [f["code"] for f in result.validity.as_json()["channels"][channel]["findings"]]
 
 
 def finite_json(result) -> dict:
@@ -51,8 +51,8 @@ def finite_json(result) -> dict:
 @pytest.mark.parametrize("silent", ["voltage", "current"])
 def test_a_silent_voltage_or_current_is_red_with_its_remedy_and_nothing_is_fitted(good, silent):
     result = analyze_recording(variant(good, **{silent: lambda d: np.zeros_like(d["voltage"])}))
-    assert result.fit is None and result.validity["overall"] == "red"
-    finding = result.validity["channels"][silent]["findings"][0]
+    assert result.fit is None and result.validity.overall == "red"
+    finding = result.validity.as_json()["channels"][silent]["findings"][0]
     assert finding["code"] == NO_SIGNAL and finding["remedy"]
     assert all(p.value is None and silent in p.reason and finding["remedy"] in p.reason
                for p in result.parameters.values())
@@ -68,7 +68,7 @@ def test_a_silent_displacement_still_gives_the_electrical_parameters(good):
         good.sample_rate, {"voltage": good.signal("voltage"), "current": good.signal("current")},
         good.period_samples, good.settle_periods, good.excited_bins, dict(good.driver)))
     assert result.fit is not None and not result.fit.model.with_displacement
-    assert NO_SIGNAL in codes(result, "displacement") and result.validity["overall"] == "red"
+    assert NO_SIGNAL in codes(result, "displacement") and result.validity.overall == "red"
     for name in ("RE", "LE", "fs", "Qts", "Qes", "Qms"):       # as for a recording made without the laser
         assert result.parameters[name].value == pytest.approx(impedance_only.parameters[name].value, rel=1e-9)
     for name in ("Bl", "Mms", "Cms", "Vas"):
@@ -80,8 +80,8 @@ def test_a_silent_displacement_still_gives_the_electrical_parameters(good):
 @pytest.mark.parametrize("copy, onto", [("current", "voltage"), ("displacement", "current")])
 def test_a_channel_that_copies_another_is_a_red_wiring_finding_never_green_never_pass(good, copy, onto):
     result = analyze_recording(variant(good, **{copy: lambda d: -0.37 * d[onto]}))
-    assert result.validity["overall"] == "red"
-    (finding,) = [f for f in result.validity["channels"][copy]["findings"] if f["code"] == CHANNEL_COPY]
+    assert result.validity.overall == "red"
+    (finding,) = [f for f in result.validity.as_json()["channels"][copy]["findings"] if f["code"] == CHANNEL_COPY]
     assert f"a scaled copy of the {onto}" in finding["message"] and "wiring" in finding["remedy"]
     judged = judge_result(LIMITS, result.parameters, result.validity)
     assert judged["verdict"] == "invalid"
@@ -107,8 +107,8 @@ def misfit():
 def test_a_misfit_of_1e6_is_yellow_and_qa_does_not_judge_it(misfit):
     chi2 = misfit.fit.chi2_red_by_channel()["impedance"]
     assert 2e5 < chi2 < 5e6
-    assert misfit.validity["overall"] in ("yellow", "red")
-    (finding,) = [f for f in misfit.validity["channels"]["current"]["findings"] if f["code"] == MODEL_MISFIT]
+    assert misfit.validity.overall in ("yellow", "red")
+    (finding,) = [f for f in misfit.validity.as_json()["channels"]["current"]["findings"] if f["code"] == MODEL_MISFIT]
     assert finding["severity"] == "yellow" and "does not describe this measurement" in finding["message"]
     assert "Model lab" in finding["remedy"] and finding["value"] == pytest.approx(chi2)
     judged = judge_result(LIMITS, misfit.parameters, misfit.validity)
@@ -119,7 +119,7 @@ def test_a_misfit_of_1e6_is_yellow_and_qa_does_not_judge_it(misfit):
 
 def test_a_model_that_fits_leaves_the_measurement_green(good):
     result = analyze_recording(good)
-    assert result.validity["overall"] == "green"
+    assert result.validity.overall == "green"
     assert max(result.fit.chi2_red_by_channel().values()) < 2
     assert judge_result(LIMITS, result.parameters, result.validity)["verdict"] == "pass"
 
@@ -140,5 +140,5 @@ def test_a_refit_that_fits_takes_the_misfit_finding_away(misfit):
     better = fit_model(FitData.from_spectra(misfit.spectra), Model(parse_effects("lr2,creep-log,delay-current")))
     assert max(better.chi2_red_by_channel().values()) < 2
     validity = rejudged(misfit.validity, better)
-    assert validity["overall"] == "green" and qa_blocker(validity) is None
-    assert rejudged(validity, misfit.fit)["overall"] == "yellow"          # and back
+    assert validity.overall == "green" and qa_blocker(validity) is None
+    assert rejudged(validity, misfit.fit).overall == "yellow"          # and back

@@ -51,9 +51,9 @@ def test_without_the_correction_the_drift_inflates_the_noise(hot):
 
 def test_the_analysis_takes_the_drift_out_of_the_noise_and_says_it_with_the_validity(hot):
     result = analyze_recording(hot)
-    findings = result.validity["channels"]["current"]["findings"]
+    findings = result.validity.as_json()["channels"]["current"]["findings"]
     assert any(f["code"] == "drift" for f in findings)
-    assert result.validity["heating"]["significant"]
+    assert result.validity.heating["significant"]
     for channel, chi2 in result.fit.chi2_red_by_channel().items():
         assert 0.6 < chi2 < 1.5, channel            # an honest noise estimate again
     true_mean_re = np.mean([_re(k) for k in range(SETTLE, SETTLE + PERIODS)])
@@ -78,7 +78,7 @@ def test_a_steady_coil_is_left_alone():
     steady = synthesize_recording(Model(parse_effects("lr2,creep-log")), PAPER.parameters, mt.waveform,
                                   mt.excited_bins, mt.sample_rate, PERIODS, SETTLE, TYPICAL_NOISE, seed=21)
     result = analyze_recording(steady)
-    assert "heating" not in result.validity
+    assert result.validity.heating is None
     spectra = estimate_spectra(steady)
     heating = coil_heating(steady, spectra, result.fit.values["RE"])
     assert not heating.significant and abs(heating.rise_k) < 0.2

@@ -17,6 +17,7 @@ from analysis.derived import ParameterValue, derived_from_values
 from analysis.level_series import (TABLE_PARAMETERS, LevelSeriesError, concise, drive_rms, format_series,
                                    level_series, small_signal_reasons)
 from analysis.pipeline import analyze_recording
+from analysis.validity.result import ResultValidity
 from instruments.simulation.level_series import check_levels, simulate_level_series
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
@@ -135,13 +136,15 @@ def test_drive_rms_is_the_voltage_rms():
 def test_small_signal_reasons():
     def finding(code, severity="red"):
         return {"code": code, "severity": severity}
+    def reasons(doc):
+        return small_signal_reasons(ResultValidity.from_json(doc))
     green = {"overall": "green", "channels": {"current": {"findings": []}}}
-    assert small_signal_reasons(green) == ()
+    assert reasons(green) == ()
     distorted = {"overall": "yellow", "channels": {"current": {"findings": [finding("distortion-high", "yellow")]}}}
-    assert small_signal_reasons(distorted) == ("distortion-high on current (yellow)",)
+    assert reasons(distorted) == ("distortion-high on current (yellow)",)
     noisy = {"overall": "yellow", "channels": {"current": {"findings": [finding("snr-low", "yellow")]}}}
-    assert small_signal_reasons(noisy) == ("validity yellow: snr-low",)
-    assert small_signal_reasons({"overall": "unknown"}) == ("validity unknown",)
+    assert reasons(noisy) == ("validity yellow: snr-low",)
+    assert reasons({"overall": "unknown"}) == ("validity unknown",)
 
 
 @pytest.mark.parametrize("value, std, text", [

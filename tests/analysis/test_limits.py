@@ -5,6 +5,7 @@ import pytest
 
 from analysis.derived import ParameterValue
 from analysis.limits import LimitsError, judge_result, load_limits
+from analysis.validity.result import ResultValidity
 
 
 def write(tmp_path, doc, name="limits.json"):
@@ -121,6 +122,8 @@ def judged_re(tmp_path, value, std, validity="green", **extra):
     doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})
     doc.update(extra)
     params = {"RE": ParameterValue("RE", value, std, "ohm", "ohm", 1.0)}
+    # A validity as a stored results document holds it (or its overall light alone).
+    validity = validity if isinstance(validity, str) else ResultValidity.from_json(validity)
     return judge_result(load_limits(write(tmp_path, doc)), params, validity)
 
 

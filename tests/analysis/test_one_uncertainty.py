@@ -49,7 +49,7 @@ def analysed(request):
 def test_the_model_part_is_estimated_once_and_kept_with_the_result(analysed, monkeypatch):
     name, _, statistical, full = analysed
     assert statistical.model_part is None and full.model_part.state == ESTIMATED
-    assert full.validity["model_part"]["state"] == ESTIMATED and full.validity["model_part"]["seconds"] > 0
+    assert full.validity.model_part["state"] == ESTIMATED and full.validity.model_part["seconds"] > 0
     monkeypatch.setattr("analysis.fit.model_uncertainty.fit_with", lambda *a, **k: pytest.fail("refitted"))
     assert model_uncertainty(full) is full
     assert result_json(full)["parameters"]["Mms"]["std_model"] == full.parameters["Mms"].std_model

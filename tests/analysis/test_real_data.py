@@ -118,12 +118,13 @@ def test_dayton_half_hertz_data_in_radians_fit_well_and_not_as_degrees(dayton):
     free = dayton[0].transfer
     good = fit_curves(free, None, "leach,creep-log-causal")
     # Each line weighted by the noise of its local scatter (2.5 % at the median): the quiet lines lead.
-    assert good.validity["rms_relative_residual"]["impedance"] < 0.08
+    assert good.validity.imported.rms_relative_residual["impedance"] < 0.08
     assert good.fit.n_data < 0.1 * 2 * len(free.freqs)            # thinned to ~100 lines per decade
     as_degrees = read_curve(DAYTON / "test_impedance.txt", phase="deg")
     assert any("overrides" in n for n in as_degrees.notes) and any("+-pi" in n for n in as_degrees.notes)
     bad = fit_curves(as_degrees.transfer, None, "leach,creep-log-causal")
-    assert bad.validity["rms_relative_residual"]["impedance"] > 3 * good.validity["rms_relative_residual"]["impedance"]
+    misfit = {name: r.validity.imported.rms_relative_residual["impedance"] for name, r in (("good", good), ("bad", bad))}
+    assert misfit["bad"] > 3 * misfit["good"]
 
 
 @pytest.fixture(scope="module")
@@ -140,12 +141,12 @@ def test_woofer_whole_laser_method_agrees_with_the_lecturer(woofer_fit):
     for name in ("Bl", "Mms", "Cms"):
         assert p[name].std is not None and 0 < p[name].std < 0.02 * p[name].value, name
     assert woofer_fit.ranges["displacement"][1] < 700.0          # only where the cone is a piston
-    assert woofer_fit.validity["rms_relative_residual"]["displacement"] < 0.04
+    assert woofer_fit.validity.imported.rms_relative_residual["displacement"] < 0.04
 
 
 def test_woofer_a_causal_creep_law_fits_better_than_the_default(woofer, woofer_fit):
     default = fit_curves(woofer.impedance, woofer.displacement, "lr2,creep-log", None, FitRange(f_min=20.0))
     assert woofer_fit.fit.bic < default.fit.bic - 100      # BIC of unknown-noise data: n ln(chi2/n) + k ln n
-    rms = default.validity["rms_relative_residual"]["displacement"]
-    assert woofer_fit.validity["rms_relative_residual"]["displacement"] < 0.5 * rms
+    rms = default.validity.imported.rms_relative_residual["displacement"]
+    assert woofer_fit.validity.imported.rms_relative_residual["displacement"] < 0.5 * rms
     assert np.isfinite(default.parameters["Bl"].value)

@@ -50,10 +50,10 @@ def real_unit():
 
 
 def test_the_fit_error_of_the_unit_is_a_few_percent_though_its_reduced_chi2_is_huge(real_unit):
-    errors = real_unit.validity["fit_error_percent"]
+    errors = real_unit.validity.fit_error_percent
     assert 1.5 < errors["impedance"] < 5 and 1.5 < errors["displacement"] < 10
     assert min(real_unit.fit.chi2_red_by_channel().values()) > 1e4
-    findings = [f["code"] for ch in real_unit.validity["channels"].values() for f in ch.get("findings") or ()]
+    findings = [f["code"] for ch in real_unit.validity.as_json()["channels"].values() for f in ch.get("findings") or ()]
     assert MODEL_MISFIT in findings            # the reduced chi^2 stays in the details, as a yellow finding
 
 
@@ -91,7 +91,7 @@ def test_a_real_driver_measured_to_10_khz_is_judged_and_passes_limits_around_its
     from analysis.curves.fitting import FitRange, fit_curves
     from analysis.importers import read_curve
     result = fit_curves(read_curve(SEAS_FREE_AIR).transfer, None, None, None, FitRange(f_max=10_000.0))
-    assert 2.0 < result.validity["fit_error_percent"]["impedance"] < 5.0
+    assert 2.0 < result.validity.fit_error_percent["impedance"] < 5.0
     limits = parse_limits({"format": "linpar-limits/1", "parameters": {
         "RE": {"nominal": 5.7212, "tolerance": "15%", "unit": "ohm"},
         "fs": {"nominal": 44.985, "tolerance": "15%", "unit": "Hz"}}}, "", Path("seas.json"))

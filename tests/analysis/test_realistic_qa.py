@@ -49,7 +49,7 @@ def test_limits_at_the_truth_plus_minus_15_percent_pass(analysed, case):
 @pytest.mark.parametrize("case", CASES, ids=[f"{n}-{s}" for n, s in CASES])
 def test_the_truth_lies_within_two_reported_std(analysed, case):
     result, truth = analysed[case], REALISTIC[case[0]].truth
-    assert result.validity["model_part"]["state"] == ESTIMATED
+    assert result.validity.model_part["state"] == ESTIMATED
     for name in LUMPED:
         p = result.parameters[name]
         assert abs(p.value - truth[name]) <= 2.0 * p.std, (name, p.value, truth[name], p.std)
@@ -59,7 +59,7 @@ def test_the_truth_lies_within_two_reported_std(analysed, case):
 @pytest.mark.parametrize("case", CASES, ids=[f"{n}-{s}" for n, s in CASES])
 def test_the_fit_error_is_a_few_percent_over_the_piston_band_it_names(analysed, case):
     result = analysed[case]
-    errors, bands = result.validity["fit_error_percent"], result.validity["fit_band_hz"]
+    errors, bands = result.validity.fit_error_percent, result.validity.as_json()["fit_band_hz"]
     assert errors["impedance"] < 0.7 * FIT_ERROR_DEFAULTS["impedance"]
     assert errors["displacement"] < 0.5 * FIT_ERROR_DEFAULTS["displacement"]
     fs = 1.05 * result.parameters["fs"].value       # the band's fs is the whole band's fit's, within a few %
@@ -85,13 +85,14 @@ def test_tighter_limits_around_the_truth_never_fail(analysed, percent):
 
 def test_the_band_is_said_in_the_json_the_text_and_the_qa_table(analysed):
     result = analysed[("woofer", 0)]
-    low, high = result.validity["fit_band_hz"]["displacement"]
+    low, high = result.validity.fit_band_hz["displacement"]
     limits = limits_around(REALISTIC["woofer"].truth, 15)
-    assert judge_result(limits, result.parameters, result.validity)["fit_band_hz"] == result.validity["fit_band_hz"]
-    said = f"displacement {result.validity['fit_error_percent']['displacement']:.2g} % ({low:.3g}-{high:.3g} Hz)"
+    bands = result.validity.as_json()["fit_band_hz"]
+    assert judge_result(limits, result.parameters, result.validity)["fit_band_hz"] == bands
+    said = f"displacement {result.validity.fit_error_percent['displacement']:.2g} % ({low:.3g}-{high:.3g} Hz)"
     assert said in result.report()
     assert said in format_verdicts(limits, result.parameters, result.validity)
-    assert result.as_json()["validity"]["fit_band_hz"] == result.validity["fit_band_hz"]
+    assert result.as_json()["validity"]["fit_band_hz"] == result.validity.as_json()["fit_band_hz"]
 
 
 def test_a_recording_the_model_describes_is_fitted_over_every_line():
@@ -99,4 +100,4 @@ def test_a_recording_the_model_describes_is_fitted_over_every_line():
     whole = FitData.from_spectra(result.spectra)
     assert result.data is whole or (len(result.data.impedance.freqs) == len(whole.impedance.freqs)
                                      and len(result.data.displacement.freqs) == len(whole.displacement.freqs))
-    assert result.validity["fit_band_hz"]["displacement"][1] == whole.displacement.freqs[-1]
+    assert result.validity.fit_band_hz["displacement"][1] == whole.displacement.freqs[-1]

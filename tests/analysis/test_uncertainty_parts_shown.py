@@ -25,7 +25,7 @@ def test_the_archive_keeps_the_parts_and_the_fit_errors(with_parts):
     mms = stored.parameters["Mms"]
     assert (mms.std_noise, mms.std_model) == pytest.approx((0.12e-3, 0.9e-3))
     assert stored.parameters["RE"].std_noise is None                 # not estimated: not invented
-    assert stored.validity["fit_error_percent"] == pytest.approx(with_parts.validity["fit_error_percent"])
+    assert stored.validity.fit_error_percent == pytest.approx(with_parts.validity.fit_error_percent)
 
 
 def test_the_report_names_the_parts_and_each_curves_fit_error(with_parts):

@@ -78,7 +78,7 @@ def test_the_results_and_qa_pages_read_the_woofer_as_the_cli_does(qtbot, window,
         assert p.std_model is not None and p.std_model > 0, name
         assert (p.value, p.std, p.std_noise, p.std_model) == pytest.approx(
             (q["value"], q["std"], q["std_noise"], q["std_model"]), rel=1e-9), name
-    assert final.validity["model_part"]["state"] == doc["validity"]["model_part"]["state"] == "estimated"
+    assert final.validity.model_part["state"] == doc["validity"]["model_part"]["state"] == "estimated"
     # The pages say both parts and the fit error in %.
     text = window.results.fit_quality.text()
     assert "Fit error" in text and "%" in text and "estimating" not in text

@@ -94,7 +94,7 @@ def test_garbage_cut_frames_and_error_floods_on_the_serial_line_are_skipped_coun
     assert gaps["lost"] > 0                                   # the cut measurements, counted where validity looks
     assert 0 < capture["laser_error_counts"]["262076"] < 300      # the floods inside the recording, not averaged
     assert gaps["samples"] >= gaps["lost"] + capture["laser_error_counts"]["262076"]
-    findings = {f["code"]: f for f in outcome.result.validity["channels"]["displacement"]["findings"]}
+    findings = {f["code"]: f for f in outcome.result.validity.as_json()["channels"]["displacement"]["findings"]}
     assert "lost on the line" in findings["laser-errors"]["message"] and "dropouts" not in findings
     assert rig.laser.stats.discarded_bytes > 0 and rig.laser.stats.incomplete_measurements > 0
     no_journal_and_no_litter(tmp_path)

@@ -63,7 +63,7 @@ def test_magnitude_only_curves_still_give_the_parameters():
                         "lr2,creep-log", None, FitRange(hx_f_max=1e5))
     assert result.fit.values["Bl"] == pytest.approx(values["Bl"], rel=1e-3)
     assert result.parameters["Mms"].value == pytest.approx(values["CMES"] * values["Bl"] ** 2, rel=3e-3)
-    assert set(result.validity["magnitude_only"]) == {"impedance", "displacement"}
+    assert set(result.validity.imported.magnitude_only) == {"impedance", "displacement"}
 
 
 def test_uncertainties_come_from_the_scatter_and_cover_the_truth():
@@ -75,7 +75,7 @@ def test_uncertainties_come_from_the_scatter_and_cover_the_truth():
         assert r.fit.chi2_red == pytest.approx(1.0, abs=0.15)      # 1 % noise, estimated from the local scatter
         pulls.append((r.fit.values["Bl"] - values["Bl"]) / r.fit.stderr["Bl"])
     assert np.all(np.abs(pulls) < 4)
-    assert "local scatter" in r.validity["uncertainties"]
+    assert "local scatter" in r.validity.imported.uncertainties
 
 
 def test_ranges_limit_each_channel_and_hx_defaults_to_four_fs():

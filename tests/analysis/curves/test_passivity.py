@@ -16,7 +16,7 @@ LOW_Q = electrical(5.7, 0.4e-3, 15e-3, 0.84e-3, 15.0, 7.0, L2=0.6e-3, R2=8.0, **
 
 
 def _codes(result) -> set[str]:
-    return {f["code"] for ch in result.validity.get("channels", {}).values() for f in ch["findings"]}
+    return {f["code"] for ch in result.validity.as_json().get("channels", {}).values() for f in ch["findings"]}
 
 
 def _impedance(values, noise=0.003, **kw) -> TransferFunction:
@@ -43,8 +43,8 @@ def test_real_drivers_curves_are_passive_with_a_resonance(where):
 
 def _red(z, hx=None):
     result = fit_curves(z, hx)
-    found = result.validity["channels"]["impedance"]["findings"]
-    assert result.validity["overall"] == "red" and all(f["severity"] == "red" for f in found)
+    found = result.validity.as_json()["channels"]["impedance"]["findings"]
+    assert result.validity.overall == "red" and all(f["severity"] == "red" for f in found)
     assert all(p.value is None and "no driver's" in p.reason for p in result.parameters.values())
     doc = curve_json(result)
     assert doc["parameters"]["fs"]["value"] is None and doc["validity"]["overall"] == "red"

@@ -23,7 +23,7 @@ def test_each_channel_fitted_is_compared_over_its_band(midwoofer):
         assert c["band_hz"][0] == pytest.approx(low, rel=1e-6) and c["band_hz"][1] == pytest.approx(high, rel=1e-6)
         # linpar's curve misses the measured one by about the noise (0.15-0.3 %); the tool's fitted curve, a fit
         # of another model over another band, by more; the two fitted curves are a few % apart at most.
-        assert c["linpar_fit_error_percent"] == pytest.approx(result.validity["fit_error_percent"][name], rel=0.3)
+        assert c["linpar_fit_error_percent"] == pytest.approx(result.validity.fit_error_percent[name], rel=0.3)
         assert c["linpar_fit_error_percent"] < c["tool_fit_error_percent"] < 10.0
         assert 0.0 < c["tool_vs_linpar_percent"] < 10.0
 

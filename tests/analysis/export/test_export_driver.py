@@ -26,6 +26,7 @@ from analysis.derived import ParameterValue
 from analysis.export import winisd
 from analysis.export.winisd import wdr_bytes
 from analysis.pipeline import analyze_recording
+from analysis.validity.result import ResultValidity
 from tests.builders import TYPICAL_NOISE, recording
 
 KEYS = ("Brand Model Manufacturer ProvidedBy Comment DateAdded DateModified Qts Znom Fs Pe SPL Re Le fLe KLe "
@@ -76,7 +77,8 @@ def _marks(fields: dict[str, str]) -> dict[str, str]:
 def _known(values: dict[str, tuple[float, str]], sd_m2: float, model: dict[str, float]) -> StoredResult:
     """A result with chosen SI values and the textbook model (RE + s LE)."""
     params = {n: ParameterValue(n, v, None, u, u, 1.0) for n, (v, u) in values.items()}
-    return StoredResult(params, (), True, model, {}, {"overall": "ok"}, sd_m2, {})
+    return StoredResult(parameters=params, effects=(), with_displacement=True, values=model, model_info={},
+                        validity=ResultValidity(overall="ok"), sd_m2=sd_m2, settings={})
 
 
 KNOWN = {"RE": (6.4, "ohm"), "LE": (0.8e-3, "H"), "fs": (38.0, "Hz"), "Qms": (6.2, "1"), "Qes": (0.38, "1"),

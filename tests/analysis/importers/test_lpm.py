@@ -41,7 +41,7 @@ def test_the_measured_columns_give_the_driver_back_not_the_fitted_ones(exports):
     truth = PAPER.parameters
     for name in ("RE", "Bl", "LCES", "CMES"):
         assert result.fit.values[name] == pytest.approx(truth[name], rel=0.01), name
-    assert 0.1 < result.validity["fit_error_percent"]["impedance"] < 1.0       # the 0.3 % noise, not the model
+    assert 0.1 < result.validity.fit_error_percent["impedance"] < 1.0       # the 0.3 % noise, not the model
 
 
 def test_a_shorter_fitted_curve_leaves_its_fields_empty_and_is_read(tmp_path):

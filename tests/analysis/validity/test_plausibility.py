@@ -67,18 +67,18 @@ def _scale(signal, factor):
 
 
 def _red_codes(result):
-    return {f["code"]: f for ch in result.validity["channels"].values() for f in ch.get("findings", ())
+    return {f["code"]: f for ch in result.validity.as_json()["channels"].values() for f in ch.get("findings", ())
             if f["severity"] == "red"}
 
 
 def _plausibility(result):
-    return {f["code"] for ch in result.validity["channels"].values() for f in ch.get("findings", ())} \
+    return {f["code"] for ch in result.validity.as_json()["channels"].values() for f in ch.get("findings", ())} \
         & PLAUSIBILITY_CODES
 
 
 def test_the_recording_as_written_is_plausible(written):
     result = analyze_recording(read_recording(written))
-    assert result.validity["overall"] != "red" and not _plausibility(result), result.validity
+    assert result.validity.overall != "red" and not _plausibility(result), result.validity
 
 
 @pytest.mark.parametrize("name", ["fullrange-2in", "midwoofer-6in", "woofer-12in", "woofer-18in"])
@@ -92,7 +92,7 @@ def test_real_drivers_from_2_to_18_inch_are_plausible(name):
 def test_a_laser_in_mm_declared_as_m_is_red_with_its_scale_named(written, tmp_path):
     result = analyze_recording(_variant(tmp_path, written, _scale("displacement", 1000.0)))
     red = _red_codes(result)
-    assert result.validity["overall"] == "red"
+    assert result.validity.overall == "red"
     assert {pl.EFFICIENCY, pl.MASS_PER_AREA, pl.EXCURSION} <= set(red)
     assert all("looks like mm, not m" in red[c]["remedy"] for c in (pl.EFFICIENCY, pl.MASS_PER_AREA, pl.EXCURSION))
 
@@ -137,4 +137,4 @@ def test_a_low_q_driver_with_a_right_laser_is_not_judged_inverted():
     result = analyze_recording(_odd_recording(values), sd_m2=0.0104)
     assert result.parameters["Qms"].value < result.parameters["Qes"].value
     assert pl.LASER_SIGN not in _plausibility(result), result.validity
-    assert result.validity["overall"] != "red", result.validity
+    assert result.validity.overall != "red", result.validity

@@ -185,4 +185,4 @@ def test_a_measurement_with_the_voltage_lead_off_is_judged_kept_and_stored_red(m
     (entry,) = Archive(root).list()
     assert entry.id == printed["archive"]["id"] and entry.validity == "red" and entry.serial == "SN-9"
     stored = Archive(root).get(entry.id).result()
-    assert stored.not_fitted and stored.validity["channels"]["voltage"]["findings"][0]["remedy"]
+    assert stored.not_fitted and stored.validity.as_json()["channels"]["voltage"]["findings"][0]["remedy"]

@@ -101,9 +101,9 @@ def test_a_band_fitted_result_is_modelled_over_every_line_where_the_cone_mode_sh
     fitted_lines = first.fit.channels["displacement"].freqs
     assert len(fitted_lines) == len(session.data.displacement.freqs)
     # Over every line the model misses the cone mode: the lab's starting point shows it (the band hides it).
-    assert first.result.validity["fit_error_percent"]["displacement"] > 10.0
-    assert band_fitted.validity["fit_error_percent"]["displacement"] < 10.0
-    assert first.result.validity["fit_band_hz"]["displacement"][1] == pytest.approx(float(fitted_lines[-1]))
+    assert first.result.validity.fit_error_percent["displacement"] > 10.0
+    assert band_fitted.validity.fit_error_percent["displacement"] < 10.0
+    assert first.result.validity.fit_band_hz["displacement"][1] == pytest.approx(float(fitted_lines[-1]))
     assert first.result.data is None and first.result.whole_band_fit is None
 
 

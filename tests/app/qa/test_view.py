@@ -44,7 +44,7 @@ def test_a_faulty_recording_shows_a_red_light_and_its_message(qtbot, window, fau
     assert qa.overall_light.status == "red"
     current = qa.channels["current"]
     assert current.light.status == "red"
-    finding = outcome.result.validity["channels"]["current"]["findings"][0]
+    finding = outcome.result.validity.as_json()["channels"]["current"]["findings"][0]
     shown = plain(current.details)
     assert finding["message"] in shown and finding["remedy"] in shown
     assert current.details.isVisible() and current.details.width() > 100

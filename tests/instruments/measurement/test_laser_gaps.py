@@ -155,7 +155,7 @@ def test_a_bridge_across_the_floods_was_biased(bench, fault_free, monkeypatch):
 
 def test_the_validity_says_how_many_were_missing_and_judges_their_effect(bench):
     result, capture = bench.measure(bench.floods_at(0.25))
-    findings = {f["code"]: f for f in result.validity["channels"]["displacement"]["findings"]}
+    findings = {f["code"]: f for f in result.validity.as_json()["channels"]["displacement"]["findings"]}
     gap = findings["laser-errors"]
     assert f"in {KEPT} of {KEPT} periods" in gap["message"] and "262076" in gap["message"]
     assert gap["severity"] == "green"          # 2 % left out: the uncertainty grows by ~2 %
@@ -165,6 +165,6 @@ def test_the_validity_says_how_many_were_missing_and_judges_their_effect(bench):
         first = bench.laser_index(bench.start + (p + 0.25) * P)
         everywhere[first:first + FLOOD] = True
     result, capture = bench.measure(everywhere)
-    gap = {f["code"]: f for f in result.validity["channels"]["displacement"]["findings"]}["laser-errors"]
+    gap = {f["code"]: f for f in result.validity.as_json()["channels"]["displacement"]["findings"]}["laser-errors"]
     assert capture["laser_gaps"]["unseen_s"] > 5e-3 and gap["severity"] == "red"
     assert "same point of every period" in gap["remedy"]

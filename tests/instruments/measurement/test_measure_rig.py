@@ -91,7 +91,7 @@ def test_the_full_path_recovers_the_paper_driver_with_the_files_written_before_t
     for name in ("RE", "fs", "Bl", "Mms", "Qts"):
         assert result.parameters[name].value == pytest.approx(TRUTH[name], rel=0.005), name
     assert result.parameters["lambda"].value == pytest.approx(TRUTH["lambda"], abs=0.01)
-    assert result.validity["overall"] == "green", result.validity
+    assert result.validity.overall == "green", result.validity
     assert outcome.alignment["clock_ppm"] == pytest.approx(37.0, abs=1.0)
     # The live view averages the periods in order and leaves out one it could not reach in time: how many
     # frames came depends on the host's scheduling, their order and the last one's displacement do not.
@@ -113,7 +113,7 @@ def test_a_laser_clock_200_ppm_off_starting_100_ms_late_is_corrected(rig, tmp_pa
     # Wherever the host placed the laser's stream (the two streams' smallest arrival latencies: typically
     # -0.1 .. +0.1 ms, once -1.1 ms on a loaded machine), the data place the delay it left (analysis/
     # laser_delay.py), and Hx advanced by it is the driver's: nothing here bounds the host's scheduling.
-    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] != "red", result.validity
+    assert result.validity.laser_delay["placed"] is True and result.validity.overall != "red", result.validity
     tau = result.fit.values["tau_x"]
     assert result.parameters["tau_x"].std < 20e-6
     hx = result.spectra.displacement
@@ -133,7 +133,7 @@ def test_a_usb_link_late_by_ms_with_jitter_is_found_from_the_data(rig, tmp_path,
         result = measure(rig, tmp_path).result
     finally:
         rig.command("fault", clear=True)
-    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] != "red", result.validity
+    assert result.validity.laser_delay["placed"] is True and result.validity.overall != "red", result.validity
     for name in ("Bl", "Mms", "Kms"):
         assert result.parameters[name].value == pytest.approx(TRUTH[name], rel=0.005), name
     tau = result.fit.values["tau_x"]

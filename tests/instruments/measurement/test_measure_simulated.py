@@ -113,7 +113,7 @@ def test_a_usb_links_latency_with_jitter_is_found_from_the_data(tmp_path, record
     found = result.fit.values["tau_x"]
     record_property("delay_error_s", found - injected)      # for the spread over runs (--junitxml)
     assert found == pytest.approx(injected, abs=FIT_TAU_S)
-    assert result.validity["laser_delay"]["placed"] is True and result.validity["overall"] == "green"
+    assert result.validity.laser_delay["placed"] is True and result.validity.overall == "green"
     for name in ("Bl", "Mms", "Kms"):
         assert result.parameters[name].value == pytest.approx(TRUTH[name], rel=0.005), name
     assert result.parameters["tau_x"].std < FIT_TAU_S       # reported with its uncertainty
@@ -126,7 +126,7 @@ def test_laser_error_codes_are_counted_not_averaged_and_judged(tmp_path):
     capture = json.loads(outcome.sidecar_path.read_text())["capture"]
     share = capture["laser_error_counts"]["262076"] / capture["laser_samples"]
     assert share == pytest.approx(0.02, abs=0.006)
-    findings = outcome.result.validity["channels"]["displacement"]["findings"]
+    findings = outcome.result.validity.as_json()["channels"]["displacement"]["findings"]
     assert "laser-errors" in {f["code"] for f in findings}
     assert outcome.result.parameters["Bl"].value == pytest.approx(TRUTH["Bl"], rel=0.005)
 

@@ -97,7 +97,7 @@ def test_at_large_excursion_fs_falls_and_cms_rises_like_the_papers_driver():
         rec = make_recording(FS, signals, n, settle_periods=2, excited_bins=tuple(int(b) for b in mt.excited_bins))
         result = analyze_recording(rec)
         fitted[rms] = (result.parameters["fs"].value, result.parameters["Cms"].value,
-                       result.validity["peak_displacement_m"])
+                       result.validity.peak_displacement_m)
     (fs_small, cms_small, peak_small), (fs_large, cms_large, peak_large) = fitted[0.33], fitted[14.0]
     assert peak_small == pytest.approx(0.17e-3, rel=0.1) and peak_large == pytest.approx(8.5e-3, rel=0.05)
     assert fs_small == pytest.approx(70.5, abs=0.3)
