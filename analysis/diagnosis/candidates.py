@@ -24,17 +24,14 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Callable
 
-import numpy as np
-
-from analysis.diagnosis import acceptance, noise_floor, pairs, residuals
+from analysis.diagnosis import acceptance, jobs, noise_floor, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.diagnosis.sites import SiteResult, first_among_tied, localise, usable_sites
+from analysis.diagnosis.starts import best_starts, residual_context, same_compliance_at_fs, screen_calls
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
-from analysis.fit.least_squares import FitData, FitError, FitResult, fit_model, screen_fit
-from analysis.fit.startvalues import StartContext, phase_slope, start_context
+from analysis.fit.least_squares import FitData, FitResult, fit_model
 from analysis.model.composed import Model, ModelError
-from analysis.model.lumped import resonance_frequency
 
 MAX_STEPS = 6
 # A candidate's refit gets fewer evaluations than a fit of one's choice: every candidate the path takes
@@ -42,7 +39,6 @@ MAX_STEPS = 6
 # parameter (the closed box), while one the data do not ask for wanders along its undetermined parameters,
 # or crawls along one held at a bound, until the budget ends it without a covariance (flagged undetermined).
 CANDIDATE_EVALUATIONS_PER_PARAMETER = 120
-SCREENS_PER_TASK = 5
 # Far from the data (reduced chi^2 above this) the current fit's parameters are bent: effects that bend
 # every parameter when missing (Effect.cold_start) are also refitted from the data's own start values.
 FAR_CHI2 = 100.0
@@ -167,95 +163,51 @@ def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
     return fit_model(data, model, start=start, cancel=cancel, per_parameter=CANDIDATE_EVALUATIONS_PER_PARAMETER)
 
 
-def _run(calls, executor: Executor | None, cancel: threading.Event | None) -> list:
-    """Results (fit, error) of the calls, in order, on the pool when there is one."""
-    if executor is not None:
-        futures = [executor.submit(fn, *args) for fn, args in calls]
-        return [_outcome(f.result) for f in futures]
-    return [_outcome(lambda: fn(*args), cancel) for fn, args in calls]
-
-
-def _outcome(call, cancel: threading.Event | None = None) -> tuple[FitResult | None, str | None]:
-    try:
-        return call(), None
-    except (FitError, ValueError, ArithmeticError) as exc:
-        if cancel is not None and cancel.is_set():
-            raise
-        return None, str(exc)
-
-
-def residual_context(data: FitData, current: FitResult) -> StartContext:
-    """The data's start context plus what the current fit leaves: the phase slopes where delays start."""
-    ctx = start_context(data.impedance)
-    slopes = {}
-    for name, field in (("impedance", "z_phase_slope"), ("displacement", "x_phase_slope")):
-        ch = current.channels.get(name)
-        if ch is not None and ch.has_phase:
-            slopes[field] = phase_slope(ch.freqs, ch.measured, ch.model, ch.std)
-    return dataclasses.replace(ctx, **slopes)
-
-
-def _screen_starts(data: FitData, model: Model, starts: list[dict], vary: set[str]) -> FitResult | None:
-    """The best of short fits of `vary` alone from each of `starts` (None when none ran)."""
-    best = None
-    for start in starts:
-        try:
-            fit = screen_fit(data, model, start, vary)
-        except (FitError, ValueError, ArithmeticError):
-            continue
-        if best is None or fit.chi2 < best.chi2:
-            best = fit
-    return best
-
-
-def _best_starts(data: FitData, current: FitResult, moves, ctx, executor, cancel) -> dict[int, dict]:
-    """For effects that ask for several start points (a narrow resonance), the most promising one.
-
-    Each start is screened by a short fit of the new effect's parameters alone; only the best goes on
-    to the full refit. A few starts go to the pool as one task: one screen is a few milliseconds, about
-    what handing a task to a process costs.
-    """
-    calls, owners = [], []
-    for index, (_, effect, _, model) in enumerate(moves):
-        starts = [{**current.values, **start} for start in effect.starts(ctx)]
-        if len(starts) > 1:
-            for chunk in range(0, len(starts), SCREENS_PER_TASK):
-                calls.append((_screen_starts, (data, model, starts[chunk:chunk + SCREENS_PER_TASK],
-                                               set(effect.param_names))))
-                owners.append(index)
-    best: dict[int, tuple[float, dict]] = {}
-    for index, (fit, _) in zip(owners, _run(calls, executor, cancel)):
-        if fit is not None and (index not in best or fit.chi2 < best[index][0]):
-            best[index] = (fit.chi2, fit.values)
-    return {index: values for index, (_, values) in best.items()}
-
-
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
-                    cancel: threading.Event | None = None) -> tuple[Candidate, ...]:
+                    cancel: threading.Event | None = None, costs: dict[str, float] | None = None
+                    ) -> tuple[Candidate, ...]:
     """Every candidate refitted, warm-started from `current`, flagged and ranked by delta BIC (best first).
 
     Their assessment applies rules 1 and 2 of the acceptance rule; rule 3
     (the site's correction) is applied by the greedy path to those that pass.
+    `costs`: what each effect's refit cost before (by effect id), to hand the costliest to the pool first.
     """
     moves = candidate_models(current.model)
     ctx = residual_context(data, current)
-    screened = _best_starts(data, current, moves, ctx, executor, cancel)
-    calls, owners = [], []
+    screens, screen_owners = screen_calls(data, current, moves, ctx)
+    screen_handles = jobs.submit(screens, executor, cancel)
+    screened_moves = set(screen_owners)
     far = current.chi2_red > FAR_CHI2
-    for index, (_, effect, replaced, model) in enumerate(moves):
-        # The new effect starts from its guess; the rest from the current fit.
-        start = screened.get(index) or {**current.values, **effect.guess(ctx)}
-        if replaced is not None and effect.site is Site.COMPLIANCE:
-            start = _same_compliance_at_fs(current, model, start)
-        calls.append((_refit, (data, model, start, None if executor else cancel)))
-        owners.append(index)
-        if far and effect.cold_start:
-            # From the data's own start values, the effect from the best of its screened starts if it has any.
-            own = {name: start[name] for name in effect.param_names} if index in screened else effect.guess(ctx)
-            calls.append((_refit, (data, model, own, None if executor else cancel)))
+    refit_cancel = None if executor else cancel
+
+    def refit_calls(indices, screened: dict[int, dict]) -> tuple[list, list[int]]:
+        calls, owners = [], []
+        for index in indices:
+            _, effect, replaced, model = moves[index]
+            cost = (costs or {}).get(effect.id, 0.0)
+            # The new effect starts from its guess; the rest from the current fit.
+            start = screened.get(index) or {**current.values, **effect.guess(ctx)}
+            if replaced is not None and effect.site is Site.COMPLIANCE:
+                start = same_compliance_at_fs(current, model, start)
+            calls.append((_refit, (data, model, start, refit_cancel), cost))
             owners.append(index)
+            if far and effect.cold_start:
+                # From the data's own start values, the effect from the best of its screened starts if it has any.
+                own = {name: start[name] for name in effect.param_names} if index in screened else effect.guess(ctx)
+                calls.append((_refit, (data, model, own, refit_cancel), cost))
+                owners.append(index)
+        return calls, owners
+
+    # The refits that need no screen go to the pool behind the screens, the others once theirs are back.
+    plain_calls, plain_owners = refit_calls([i for i in range(len(moves)) if i not in screened_moves], {})
+    plain_handles = jobs.submit(plain_calls, executor, cancel)
+    screened = best_starts(screen_owners, screen_handles)
+    narrow_calls, narrow_owners = refit_calls(sorted(screened_moves), screened)
+    narrow_handles = jobs.submit(narrow_calls, executor, cancel)
     outcomes: dict[int, tuple[FitResult | None, str | None]] = {}
-    for index, (fit, error) in zip(owners, _run(calls, executor, cancel)):
+    for index, handle in sorted(zip(plain_owners + narrow_owners, plain_handles + narrow_handles),
+                                key=lambda pair: pair[0]):
+        fit, error = handle.outcome()
         kept = outcomes.get(index)
         if kept is None or kept[0] is None or (fit is not None and fit.chi2 < kept[0].chi2):
             outcomes[index] = (fit, error)
@@ -266,23 +218,8 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
         candidates.append(Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
                                     delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
                                     flags=flags, assessment=acceptance.assess(current, fit, effect, flags)))
-    candidates += pairs.rank_pairs(data, current, candidates, _refit, _run, executor, cancel, Candidate)
+    candidates += pairs.rank_pairs(data, current, candidates, _refit, jobs.run, executor, cancel, Candidate)
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
-
-
-def _same_compliance_at_fs(current: FitResult, model: Model, start: dict) -> dict:
-    """A swapped creep law starts with the compliance the current fit has at fs.
-
-    The laws normalise LCES differently (the compliance at fs for the log laws, above the creep band for
-    creep-3p and creep-zener): started from the old LCES, a law whose factor at fs is far from 1 starts
-    far from the data and can crawl for thousands of evaluations into a poor minimum.
-    """
-    s = np.array([2j * np.pi * resonance_frequency(current.values)])
-    before = abs(np.atleast_1d(current.model.motional_compliance_factor(s, current.values))[0])
-    after = abs(np.atleast_1d(model.motional_compliance_factor(s, start))[0])
-    if not (np.isfinite(before) and np.isfinite(after) and after > 0):
-        return start
-    return {**start, "LCES": start["LCES"] * before / after}
 
 
 class _SiteFits:
@@ -359,10 +296,11 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
                 break
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
-        ranked = rank_candidates(data, current, executor, cancel)
+        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps))
         ranked, best = choose(current, ranked, sites)
         if best is None:    # the candidates rule 3 refused, tried with what acts on the channel they left
-            refused = pairs.rank_pairs(data, current, ranked, _refit, _run, executor, cancel, Candidate, refused=True)
+            refused = pairs.rank_pairs(data, current, ranked, _refit, jobs.run, executor, cancel, Candidate,
+                                      refused=True)
             if refused:
                 ranked, best = choose(current, tuple(sorted(ranked + tuple(refused), key=lambda c: c.delta_bic)),
                                       sites)
@@ -389,6 +327,12 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     located = localise(data, final, executor, known=known, cancel=cancel)
     taken = {site for step in result.steps if step.chosen is not None for site in _sites_of(step.chosen)}
     return dataclasses.replace(result, sites=first_among_tied(located, taken))
+
+
+def _refit_costs(steps: list[Step]) -> dict[str, float]:
+    """What each effect's refit cost in the last round (its evaluations): the next round's estimate."""
+    last = steps[-1].candidates if steps else ()
+    return {c.effect.id: float(c.fit.nfev) for c in last if c.partner is None and c.fit is not None}
 
 
 def _sites_of(candidate: Candidate) -> tuple[Site, ...]:

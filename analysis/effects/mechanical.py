@@ -31,6 +31,26 @@ def piston_radiation_impedance(w: np.ndarray, a: float) -> np.ndarray:
     return RHO * C_SOUND * np.pi * a * a * ((1.0 - 2.0 * j1(x) / x) + 1j * (4.0 * x / (3.0 * np.pi) + _x1_excess(x)))
 
 
+# The last radiation impedance worked out, by its radius and lines: a fit's Jacobian moves one parameter at a
+# time, so the radius is the same in most evaluations (with 14 parameters varying, in 13 of 15), and the
+# Bessel and Struve terms cost more than the rest of the model. One entry per process is enough: a fit
+# evaluates its model on the same lines from start to end. A tuple is replaced whole, so threads are safe.
+_last_radiation: tuple[float, bytes, np.ndarray] | None = None
+
+
+def _radiation_impedance(w: np.ndarray, a: float) -> np.ndarray:
+    """piston_radiation_impedance(w, a), from the last call when it had the same radius and lines (read-only)."""
+    global _last_radiation
+    key = w.dtype.str.encode() + w.tobytes()
+    last = _last_radiation
+    if last is not None and last[0] == a and last[1] == key:
+        return last[2]
+    zr = piston_radiation_impedance(w, a)
+    zr.flags.writeable = False
+    _last_radiation = (a, key, zr)
+    return zr
+
+
 # scipy's Struve function costs about 4 us a point, twenty times the rest of the model: X1 beyond its
 # low-frequency slope, X1(x) - 4x/(3*pi), is tabulated once on a fine logarithmic grid (interpolated to
 # better than 1e-6 of itself), with its series below the grid and the exact function above it.
@@ -79,7 +99,7 @@ class AirLoad(Effect):
     def response(self, s, p):
         a = p["a_rad"]
         w = np.abs(s)
-        return (piston_radiation_impedance(w, a) - s * air_mass(a)) / p["Bl"] ** 2
+        return (_radiation_impedance(w, a) - s * air_mass(a)) / p["Bl"] ** 2
 
     def guess(self, ctx):
         return {"a_rad": START_RADIUS}

@@ -65,6 +65,13 @@ class FitData:
         return self.impedance if name == "impedance" else self.displacement
 
     @functools.cached_property
+    def s(self) -> dict[str, np.ndarray]:
+        """s = 2j*pi*f at each channel's lines, worked out once: a fit evaluates its model there thousands of
+        times (and the model remembers its effects' responses at lines it has seen: analysis.model.response_memo)."""
+        return {name: 2j * np.pi * tf.freqs for name, tf in (("impedance", self.impedance),
+                                                             ("displacement", self.displacement)) if tf is not None}
+
+    @functools.cached_property
     def same_lines(self) -> bool:
         """Both channels at the same lines (the usual case): the model is then evaluated once for both."""
         x = self.displacement
@@ -183,13 +190,13 @@ def _residual_vector(model: Model, p: Mapping[str, float], data: FitData, use_x:
                      sigmas: dict[str, np.ndarray], use_z: bool = True) -> np.ndarray:
     z = data.impedance
     if use_x and use_z and data.same_lines:    # both channels from one pass through the model
-        Z, Hx = model.responses(2j * np.pi * z.freqs, p)
+        Z, Hx = model.responses(data.s["impedance"], p)
         return np.concatenate(_channel_residual(Z, z, sigmas["impedance"])
                               + _channel_residual(Hx, data.displacement, sigmas["displacement"]))
-    parts = _channel_residual(model.impedance(2j * np.pi * z.freqs, p), z, sigmas["impedance"]) if use_z else []
+    parts = _channel_residual(model.impedance(data.s["impedance"], p), z, sigmas["impedance"]) if use_z else []
     if use_x:
         x = data.displacement
-        parts += _channel_residual(model.displacement(2j * np.pi * x.freqs, p), x, sigmas["displacement"])
+        parts += _channel_residual(model.displacement(data.s["displacement"], p), x, sigmas["displacement"])
     return np.concatenate(parts)
 
 

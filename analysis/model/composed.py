@@ -23,6 +23,7 @@ import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site
 from analysis.errors import LinparError
+from analysis.model import response_memo
 
 # The textbook model without extra effects: the lumped elements of docs/physics.md section 1.
 BASE_PARAMS: tuple[ParamSpec, ...] = (
@@ -97,23 +98,26 @@ class Model:
         return self._by_site[site]
 
     def blocked_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
+        memo = response_memo.for_model(self, s)
         Ze = p["RE"] + s * p["LE"]
         for effect in self._site(Site.BLOCKED):
-            Ze = Ze + effect.response(s, p)
+            Ze = Ze + memo.response(effect, s, p)
         return Ze
 
     def motional_compliance_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray | float:
         """c(s): the product of the compliance-site factors (1.0 without any)."""
+        memo = response_memo.for_model(self, s)
         compliance = 1.0
         for effect in self._site(Site.COMPLIANCE):
-            compliance = compliance * effect.response(s, p)
+            compliance = compliance * memo.response(effect, s, p)
         return compliance
 
     def motional_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
         compliance = self.motional_compliance_factor(s, p)
         Y = s * p["CMES"] + 1.0 / p["RES"] + 1.0 / (s * p["LCES"] * compliance)
+        memo = response_memo.for_model(self, s)
         for effect in self._site(Site.MECHANICAL):
-            Y = Y + effect.response(s, p)
+            Y = Y + memo.response(effect, s, p)
         return 1.0 / Y
 
     def force_factor(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray | None:
@@ -121,9 +125,10 @@ class Model:
         effects = self._site(Site.FORCE_FACTOR)
         if not effects:
             return None
-        g = effects[0].response(s, p)
+        memo = response_memo.for_model(self, s)
+        g = memo.response(effects[0], s, p)
         for effect in effects[1:]:
-            g = g * effect.response(s, p)
+            g = g * memo.response(effect, s, p)
         return g
 
     def driver_impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
@@ -135,8 +140,9 @@ class Model:
     def impedance(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
         """Z = U / I as the current channel measures it."""
         Z = self.driver_impedance(s, p)
+        memo = response_memo.for_model(self, s)
         for effect in self._site(Site.CURRENT):
-            Z = Z * effect.response(s, p)
+            Z = Z * memo.response(effect, s, p)
         return Z
 
     def displacement(self, s: np.ndarray, p: Mapping[str, float]) -> np.ndarray:
@@ -148,8 +154,9 @@ class Model:
             Hx = ZR / (ZR + Ze) / (p["Bl"] * s)
         else:
             Hx = g * ZR / (Ze + g * g * ZR) / (p["Bl"] * s)
+        memo = response_memo.for_model(self, s)
         for effect in self._site(Site.DISPLACEMENT):
-            Hx = Hx * effect.response(s, p)
+            Hx = Hx * memo.response(effect, s, p)
         return Hx
 
     def responses(self, s: np.ndarray, p: Mapping[str, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -157,25 +164,26 @@ class Model:
 
         The same numbers as impedance(s, p) and displacement(s, p), in half the work.
         """
+        memo = response_memo.for_model(self, s)
         by_site = self._by_site
         Ze = p["RE"] + s * p["LE"]
         for effect in by_site[Site.BLOCKED]:
-            Ze = Ze + effect.response(s, p)
+            Ze = Ze + memo.response(effect, s, p)
         compliance = 1.0
         for effect in by_site[Site.COMPLIANCE]:
-            compliance = compliance * effect.response(s, p)
+            compliance = compliance * memo.response(effect, s, p)
         Y = s * p["CMES"] + 1.0 / p["RES"] + 1.0 / (s * p["LCES"] * compliance)
         for effect in by_site[Site.MECHANICAL]:
-            Y = Y + effect.response(s, p)
+            Y = Y + memo.response(effect, s, p)
         ZR = 1.0 / Y
         g = self.force_factor(s, p)
         Zd = Ze + (ZR if g is None else g * g * ZR)
         Z = Zd
         for effect in by_site[Site.CURRENT]:
-            Z = Z * effect.response(s, p)
+            Z = Z * memo.response(effect, s, p)
         Hx = (ZR if g is None else g * ZR) / Zd / (p["Bl"] * s)
         for effect in by_site[Site.DISPLACEMENT]:
-            Hx = Hx * effect.response(s, p)
+            Hx = Hx * memo.response(effect, s, p)
         return Z, Hx
 
     def describe(self) -> str:
