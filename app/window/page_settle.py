@@ -11,7 +11,7 @@ is laid out once and painted once.
 from __future__ import annotations
 
 from PySide6.QtCore import QCoreApplication, QEvent, QObject
-from PySide6.QtWidgets import QGraphicsView, QTabWidget, QWidget
+from PySide6.QtWidgets import QAbstractItemView, QGraphicsView, QTabWidget, QWidget
 
 MAX_PASSES = 64         # a layout request climbs one widget per pass; the pages are ~15 widgets deep
 
@@ -43,6 +43,8 @@ def settle(page: QWidget) -> int:
                 break
     finally:
         app.removeEventFilter(counter)
+    for view in page.findChildren(QAbstractItemView):
+        view.executeDelayedItemsLayout()        # laid out now, not by its timer just after the first paint
     for view in page.findChildren(QGraphicsView):
         if view.scene() is not None:
             QCoreApplication.sendPostedEvents(view.scene(), QEvent.MetaCall)     # the scene's own queued updates
