@@ -8,6 +8,7 @@ from PySide6.QtWidgets import QApplication, QGraphicsWidget, QLabel, QTabWidget
 
 from app.widgets.plots import TransferPlot
 from app.widgets.still_scene import StillScene
+from tests.pace import wait_ms
 
 
 class ActivationWitness(QGraphicsWidget):
@@ -36,7 +37,7 @@ def _switch_back_and_forth(qtbot, view, times: int = 3) -> ActivationWitness:
     tabs.addTab(view, "plot")
     tabs.show()
     tabs.activateWindow()
-    qtbot.waitUntil(tabs.isActiveWindow)
+    qtbot.waitUntil(tabs.isActiveWindow, timeout=wait_ms(10))
     for _ in range(times):
         tabs.setCurrentIndex(1)
         QApplication.processEvents()

@@ -11,6 +11,7 @@ from PySide6.QtWidgets import QApplication
 
 from app.window.page_settle import MAX_PASSES, settle
 from tests.app.conftest import open_and_wait
+from tests.pace import wait_ms
 
 QUIET_TURNS = 20        # turns of the event loop after the switch in which nothing may paint again
 
@@ -38,7 +39,7 @@ def _drain(turns: int = QUIET_TURNS) -> None:
 
 def test_the_results_page_and_the_model_lab_are_painted_once_per_switch(qtbot, window, recordings):
     open_and_wait(qtbot, window, recordings["paper"], signal="model_part_shown")
-    qtbot.waitUntil(lambda: not window.busy and window.model_lab.current is not None)
+    qtbot.waitUntil(lambda: not window.busy and window.model_lab.current is not None, timeout=wait_ms(30))
     pages = {window.results: window.results.impedance_plot.viewport(),
              window.model_lab: window.model_lab.residual_panel.impedance.viewport()}
     for page, plot in pages.items():
