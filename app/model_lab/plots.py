@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 from app.widgets import style
 from app.widgets.grid_axis import OpaqueGridAxis, show_grid
 from app.widgets.plots import LEFT_AXIS_WIDTH, RESIDUAL_MIN_RANGE, LogFrequencyAxis
+from app.widgets.still_scene import StillPlotWidget, StillScene
 from app.results.curves import ChannelCurves, ResultCurves
 
 CHANNEL_SHORT = {"impedance": "Z", "displacement": "Hx"}
@@ -34,7 +35,7 @@ def _guides(plot: pg.PlotItem) -> None:
                                      pen=pg.mkPen(style.GUIDE, width=1, style=dash)))
 
 
-class ResidualPlot(pg.PlotWidget):
+class ResidualPlot(StillScene, pg.PlotWidget):
     """The normalised residual of one channel per line: real and imaginary parts, in sigma."""
 
     def __init__(self, channel: str, bottom_label: bool, parent=None):
@@ -185,7 +186,7 @@ class ChiSquareChart(QWidget):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.points: list[ChartPoint] = []
-        self.plot_widget = pg.PlotWidget(axisItems={"bottom": VersionAxis("bottom"), "left": DecadeAxis("left")})
+        self.plot_widget = StillPlotWidget(axisItems={"bottom": VersionAxis("bottom"), "left": DecadeAxis("left")})
         plot = self.plot = self.plot_widget.getPlotItem()
         plot.setLogMode(x=False, y=True)
         show_grid(plot, x=False, y=True)

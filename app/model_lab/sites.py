@@ -20,6 +20,7 @@ from analysis.diagnosis.words import SITE_WORDS, chi2_words, tied_sites
 from app.widgets import style
 from app.widgets.grid_axis import show_grid
 from app.widgets.plots import LEFT_AXIS_WIDTH, LogFrequencyAxis
+from app.widgets.still_scene import StillScene
 
 SIZE_COLOUR = "#6a3d9a"
 PHASE_COLOUR = "#e08a00"
@@ -30,7 +31,7 @@ MIN_SPAN = 1.0          # % and degrees: a flat correction still gets a readable
 RANKED_SHOWN = 4
 
 
-class CorrectionPlot(pg.PlotWidget):
+class CorrectionPlot(StillScene, pg.PlotWidget):
     """A site's correction against frequency: real and imaginary part of what it adds, or a factor's size and phase."""
 
     def __init__(self, parent=None):

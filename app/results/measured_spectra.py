@@ -12,6 +12,7 @@ import pyqtgraph as pg
 
 from app.widgets import style
 from app.widgets.plots import LogFrequencyAxis, style_plot
+from app.widgets.still_scene import StillScene
 
 # channel -> (what is plotted, display scale from SI): displacement in mm, as everywhere in the GUI.
 CHANNEL_AXES = {"voltage": ("voltage (V)", 1.0), "current": ("current (A)", 1.0),
@@ -30,7 +31,7 @@ def broken_channels(result) -> list[str]:
     return [name for name, channel in result.validity.channels.items() if channel.status == "red"]
 
 
-class MeasuredSpectraView(pg.GraphicsLayoutWidget):
+class MeasuredSpectraView(StillScene, pg.GraphicsLayoutWidget):
     """One plot per valid channel (amplitude and noise floor at the excited lines), then |Hx| if it was
     measured; frequency axes linked."""
 

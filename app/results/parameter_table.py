@@ -16,8 +16,8 @@ from typing import Mapping
 
 import numpy as np
 
-from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
-from PySide6.QtGui import QBrush, QColor, QFont
+from PySide6.QtCore import QModelIndex, Qt
+from PySide6.QtGui import QBrush, QColor, QFont, QStandardItem, QStandardItemModel
 from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeaderView, QLabel, QTableView,
                                QVBoxLayout, QWidget)
 
@@ -131,12 +131,24 @@ def shared_reason(rows) -> str:
     return reasons.pop() if unmeasured and len(reasons) == 1 else ""
 
 
-class ParameterModel(QAbstractTableModel):
+def _item(roles: dict) -> QStandardItem:
+    item = QStandardItem()
+    item.setFlags(Qt.ItemIsSelectable | Qt.ItemIsEnabled)      # as a read-only table model's cells
+    for role, value in roles.items():
+        item.setData(value, role)
+    return item
+
+
+class ParameterModel(QStandardItemModel):
+    """Every role of every cell worked out once and kept by Qt: a view asks for each of them on every repaint
+    (some 1,700 calls to show the table). Formatting them each time made up half of the Results page's repaint;
+    answering from Python still took 5-8 ms of it, the calls themselves."""
+
     def __init__(self, parent=None):
-        super().__init__(parent)
+        super().__init__(0, len(COLUMNS), parent)
+        self.setHorizontalHeaderLabels(list(COLUMNS))
         self._rows: list = []                      # ParameterValue, or a section title (str)
         self._descriptions: dict[str, str] = {}
-        self._cells: list[list[dict]] = []         # per row and column: role -> value
         self._parameters: Mapping[str, ParameterValue] = {}
         self._sd_m2: float | None = None
         self.all_digits = False
@@ -148,11 +160,15 @@ class ParameterModel(QAbstractTableModel):
         self._parameters, self._sd_m2 = parameters, sd_m2
         self._rows = ordered_rows(parameters, sd_m2)
         self._descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
-        # Every role of every cell, worked out once: a view asks for each of them on every repaint
-        # (some 1,700 calls to show the table), and formatting them each time made up half of the
-        # Results page's repaint.
         self.common_reason = shared_reason(self._rows)
-        self._cells = [self._row_roles(p) for p in self._rows]
+        # Filled inside the reset, quietly: the views hear of the new table once, by modelReset.
+        quiet = self.blockSignals(True)
+        try:
+            self.setRowCount(0)
+            for cells in (self._row_roles(p) for p in self._rows):
+                self.appendRow([_item(roles) for roles in cells])
+        finally:
+            self.blockSignals(quiet)
         self.endResetModel()
 
     def set_all_digits(self, on: bool) -> None:
@@ -195,22 +211,6 @@ class ParameterModel(QAbstractTableModel):
             if not isinstance(p, str) and p.name == name:
                 return row
         raise KeyError(name)
-
-    def rowCount(self, parent=QModelIndex()) -> int:
-        return 0 if parent.isValid() else len(self._rows)
-
-    def columnCount(self, parent=QModelIndex()) -> int:
-        return 0 if parent.isValid() else len(COLUMNS)
-
-    def headerData(self, section, orientation, role=Qt.DisplayRole):
-        if orientation == Qt.Horizontal and role == Qt.DisplayRole:
-            return COLUMNS[section]
-        return None
-
-    def data(self, index: QModelIndex, role=Qt.DisplayRole):
-        if not index.isValid():
-            return None
-        return self._cells[index.row()][index.column()].get(role)
 
     def _display(self, p: ParameterValue, col: int) -> str:
         if col == NAME:

@@ -14,6 +14,7 @@ from PySide6.QtCore import Qt
 from app.widgets import style
 from app.widgets.grid_axis import OpaqueGridAxis, show_grid
 from app.widgets.plot_placeholder import PlotPlaceholder
+from app.widgets.still_scene import StillScene
 
 LEFT_AXIS_WIDTH = 72          # the same on every row, so that the x axes line up
 RESIDUAL_MIN_RANGE = 4.0      # sigma: the +-3 guides always stay in view
@@ -121,7 +122,7 @@ def beyond_range(freqs: np.ndarray, residual: np.ndarray, limit: float) -> tuple
     return np.asarray(freqs)[out], sign, words
 
 
-class TransferPlot(pg.GraphicsLayoutWidget):
+class TransferPlot(StillScene, pg.GraphicsLayoutWidget):
     """Magnitude, phase and normalised residual of one transfer function, x axes linked."""
 
     def __init__(self, magnitude_label: str, display_scale: float, log_y: bool, parent=None):
@@ -241,7 +242,7 @@ class TransferPlot(pg.GraphicsLayoutWidget):
         self.placeholder.show_text(NO_CURVES)
 
 
-class SplPlot(pg.GraphicsLayoutWidget):
+class SplPlot(StillScene, pg.GraphicsLayoutWidget):
     """Predicted SPL: from the measured Hx lines (points) and from the model (line)."""
 
     def __init__(self, parent=None):

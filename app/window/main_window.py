@@ -13,6 +13,7 @@ from app.archive.page import ArchivePage
 from app.jobs.controls import JobControls
 from app.large_signal.page import LargeSignalPage
 from app.window.menus import Menus
+from app.window.page_settle import settle_on_switch
 from app.model_lab.page import ModelLab
 from app.production.page import ProductionPage
 from app.qa.view import QAView
@@ -106,6 +107,7 @@ class MainWindow(QMainWindow):
         first_start = self.settings.window_geometry()[0] is None
         self.pages.setCurrentWidget(self.wizard if first_start else self.results)
         self.setCentralWidget(self.pages)
+        settle_on_switch(self.pages)            # a page switched to is laid out and painted once
 
         self._build_menus()
         self._build_status_bar()

@@ -3,7 +3,9 @@ from __future__ import annotations
 
 import socket
 
-from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout, QLineEdit, QVBoxLayout
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout, QLabel, QLineEdit,
+                               QVBoxLayout)
 
 from app.wizard.base import WizardPage, rich_label
 from app.wizard.plans import TEMPLATES, DriverInfo, sd_from_diameter
@@ -20,6 +22,36 @@ def default_station() -> str:
         return socket.gethostname()
     except OSError:
         return ""
+
+
+SD_UNKNOWN_TEXT = ("Sd unknown: Vas, the efficiency and the SPL will not be reported (it can be entered later on "
+                   "the Results page).")
+SD_DIAMETER_TEXT = "Sd = {sd_cm2:.1f} cm² (a piston of that diameter)"
+
+
+class SteadyNote(QLabel):
+    """A wrapped plain-text note as tall, at its width, as the tallest of the texts it may show."""
+
+    def __init__(self, texts: tuple[str, ...]):
+        super().__init__()
+        self.setTextFormat(Qt.PlainText)
+        self.setWordWrap(True)
+        self.setAlignment(Qt.AlignLeft | Qt.AlignTop)
+        self._measure = QLabel()            # never shown: wraps each text as this label would
+        self._measure.setTextFormat(Qt.PlainText)
+        self._measure.setWordWrap(True)
+        self._texts = texts
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        self._measure.setFont(self.font())
+        heights = []
+        for text in self._texts:
+            self._measure.setText(text)
+            # The form gives a wrapped label its size hint's height, or more when its width needs more.
+            heights.append(max(self._measure.sizeHint().height(), self._measure.heightForWidth(self.width())))
+        if max(heights) != self.minimumHeight():
+            self.setMinimumHeight(max(heights))
 
 
 class DriverPage(WizardPage):
@@ -42,7 +74,9 @@ class DriverPage(WizardPage):
         sd_row = QHBoxLayout()
         sd_row.addWidget(self.sd_mode)
         sd_row.addWidget(self.sd_value, 1)
-        self.sd_note = rich_label()
+        # As tall as its longest text whatever it says, or when it says nothing: a note that came and went as Sd
+        # was typed moved every row under it, under the mouse.
+        self.sd_note = SteadyNote((SD_UNKNOWN_TEXT, SD_DIAMETER_TEXT.format(sd_cm2=9999.9)))
         self.impedance = QDoubleSpinBox()
         self.impedance.setRange(0.0, 100.0)
         self.impedance.setDecimals(1)
@@ -98,10 +132,9 @@ class DriverPage(WizardPage):
         self.sd_value.setRange(0.0, 5000.0 if self.sd_mode.currentIndex() == SD_AREA else 80.0)
         sd = self.sd_m2()
         if sd is None:
-            self.sd_note.setText("Sd unknown: Vas, the efficiency and the SPL will not be reported "
-                                 "(it can be entered later on the Results page).")
+            self.sd_note.setText(SD_UNKNOWN_TEXT)
         elif self.sd_mode.currentIndex() == SD_DIAMETER:
-            self.sd_note.setText(f"Sd = {sd * 1e4:.1f} cm² (a piston of that diameter)")
+            self.sd_note.setText(SD_DIAMETER_TEXT.format(sd_cm2=sd * 1e4))
         else:
             self.sd_note.setText("")
         template = TEMPLATES[self.template.currentData()]
