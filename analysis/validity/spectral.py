@@ -32,6 +32,8 @@ per-period frames (analysis.live); they hold no state.
 """
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 from typing import Mapping
 
@@ -80,14 +82,45 @@ def pooled_mean(values: np.ndarray, window: int) -> np.ndarray:
     if window == 1 or values.size < 2:
         return values
     half, n = window // 2, values.size
-    kernel = np.ones(window)
+    kernel, counts = _window_of(n, window)
     # The full convolution's element i + half is the sum of the window centred on i ("same" would not do:
     # it returns max(n, window) elements).
     sums = np.convolve(values, kernel)[half:half + n]
-    # How many values each window holds, counted rather than convolved (half the cost; the same integers).
+    return sums / counts
+
+
+@functools.lru_cache(maxsize=32)
+def _window_of(n: int, window: int) -> tuple[np.ndarray, np.ndarray]:
+    """pooled_mean's kernel and how many values each window holds, counted rather than convolved (the same
+    integers at half the cost); kept, since a live frame pools arrays of the same few sizes every period."""
+    half = window // 2
     index = np.arange(n)
     counts = np.minimum(index + half, n - 1) - np.maximum(index - half, 0) + 1
-    return sums / counts
+    kernel = np.ones(window)
+    kernel.flags.writeable = counts.flags.writeable = False
+    return kernel, counts
+
+
+def quantile(values: np.ndarray, q: float) -> float:
+    """np.quantile(values, q) with its default (linear) method: the same partition and the same arithmetic,
+    without its ~0.1 ms of general-purpose set-up per call (a live frame takes three every period).
+    NaN if any value is NaN, as numpy's."""
+    n = values.size
+    if n == 0:
+        raise ValueError("the quantile of no values")
+    virtual = (n - 1) * q
+    if virtual >= n - 1:                # numpy takes the last value twice, weight virtual + 1
+        lo = hi = n - 1
+        gamma = virtual + 1.0
+    else:
+        lo = int(math.floor(virtual))
+        hi, gamma = lo + 1, virtual - lo
+    ordered = np.partition(values, sorted({0, lo, hi, n - 1}))
+    if np.isnan(ordered[-1]):           # NaN sorts last
+        return float("nan")
+    a, b = ordered[lo], ordered[hi]
+    diff = b - a
+    return float(b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma)
 
 
 def line_snr_db(lines: np.ndarray, var: np.ndarray, pool: int) -> np.ndarray:
@@ -233,7 +266,7 @@ def spectral_checks(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray
                 _NO_SIGNAL_REMEDY[name], share))
             out[name] = (findings, measures)
             continue
-        q = float(np.quantile(snr[judged], th.snr_quantile))
+        q = quantile(snr[judged], th.snr_quantile)
         measures["snr_db"] = q
         severity = graded(q, th.snr_yellow_db, th.snr_red_db, below=True)
         if severity is not Severity.GREEN:
