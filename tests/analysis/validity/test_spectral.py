@@ -48,3 +48,17 @@ def test_the_pooled_mean_gives_the_same_for_each_size_its_kept_windows_serve():
         half = 16
         expected = [values[max(0, i - half):i + half + 1].mean() for i in range(n)]
         np.testing.assert_allclose(first, expected, rtol=1e-12)
+
+
+@pytest.mark.parametrize("window", [3, 5, 33, 65])
+def test_a_huge_or_infinite_value_spoils_only_the_windows_that_hold_it(window):
+    values = np.full(400, 2.0)
+    values[100], values[250] = 1e300, np.inf
+    pooled = pooled_mean(values, window)
+    half = window // 2
+    near = np.zeros(400, dtype=bool)
+    for spot in (100, 250):
+        near[spot - half:spot + half + 1] = True
+    np.testing.assert_array_equal(pooled[~near], 2.0)      # exactly: no cancellation after the huge values
+    assert np.all(pooled[250 - half:250 + half + 1] == np.inf)
+    np.testing.assert_allclose(pooled[100 - half:100 + half + 1], 1e300 / window, rtol=1e-15)
