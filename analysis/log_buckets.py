@@ -26,16 +26,20 @@ class LogBuckets:
         edges = np.linspace(log_f[0], log_f[-1], n_buckets + 1)
         index = np.clip(np.searchsorted(edges, log_f, side="right") - 1, 0, n_buckets - 1)
         self.starts = np.flatnonzero(np.r_[True, index[1:] != index[:-1]])
-        counts = np.diff(np.r_[self.starts, freqs.size])
-        self.freqs = 10.0 ** (np.add.reduceat(log_f, self.starts) / counts)
+        self._sizes = np.diff(np.r_[self.starts, freqs.size])
+        self.freqs = 10.0 ** (np.add.reduceat(log_f, self.starts) / self._sizes)
         self.freqs.flags.writeable = False
 
     def power_mean_db(self, power: np.ndarray) -> np.ndarray:
         """10 log10 of the mean of each bucket's powers above nothing (last axis); NaN for a bucket without any
         (NaN powers, unknown, are left out too)."""
         shown = power > _NOTHING_POWER
-        sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
-        counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
+        if shown.all():                 # the usual frame: every bin counts, the buckets' sizes are known
+            sums = np.add.reduceat(power, self.starts, axis=-1)
+            counts = np.broadcast_to(self._sizes, sums.shape)
+        else:
+            sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
+            counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
         with np.errstate(invalid="ignore", divide="ignore"):
             db = 10.0 * np.log10(sums / counts)
         db[counts == 0] = np.nan

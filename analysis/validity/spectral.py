@@ -32,6 +32,8 @@ per-period frames (analysis.live); they hold no state.
 """
 from __future__ import annotations
 
+import functools
+import math
 from dataclasses import dataclass
 from typing import Mapping
 
@@ -72,22 +74,72 @@ _SENSOR_NONLINEAR = ("the current is clean, so this is the triangulation sensor'
 def pooled_mean(values: np.ndarray, window: int) -> np.ndarray:
     """Centred moving mean over `window` (made odd) neighbours, the window shrinking at the ends.
 
-    Each window is summed on its own (a convolution), not as a difference of running sums: the values
+    Each window is a sum of its own values (_window_sums), never a difference of running sums: the values
     span many decades (a line's SNR as a power ratio, 10^2 to 10^30), and a difference of running sums
     would lose every window after a large value to cancellation, or to inf - inf.
     """
     window = max(1, int(window)) | 1
     if window == 1 or values.size < 2:
         return values
+    return _window_sums(np.asarray(values, dtype=np.float64), window) / _window_counts(values.size, window)
+
+
+def _window_sums(values: np.ndarray, window: int) -> np.ndarray:
+    """The sum of each centred window of `window` (odd) values, zeros beyond the ends.
+
+    Built from blocks whose sizes are the powers of two in `window`: a block of 2s values is two blocks of s
+    side by side, so a window of 33 takes 6 additions of the whole array where a convolution takes 33
+    multiply-adds per value (the voltage's pool of 33 over ~13,500 unexcited lines: 0.37 -> ~0.05 ms, every
+    live period). Only additions of the values themselves: the same rounding as any sum of 33 terms, no
+    cancellation.
+    """
     half, n = window // 2, values.size
-    kernel = np.ones(window)
-    # The full convolution's element i + half is the sum of the window centred on i ("same" would not do:
-    # it returns max(n, window) elements).
-    sums = np.convolve(values, kernel)[half:half + n]
-    # How many values each window holds, counted rather than convolved (half the cost; the same integers).
+    padded = np.concatenate((np.zeros(half), values, np.zeros(half)))
+    block, size, offset, sums = padded, 1, 0, None       # block[i] = sum(padded[i:i + size])
+    remaining = window
+    while True:
+        if remaining & 1:
+            part = block[offset:offset + n]
+            sums = part.copy() if sums is None else np.add(sums, part, out=sums)
+            offset += size
+        remaining >>= 1
+        if not remaining:
+            return sums
+        block = block[:-size] + block[size:]
+        size *= 2
+
+
+@functools.lru_cache(maxsize=32)
+def _window_counts(n: int, window: int) -> np.ndarray:
+    """How many of the n values each centred window holds, counted rather than convolved; kept, since a live
+    frame pools arrays of the same few sizes every period."""
+    half = window // 2
     index = np.arange(n)
     counts = np.minimum(index + half, n - 1) - np.maximum(index - half, 0) + 1
-    return sums / counts
+    counts.flags.writeable = False
+    return counts
+
+
+def quantile(values: np.ndarray, q: float) -> float:
+    """np.quantile(values, q) with its default (linear) method: the same partition and the same arithmetic,
+    without its ~0.1 ms of general-purpose set-up per call (a live frame takes three every period).
+    NaN if any value is NaN, as numpy's."""
+    n = values.size
+    if n == 0:
+        raise ValueError("the quantile of no values")
+    virtual = (n - 1) * q
+    if virtual >= n - 1:                # numpy takes the last value twice, weight virtual + 1
+        lo = hi = n - 1
+        gamma = virtual + 1.0
+    else:
+        lo = int(math.floor(virtual))
+        hi, gamma = lo + 1, virtual - lo
+    ordered = np.partition(values, sorted({0, lo, hi, n - 1}))
+    if np.isnan(ordered[-1]):           # NaN sorts last
+        return float("nan")
+    a, b = ordered[lo], ordered[hi]
+    diff = b - a
+    return float(b - diff * (1.0 - gamma) if gamma >= 0.5 else a + diff * gamma)
 
 
 def line_snr_db(lines: np.ndarray, var: np.ndarray, pool: int) -> np.ndarray:
@@ -233,7 +285,7 @@ def spectral_checks(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray
                 _NO_SIGNAL_REMEDY[name], share))
             out[name] = (findings, measures)
             continue
-        q = float(np.quantile(snr[judged], th.snr_quantile))
+        q = quantile(snr[judged], th.snr_quantile)
         measures["snr_db"] = q
         severity = graded(q, th.snr_yellow_db, th.snr_red_db, below=True)
         if severity is not Severity.GREEN:

@@ -26,3 +26,17 @@ def test_nothing_and_unknown_are_left_out_of_a_bucket_and_a_bucket_of_neither_is
     assert db.shape == (2, buckets.starts.size)
     assert np.isnan(db[0, 0])
     assert np.allclose(db[0, 1:], -100.0) and np.allclose(db[1], -100.0)
+
+
+def test_a_frame_where_every_bin_counts_gives_each_bucket_s_power_mean_as_one_with_a_gap():
+    freqs = np.geomspace(10, 10000, 3000)
+    buckets = LogBuckets(freqs, 100)
+    power = np.random.default_rng(5).uniform(1e-12, 1e-6, size=(3, freqs.size))
+    every = buckets.power_mean_db(power)                # the short path: all bins above nothing
+    gapped = power.copy()
+    gapped[:, -1] = 0.0                                 # one exact zero in the last bucket: the general path
+    general = buckets.power_mean_db(gapped)
+    np.testing.assert_array_equal(every[:, :-1], general[:, :-1])
+    sizes = np.diff(np.r_[buckets.starts, freqs.size])
+    expected = [10 * np.log10(power[:, s:s + k].mean(axis=-1)) for s, k in zip(buckets.starts, sizes)]
+    np.testing.assert_allclose(every, np.transpose(expected), rtol=1e-12)
