@@ -24,6 +24,7 @@ def fit_executor(workers: int | None = None) -> Iterator[Executor | None]:
         yield None
         return
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates"])
+    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates",
+                                     "analysis.pool_preload"])
     with ProcessPoolExecutor(max_workers=n, mp_context=context) as pool:
         yield pool

@@ -64,6 +64,11 @@ def _x1_excess_table() -> tuple[np.ndarray, np.ndarray]:
     return np.log(x), 2.0 * struve(1, x) / x - 4.0 * x / (3.0 * np.pi)
 
 
+def build_tables() -> None:
+    """Build the Struve term's table now rather than at the first evaluation (the pool's fork server does)."""
+    _x1_excess_table()
+
+
 def _x1_excess(x: np.ndarray) -> np.ndarray:
     """X1(x) - 4x/(3*pi), X1(x) = 2*H1(x)/x: -4x^3/(45*pi) + 4x^5/(1575*pi) - ... at small x."""
     log_x, table = _x1_excess_table()
