@@ -31,11 +31,11 @@ class StagedFanOut(QObject):
     the steps left, and the new round starts that receiver afresh.
     """
 
-    def __init__(self, receivers: list[Callable[[object], None]], parent: QObject | None = None):
+    def __init__(self, receivers: list[Callable[[object], Iterator[None] | None]], parent: QObject | None = None):
         super().__init__(parent)
         self._receivers = list(receivers)
         self._value = None
-        self._left: list[Callable[[object], None]] = []
+        self._left: list[Callable[[object], Iterator[None] | None]] = []
         self._then: list[Callable[[], None]] = []
         self._round = 0
 

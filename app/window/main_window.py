@@ -284,7 +284,8 @@ class MainWindow(QMainWindow):
         """A measurement the wizard finished: shown (it is already analysed), and remembered.
 
         In the next turn of the event loop: the wizard's own page updates first, so the two do not add
-        up to one long stall of the GUI (the Results page takes ~30 ms to show it, the lab as much again).
+        up to one long stall of the GUI (the Results page took ~30 ms to show it, the lab as much again: both
+        now fill in steps of their own turns, ResultsView.show_outcome_in_turns and ModelLab.setting_result).
         """
         self.jobs.drop()                    # an opened file still being analysed would replace it: drop that
         in_a_later_turn(self, lambda: self._show_measured(outcome))
