@@ -209,7 +209,7 @@ class ModelLab(QWidget):
             pass
 
     def _showing_current(self) -> Iterator[None]:
-        """_show_current in two steps (the residual plots; the table and the chart), ~10-15 ms of CPU each."""
+        """_show_current in three steps (each residual plot; the table and the chart), ~5-12 ms of CPU each."""
         version = self.versions[-1]
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
@@ -220,7 +220,7 @@ class ModelLab(QWidget):
                      f"{html.escape(fit.message)}</span>")
         self.model_label.setText(text)
         self.catalogue.set_checked(fit.model.effect_ids)
-        self.residual_panel.set_fit(version.fitted.curves, version.fitted.residual)
+        yield from self.residual_panel.setting_fit(version.fitted.curves, version.fitted.residual)
         yield
         self._show_parameters()
         self.chart.set_points([ChartPoint(v.number, v.effects, v.how, v.fitted.fit.chi2_red_by_channel())
