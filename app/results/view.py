@@ -164,7 +164,7 @@ class ResultsView(QWidget):
         step()
 
     def _showing(self, outcome: AnalysisOutcome) -> Iterator[None]:
-        """The page filled in three steps, each up to a `yield`: the words and the table, |Z|, the rest."""
+        """The page filled in four steps, each up to a `yield`: the words and the table, |Z|, Hx, the rest."""
         result, curves = outcome.result, outcome.curves
         self.result, self.curves = result, curves
         imported = is_imported(result)
@@ -196,6 +196,7 @@ class ResultsView(QWidget):
         else:
             self.displacement_plot.clear_curves()
             self.displacement_stack.setCurrentWidget(self.no_displacement)
+        yield
         if imported:
             draw_references(result, {"impedance": self.impedance_plot, "displacement": self.displacement_plot})
         self.spl_panel.set_data(curves.displacement, self.result.sd_m2)
