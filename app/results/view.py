@@ -157,7 +157,12 @@ class ResultsView(QWidget):
         filling, steps = self._filling, self._showing(outcome)
 
         def step() -> None:
-            if filling == self._filling and next(steps, _DONE) is not _DONE:
+            try:
+                more = filling == self._filling and next(steps, _DONE) is not _DONE
+            except Exception:
+                then()          # a step that failed must not keep the archive's store waiting; Qt logs the error
+                raise
+            if more:
                 in_a_later_turn(self, step)
             else:
                 then()

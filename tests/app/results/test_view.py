@@ -255,3 +255,21 @@ def test_a_newer_result_stops_one_shown_in_turns_and_what_waits_for_it_still_run
     qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
     assert _plotted(results) == expected and results.result is no_laser.result
     assert changed == [no_laser.result]
+
+
+def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, recordings, monkeypatch):
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+
+    def broken(*args):
+        raise RuntimeError("a plot failed")
+
+    monkeypatch.setattr(results.impedance_plot, "set_curves", broken)
+    done = []
+    with qtbot.captureExceptions() as exceptions:
+        results.show_outcome_in_turns(paper, lambda: done.append(True))
+        qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert done == [True]
+    assert [str(e[1]) for e in exceptions] == ["a plot failed"]
