@@ -235,6 +235,9 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
     on_finished = finished.append
     on_failed = lambda job, message: failed.append(message)      # noqa: E731
     wizard.measurement_finished.connect(on_finished)
+    window, shown = wizard.window(), []
+    on_shown = shown.append
+    window.measurement_shown.connect(on_shown)
     page.jobs.runner.failed.connect(on_failed)
     paints_before, frames_before = len(page.panels.paint_times), page.panels.frames_received
     with StallMeter() as meter:
@@ -248,8 +251,12 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
         averaging = time.monotonic() - started
         averaged_ticks = len(meter.gaps)
         ok = _wait(app, lambda: finished or failed)
-        _wait(app, lambda: False, 0.3)          # the hand-off to the Results page, the Model lab and QA
+        # The hand-off to the Results page, the Model lab and QA, in turns of its own: all of it, however long the
+        # machine's load makes it, then what it left to lay out.
+        _wait(app, lambda: shown or failed)
+        _wait(app, lambda: False, 0.3)
     wizard.measurement_finished.disconnect(on_finished)
+    window.measurement_shown.disconnect(on_shown)
     page.jobs.runner.failed.disconnect(on_failed)
     if not ok or failed:
         return {"failed": failed[0] if failed else "timed out"}

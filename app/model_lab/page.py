@@ -11,6 +11,7 @@ already. The current version is handed back to the Results page
 from __future__ import annotations
 
 import html
+from collections.abc import Iterator
 from pathlib import Path
 
 from PySide6.QtCore import Qt, Signal, Slot
@@ -147,6 +148,12 @@ class ModelLab(QWidget):
     @Slot(object)
     def set_result(self, result: AnalysisResult) -> None:
         """A result from the Results page: a new recording restarts the lab from its model."""
+        for _ in self.setting_result(result):
+            pass
+
+    def setting_result(self, result: AnalysisResult) -> Iterator[None]:
+        """set_result in steps, each up to a `yield` (the main window's StagedFanOut runs each in a turn of its own:
+        the whole set-up held the GUI thread 30-40 ms of CPU). Done once the generator is exhausted."""
         if not hasattr(result, "spectra"):      # imported curves (File > Open curves…): no recording to model
             self.jobs.drop()
             self.empty.setText("The Model lab works on recordings; imported curves are analysed on the Results page "
@@ -168,7 +175,8 @@ class ModelLab(QWidget):
         self.site_panel.set_sites(())
         self.views.setCurrentWidget(self.chart)
         self.catalogue.set_displacement_available(result.fit.model.with_displacement)
-        self._add_version(*first_version(result), adopt=False)
+        yield
+        yield from self._showing_added(self.session.add(*first_version(result)), adopt=False, announce=True)
         self.status_label.setText("")
         self.stack.setCurrentWidget(self.content)
 
@@ -179,7 +187,12 @@ class ModelLab(QWidget):
 
     def _add_version(self, fitted: LabFit, how: str, adopt: bool = True, announce: bool = True) -> LabVersion:
         version = self.session.add(fitted, how)
-        self._show_current()
+        for _ in self._showing_added(version, adopt, announce):
+            pass
+        return version
+
+    def _showing_added(self, version: LabVersion, adopt: bool, announce: bool) -> Iterator[None]:
+        yield from self._showing_current()
         if self.diagnosis is not None and not self.session.diagnosis_is_current:
             self.candidates.mark_stale(version.number)
             self.site_panel.mark_stale(version.number)
@@ -189,10 +202,14 @@ class ModelLab(QWidget):
                                                     version.fitted.curves))
         if announce:
             self.version_added.emit(version)
-        return version
 
     # -- showing -----------------------------------------------------------
     def _show_current(self) -> None:
+        for _ in self._showing_current():
+            pass
+
+    def _showing_current(self) -> Iterator[None]:
+        """_show_current in three steps (each residual plot; the table and the chart), ~5-12 ms of CPU each."""
         version = self.versions[-1]
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
@@ -203,7 +220,8 @@ class ModelLab(QWidget):
                      f"{html.escape(fit.message)}</span>")
         self.model_label.setText(text)
         self.catalogue.set_checked(fit.model.effect_ids)
-        self.residual_panel.set_fit(version.fitted.curves, version.fitted.residual)
+        yield from self.residual_panel.setting_fit(version.fitted.curves, version.fitted.residual)
+        yield
         self._show_parameters()
         self.chart.set_points([ChartPoint(v.number, v.effects, v.how, v.fitted.fit.chi2_red_by_channel())
                                for v in self.versions])

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import html
+from collections.abc import Callable, Iterator
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (QFrame, QHBoxLayout, QLabel, QSplitter, QStackedWidget, QTabWidget, QVBoxLayout,
@@ -17,7 +18,9 @@ from app.results.parameter_table import titled_parameter_table
 from app.widgets.plots import TransferPlot
 from app.results.spl_panel import SplPanel
 from app.jobs.workers import AnalysisOutcome
+from app.jobs.next_turn import in_a_later_turn
 
+_DONE = object()
 EMPTY_TEXT = ("No recording loaded.\n\nOpen one with File ▸ Open recording… (Ctrl+O), "
               "or drop a recording's .wav or .json file on this window.")
 
@@ -60,6 +63,7 @@ class ResultsView(QWidget):
         super().__init__(parent)
         self.result: AnalysisResult | None = None
         self.curves = None
+        self._filling = 0                   # counts the results begun: a fill in turns stops once a newer begins
 
         self.empty = QLabel(EMPTY_TEXT)
         self.empty.setAlignment(Qt.AlignCenter)
@@ -140,6 +144,32 @@ class ResultsView(QWidget):
             self.empty.setText(EMPTY_TEXT)
 
     def show_outcome(self, outcome: AnalysisOutcome) -> None:
+        self._filling += 1
+        for _ in self._showing(outcome):
+            pass
+
+    def show_outcome_in_turns(self, outcome: AnalysisOutcome, then: Callable[[], None]) -> None:
+        """show_outcome, each plot in a later turn of the event loop than the table (a finished measurement's
+        hand-off: the whole page in one turn held the GUI thread 30-40 ms of CPU). `then()` once it is shown, or
+        once a newer result (show_outcome, clear) replaced it on its way: what waits for it (the archive's store)
+        is never lost."""
+        self._filling += 1
+        filling, steps = self._filling, self._showing(outcome)
+
+        def step() -> None:
+            try:
+                more = filling == self._filling and next(steps, _DONE) is not _DONE
+            except Exception:
+                then()          # a step that failed must not keep the archive's store waiting; Qt logs the error
+                raise
+            if more:
+                in_a_later_turn(self, step)
+            else:
+                then()
+        step()
+
+    def _showing(self, outcome: AnalysisOutcome) -> Iterator[None]:
+        """The page filled in four steps, each up to a `yield`: the words and the table, |Z|, Hx, the rest."""
         result, curves = outcome.result, outcome.curves
         self.result, self.curves = result, curves
         imported = is_imported(result)
@@ -160,20 +190,23 @@ class ResultsView(QWidget):
             self.stack.setCurrentWidget(self.content)
             self.result_changed.emit(result)
             return
+        yield
         self.impedance_stack.setCurrentWidget(self.impedance_plot)
         self.plot_tabs.setTabText(0, "Impedance Z")
         self.impedance_plot.set_curves(curves.impedance, "Impedance Z = U / I")
+        yield
         if curves.displacement is not None:
             self.displacement_plot.set_curves(curves.displacement, "Displacement per volt Hx = X / U")
             self.displacement_stack.setCurrentWidget(self.displacement_plot)
         else:
             self.displacement_plot.clear_curves()
             self.displacement_stack.setCurrentWidget(self.no_displacement)
+        yield
         if imported:
             draw_references(result, {"impedance": self.impedance_plot, "displacement": self.displacement_plot})
-        self.spl_panel.set_data(curves.displacement, result.sd_m2)
+        self.spl_panel.set_data(curves.displacement, self.result.sd_m2)
         self.stack.setCurrentWidget(self.content)
-        self.result_changed.emit(result)
+        self.result_changed.emit(self.result)       # with Sd as edited meanwhile, if it was
 
     def show_model_part(self, outcome: AnalysisOutcome) -> bool:
         """The same result with the model part of its uncertainties (AnalysisWorker.start_model_part): the table
@@ -201,6 +234,7 @@ class ResultsView(QWidget):
         return f"<br><span style='color:{style.VALIDITY_COLOURS['yellow'][1]}'>{html.escape(remark)}</span>" if remark else ""
 
     def clear(self) -> None:
+        self._filling += 1
         self.result = self.curves = None
         self.impedance_plot.clear_curves()
         self.displacement_plot.clear_curves()

@@ -82,7 +82,7 @@ class MainWindow(QMainWindow):
         self.wizard.measurement_finished.connect(self.on_measured)
         self.wizard.open_results_requested.connect(self.on_open_measured)
         # The lab and QA follow the Results page, each in its own turn of the event loop (app/jobs/staged_fanout.py).
-        self.result_pages = StagedFanOut([self.model_lab.set_result, self.qa.set_result], self)
+        self.result_pages = StagedFanOut([self.model_lab.setting_result, self.qa.set_result], self)
         self.results.result_changed.connect(self.result_pages.send)
         self.series = SeriesPage()
         self.large_signal = LargeSignalPage()
@@ -284,17 +284,20 @@ class MainWindow(QMainWindow):
         """A measurement the wizard finished: shown (it is already analysed), and remembered.
 
         In the next turn of the event loop: the wizard's own page updates first, so the two do not add
-        up to one long stall of the GUI (the Results page takes ~30 ms to show it, the lab as much again).
+        up to one long stall of the GUI (the Results page took ~30 ms to show it, the lab as much again: both
+        now fill in steps of their own turns, ResultsView.show_outcome_in_turns and ModelLab.setting_result).
         """
         self.jobs.drop()                    # an opened file still being analysed would replace it: drop that
         in_a_later_turn(self, lambda: self._show_measured(outcome))
 
     def _show_measured(self, outcome) -> None:
-        self.results.show_outcome(outcome.analysis)
+        self.results.show_outcome_in_turns(outcome.analysis, lambda: self._measured_shown(outcome))
         self.settings.add_recent_file(outcome.path)
         self._rebuild_recent_menu()
         self.setWindowTitle(f"linpar — {outcome.path.name}")
         self.status_label.setText(f"Measured {outcome.path}; storing it in the archive…")
+
+    def _measured_shown(self, outcome) -> None:
         # Stored once the lab and QA have it (the store's thread would slow their setting up: the GIL), and
         # with the model part of its uncertainties once that is estimated (the archive's record, like the CLI's).
         self.result_pages.after(lambda: (self.measurement_shown.emit(outcome), self.start_model_part(

@@ -53,3 +53,43 @@ def test_a_callback_given_while_earlier_ones_wait_runs_after_them(qtbot):
     fan.send(1, then=lambda: order.append("first"))
     qtbot.waitUntil(lambda: len(order) == 2, timeout=wait_ms(10))
     assert order == ["first", "late"]
+
+
+def _turn_by_turn(monkeypatch) -> list:
+    """The fan-out's later turns, kept to be run one by one by the test (no event loop, no timing)."""
+    import app.jobs.staged_fanout as staged_fanout
+    turns: list = []
+    monkeypatch.setattr(staged_fanout, "in_a_later_turn", lambda context, step: turns.append(step))
+    return turns
+
+
+def _steps(calls: list, name: str):
+    def receiver(value):
+        calls.append(f"{name}1 {value}")
+        yield
+        calls.append(f"{name}2 {value}")
+    return receiver
+
+
+def test_a_generator_receiver_fills_one_step_a_turn_before_the_next_receiver(monkeypatch):
+    turns, calls = _turn_by_turn(monkeypatch), []
+    fan = StagedFanOut([_steps(calls, "lab"), calls.append])
+    fan.send("v", then=lambda: calls.append("shown"))
+    seen = []
+    while turns:
+        turns.pop(0)()
+        seen.append(list(calls))
+    assert seen == [["lab1 v"], ["lab1 v", "lab2 v"], ["lab1 v", "lab2 v", "v"], ["lab1 v", "lab2 v", "v", "shown"]]
+    assert not fan.pending
+
+
+def test_a_newer_value_drops_the_steps_left_of_an_older_one(monkeypatch):
+    turns, calls, shown = _turn_by_turn(monkeypatch), [], []
+    fan = StagedFanOut([_steps(calls, "lab")])
+    fan.send("old", then=lambda: shown.append("old"))
+    turns.pop(0)()                                  # the lab's first step with the old value
+    fan.send("new", then=lambda: shown.append("new"))
+    while turns:
+        turns.pop(0)()
+    assert calls == ["lab1 old", "lab1 new", "lab2 new"]
+    assert shown == ["old", "new"]

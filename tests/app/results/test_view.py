@@ -8,6 +8,7 @@ from PySide6.QtCore import Qt
 from app.results.parameter_table import NAME, STD, UNIT, VALUE
 
 from tests.app.conftest import PAPER, open_and_wait
+from tests.pace import wait_ms
 
 
 def _cell(table, name: str, column: int, role=Qt.DisplayRole):
@@ -213,3 +214,62 @@ def test_residuals_beyond_the_strip_are_pinned_at_its_edge_and_counted(shown):
     assert plot.residual_beyond_up.getData()[0] is None or len(plot.residual_beyond_up.getData()[0]) == 0
     assert plot.beyond_text == ""
     assert beyond_range(curves.freqs, curves.residual, 1e9)[2] == ""
+
+
+def _plotted(results) -> list:
+    plots = (results.impedance_plot, results.displacement_plot)
+    return [None if item.getData()[1] is None else item.getData()[1].tolist()
+            for plot in plots for item in (plot.magnitude_measured, plot.magnitude_model, plot.residual_real)]
+
+
+# Each open below waits for the model part too: nothing of the window's own reaches the page during the test.
+def test_a_measurement_shown_in_turns_looks_as_one_shown_at_once(qtbot, window, recordings):
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+    at_once = _plotted(results)
+    open_and_wait(qtbot, window, recordings["no_laser"], "model_part_shown")
+    no_laser = _plotted(results)
+    changed, done = [], []
+    results.result_changed.connect(changed.append)
+    results.show_outcome_in_turns(paper, lambda: done.append(True))
+    assert _plotted(results) == no_laser and not done          # only the table in this turn: the plots later
+    qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert _plotted(results) == at_once
+    assert changed == [paper.result] and results.result is paper.result
+
+
+def test_a_newer_result_stops_one_shown_in_turns_and_what_waits_for_it_still_runs(qtbot, window, recordings):
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+    open_and_wait(qtbot, window, recordings["no_laser"], "model_part_shown")
+    no_laser = AnalysisOutcome(2, recordings["no_laser"], results.result, results.curves)
+    expected = _plotted(results)
+    changed, done = [], []
+    results.result_changed.connect(changed.append)
+    results.show_outcome_in_turns(paper, lambda: done.append(True))
+    results.show_outcome(no_laser)
+    qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert _plotted(results) == expected and results.result is no_laser.result
+    assert changed == [no_laser.result]
+
+
+def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, recordings, monkeypatch):
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+
+    def broken(*args):
+        raise RuntimeError("a plot failed")
+
+    monkeypatch.setattr(results.impedance_plot, "set_curves", broken)
+    done = []
+    with qtbot.captureExceptions() as exceptions:
+        results.show_outcome_in_turns(paper, lambda: done.append(True))
+        qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert done == [True]
+    assert [str(e[1]) for e in exceptions] == ["a plot failed"]
