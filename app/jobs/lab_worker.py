@@ -184,7 +184,7 @@ def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, f
     (it still counts as the path's first step, for the verdict).
     """
     begin = taken.fitted.fit if taken is not None else start
-    with fit_executor() as pool:
+    with fit_executor(background=True) as pool:        # the window keeps the cores it needs
         executor = None if pool is None else _CancellableExecutor(pool, job.cancel_event)
         result = diagnose(data, begin.model, executor=executor, cancel=job.cancel_event, start_fit=begin,
                           progress=job.say, max_steps=MAX_STEPS, follow=follow)

@@ -1,6 +1,8 @@
-"""The process pool's workers start with what the fork server built once (analysis/pool_preload.py)."""
+"""The process pool's workers: what the fork server built once (analysis/pool_preload.py), their priority."""
+import os
+
 from analysis.effects import mechanical
-from analysis.parallel import fit_executor
+from analysis.parallel import BACKGROUND_NICENESS, fit_executor
 
 
 def _table_entries() -> int:
@@ -18,3 +20,17 @@ def test_the_table_built_ahead_is_the_one_a_fit_would_build():
     mechanical._x1_excess_table.cache_clear()
     mechanical.build_tables()
     assert mechanical._x1_excess_table.cache_info().currsize == 1
+
+
+def _niceness() -> int:
+    return os.nice(0)
+
+
+def test_a_background_pool_runs_below_its_caller_and_a_plain_one_beside_it():
+    caller = os.nice(0)
+    with fit_executor(2, background=True) as pool:
+        background = {pool.submit(_niceness).result(timeout=300) for _ in range(4)}
+    with fit_executor(2) as pool:
+        plain = {pool.submit(_niceness).result(timeout=300) for _ in range(4)}
+    assert background == {min(caller + BACKGROUND_NICENESS, 19)}
+    assert plain == {caller}

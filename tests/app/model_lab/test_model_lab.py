@@ -245,7 +245,7 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
             super().shutdown(wait=wait)
 
     @contextlib.contextmanager
-    def one_process_pool(workers=None):     # same Executor interface as the process pool
+    def one_process_pool(workers=None, *, background=False):    # fit_executor's signature, a thread's pool
         with OneThreadPool(max_workers=1) as pool:
             yield pool
     monkeypatch.setattr(analysis.diagnosis.candidates, "_refit", slow_refit)
