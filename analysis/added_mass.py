@@ -72,7 +72,7 @@ class MassCurve:
         return self.label or ("free air" if self.added_mass_kg == 0 else f"+{self.added_mass_kg * 1e3:g} g")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AddedMassResult:
     method: str
     parameters: dict[str, ParameterValue]
@@ -156,7 +156,8 @@ def single_added_mass(free: TransferFunction, loaded: TransferFunction, mass_kg:
     params = {name: _pv(name, out[name]) for name in REPORTED if name in out}
     note = (f"fs {_nominal(fs):.4g} Hz free, {_nominal(fs1):.4g} Hz with {mass_kg * 1e3:g} g; the uncertainties "
             "come from the two fits' residual scatter")
-    return AddedMassResult("single added mass (classical)", params, (mass_kg,), None, (note,))
+    return AddedMassResult(method="single added mass (classical)", parameters=params, masses_kg=(mass_kg,),
+                           notes=(note,))
 
 
 def _nominal(x) -> float:
@@ -206,8 +207,8 @@ def joint_added_mass(curves: Sequence[MassCurve], effects: Sequence[Effect] | st
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     table = parameter_table(fit, sd_m2)
     notes.append(UNCERTAINTY_NOTE)
-    return AddedMassResult(f"joint fit of {len(curves)} curves", table, tuple(m for m in masses if m), fit,
-                           tuple(notes))
+    return AddedMassResult(method=f"joint fit of {len(curves)} curves", parameters=table,
+                           masses_kg=tuple(m for m in masses if m), fit=fit, notes=tuple(notes))
 
 
 def _joint_start(model: Model, effects, data, masses) -> dict[str, float]:
@@ -282,8 +283,8 @@ def model_free_dual_mass(free: TransferFunction, first: TransferFunction, m1_kg:
     params = {name: _pv(name, out[name]) for name in REPORTED if name in out}
     notes = (f"fs {fs:.4g} Hz from the peak of the model-free motional impedance; Bl averaged over "
              f"{band.sum()} lines in 0.8..1.2 fs (standard error of the mean); LOG creep beta {beta:.3g}",)
-    return AddedMassResult("model-free dual added mass (Candy-Futtrup, Speakerbench)", params,
-                           (m1_kg, m2_kg), None, notes)
+    return AddedMassResult(method="model-free dual added mass (Candy-Futtrup, Speakerbench)", parameters=params,
+                           masses_kg=(m1_kg, m2_kg), notes=notes)
 
 
 def _log_model_lsq(beta: float, y: np.ndarray, w: np.ndarray, with_covariance: bool = False):
