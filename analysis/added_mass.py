@@ -47,6 +47,7 @@ from analysis.model.composed import BASE_PARAMS, BL_PARAM, Model, ModelError
 from analysis.model.defaults import ADDED_MASS_EFFECTS
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
+from analysis.validity.result import UNKNOWN
 
 # Agreement of an added-mass result with the laser's, per parameter: green
 # when within AGREE_SIGMA combined sigmas or AGREE_PERCENT, red when beyond
@@ -83,6 +84,38 @@ class AddedMassResult:
     def value(self, name: str) -> float | None:
         p = self.parameters.get(name)
         return None if p is None else p.value
+
+    def report(self) -> str:
+        """The method, the reported parameters with their 1-sigma, the model and its reduced chi^2, the notes."""
+        from analysis.result_text import format_value
+        lines = [f"{self.method}", f"{'parameter':<10}{'value':>14}  {'1-sigma':>10}  unit"]
+        for name in REPORTED:
+            p = self.parameters.get(name)
+            if p is None or p.value is None:
+                continue
+            value, std = format_value(p)
+            lines.append(f"{name:<10}{value:>14}  {std:>10}  {p.display_unit}")
+        if self.fit is not None:
+            chi = ", ".join(f"{k} {v:.3g}" for k, v in self.fit.chi2_red_by_channel().items())
+            lines.append(f"model: {self.fit.model.describe()}   reduced chi^2: {chi}")
+        lines += [f"  {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def as_json(self) -> dict:
+        return added_mass_json(self)
+
+
+# Imported curves carry no per-line noise: the added-mass fits' validity is not checked, only said so.
+NOT_CHECKED = "imported curves: no per-line noise, no validity checks"
+
+
+def added_mass_document(primary: AddedMassResult, checks: Sequence[AddedMassResult], imports: Sequence[str]) -> dict:
+    """What `linpar addedmass --json` prints: the joint fit, its validity (unknown: NOT_CHECKED, and how each
+    curve was read, `imports`), then the cross-checks' own results."""
+    doc = primary.as_json()
+    doc["validity"] = {"overall": UNKNOWN, "note": NOT_CHECKED, "import": list(imports)}
+    doc["cross_checks"] = [check.as_json() for check in checks]
+    return doc
 
 
 def _units(name: str) -> tuple[str, str, float]:
