@@ -47,6 +47,7 @@ from analysis.model.composed import BASE_PARAMS, BL_PARAM, Model, ModelError
 from analysis.model.defaults import ADDED_MASS_EFFECTS
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
+from analysis.validity.result import UNKNOWN
 
 # Agreement of an added-mass result with the laser's, per parameter: green
 # when within AGREE_SIGMA combined sigmas or AGREE_PERCENT, red when beyond
@@ -72,7 +73,7 @@ class MassCurve:
         return self.label or ("free air" if self.added_mass_kg == 0 else f"+{self.added_mass_kg * 1e3:g} g")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class AddedMassResult:
     method: str
     parameters: dict[str, ParameterValue]
@@ -83,6 +84,38 @@ class AddedMassResult:
     def value(self, name: str) -> float | None:
         p = self.parameters.get(name)
         return None if p is None else p.value
+
+    def report(self) -> str:
+        """The method, the reported parameters with their 1-sigma, the model and its reduced chi^2, the notes."""
+        from analysis.result_text import format_value
+        lines = [f"{self.method}", f"{'parameter':<10}{'value':>14}  {'1-sigma':>10}  unit"]
+        for name in REPORTED:
+            p = self.parameters.get(name)
+            if p is None or p.value is None:
+                continue
+            value, std = format_value(p)
+            lines.append(f"{name:<10}{value:>14}  {std:>10}  {p.display_unit}")
+        if self.fit is not None:
+            chi = ", ".join(f"{k} {v:.3g}" for k, v in self.fit.chi2_red_by_channel().items())
+            lines.append(f"model: {self.fit.model.describe()}   reduced chi^2: {chi}")
+        lines += [f"  {n}" for n in self.notes]
+        return "\n".join(lines)
+
+    def as_json(self) -> dict:
+        return added_mass_json(self)
+
+
+# Imported curves carry no per-line noise: the added-mass fits' validity is not checked, only said so.
+NOT_CHECKED = "imported curves: no per-line noise, no validity checks"
+
+
+def added_mass_document(primary: AddedMassResult, checks: Sequence[AddedMassResult], imports: Sequence[str]) -> dict:
+    """What `linpar addedmass --json` prints: the joint fit, its validity (unknown: NOT_CHECKED, and how each
+    curve was read, `imports`), then the cross-checks' own results."""
+    doc = primary.as_json()
+    doc["validity"] = {"overall": UNKNOWN, "note": NOT_CHECKED, "import": list(imports)}
+    doc["cross_checks"] = [check.as_json() for check in checks]
+    return doc
 
 
 def _units(name: str) -> tuple[str, str, float]:
@@ -156,7 +189,8 @@ def single_added_mass(free: TransferFunction, loaded: TransferFunction, mass_kg:
     params = {name: _pv(name, out[name]) for name in REPORTED if name in out}
     note = (f"fs {_nominal(fs):.4g} Hz free, {_nominal(fs1):.4g} Hz with {mass_kg * 1e3:g} g; the uncertainties "
             "come from the two fits' residual scatter")
-    return AddedMassResult("single added mass (classical)", params, (mass_kg,), None, (note,))
+    return AddedMassResult(method="single added mass (classical)", parameters=params, masses_kg=(mass_kg,),
+                           notes=(note,))
 
 
 def _nominal(x) -> float:
@@ -206,8 +240,8 @@ def joint_added_mass(curves: Sequence[MassCurve], effects: Sequence[Effect] | st
         notes.append("on a bound, held for the uncertainties: " + ", ".join(held))
     table = parameter_table(fit, sd_m2)
     notes.append(UNCERTAINTY_NOTE)
-    return AddedMassResult(f"joint fit of {len(curves)} curves", table, tuple(m for m in masses if m), fit,
-                           tuple(notes))
+    return AddedMassResult(method=f"joint fit of {len(curves)} curves", parameters=table,
+                           masses_kg=tuple(m for m in masses if m), fit=fit, notes=tuple(notes))
 
 
 def _joint_start(model: Model, effects, data, masses) -> dict[str, float]:
@@ -282,8 +316,8 @@ def model_free_dual_mass(free: TransferFunction, first: TransferFunction, m1_kg:
     params = {name: _pv(name, out[name]) for name in REPORTED if name in out}
     notes = (f"fs {fs:.4g} Hz from the peak of the model-free motional impedance; Bl averaged over "
              f"{band.sum()} lines in 0.8..1.2 fs (standard error of the mean); LOG creep beta {beta:.3g}",)
-    return AddedMassResult("model-free dual added mass (Candy-Futtrup, Speakerbench)", params,
-                           (m1_kg, m2_kg), None, notes)
+    return AddedMassResult(method="model-free dual added mass (Candy-Futtrup, Speakerbench)", parameters=params,
+                           masses_kg=(m1_kg, m2_kg), notes=notes)
 
 
 def _log_model_lsq(beta: float, y: np.ndarray, w: np.ndarray, with_covariance: bool = False):

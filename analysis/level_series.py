@@ -19,7 +19,7 @@ parameters did.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Mapping, Sequence
@@ -52,7 +52,7 @@ class Drift:
         return {"percent": self.percent, "std": self.std}
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Level:
     """One measurement of the series."""
 
@@ -176,8 +176,8 @@ def _level(result: AnalysisResult, index: int) -> Level:
                                f"excursion, which needs the laser")
     parameters = {n: result.parameters[n] for n in TABLE_PARAMETERS if n in result.parameters}
     reasons = small_signal_reasons(result.validity)
-    return Level(name, drive_rms(result), float(peak), parameters, str(result.validity.overall),
-                 not reasons, reasons)
+    return Level(source=name, drive_rms_v=drive_rms(result), peak_displacement_m=float(peak), parameters=parameters,
+                 validity=str(result.validity.overall), small_signal=not reasons, reasons=reasons)
 
 
 def _with_drift(level: Level, reference: Level) -> Level:
@@ -191,8 +191,7 @@ def _with_drift(level: Level, reference: Level) -> Level:
         if level is not reference and p.std is not None and p0.std is not None and p.value != 0:
             std = 100.0 * abs(ratio) * math.hypot(p.std / p.value, p0.std / p0.value)
         drift[name] = Drift(100.0 * (ratio - 1.0), 0.0 if level is reference else std)
-    return Level(level.source, level.drive_rms_v, level.peak_displacement_m, level.parameters, level.validity,
-                 level.small_signal, level.reasons, drift)
+    return replace(level, drift=drift)
 
 
 # --- text ----------------------------------------------------------------------------------------

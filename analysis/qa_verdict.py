@@ -20,7 +20,7 @@ from analysis.validity.findings import Severity
 from analysis.validity.result import ResultValidity
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class QAJudgement:
     verdict: str                        # pass | fail | uncertain | invalid | not judged
     why: str
@@ -70,7 +70,8 @@ def judge(limits, parameters: Mapping, validity: ResultValidity | str) -> QAJudg
     errors = dict(validity.fit_error_percent or {})
     blocker = qa_blocker(validity, limits.fit_error_percent)
     if blocker is not None:
-        return QAJudgement(blocker[0], blocker[1], verdicts, False, errors)
+        return QAJudgement(verdict=blocker[0], why=blocker[1], verdicts=verdicts, judged=False,
+                           fit_error_percent=errors)
     verdict = verdict_of(verdicts)
     if verdict == FAIL:
         failed = [v for v in verdicts if v.outcome == FAIL]
@@ -85,4 +86,4 @@ def judge(limits, parameters: Mapping, validity: ResultValidity | str) -> QAJudg
         why = f"all {len(verdicts)} parameters within their limits (value ± {INTERVAL_K:g} σ)"
         if validity.overall == Severity.YELLOW:
             why += "; the measurement is doubtful: read the yellow findings"
-    return QAJudgement(verdict, why, verdicts, True, errors)
+    return QAJudgement(verdict=verdict, why=why, verdicts=verdicts, judged=True, fit_error_percent=errors)

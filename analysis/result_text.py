@@ -71,12 +71,17 @@ def format_result(result) -> str:
 
 def format_curve_result(result) -> str:
     """An analysis.curves.fitting.CurveAnalysis said (not imported here: it imports this module): format_result's
-    text, then the band each curve was fitted over, the fit errors and the notes on the curves (how far to
-    trust numbers no validity check has judged)."""
+    text, then the band each curve was fitted over, the fit errors, the exporting tool's own fit beside linpar's
+    (when the result carries the tool's fitted curves: `references`) and the notes on the curves (how far to trust
+    numbers no validity check has judged)."""
     ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
     errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity.fit_error_percent.items())
     imported = result.validity.imported
     lines = [format_result(result), f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)",
              f"note: {imported.note}; {imported.uncertainties}"]
+    if result.references:
+        from analysis.curves.reference import compare_with_reference, comparison_words
+        beside = compare_with_reference(result.fit, result.references)
+        lines += [comparison_words(name, c) for name, c in beside.items()]
     lines += [f"  {note}" for note in result.notes]
     return "\n".join(lines)

@@ -72,14 +72,14 @@ NOT_ESTIMATED = "not estimated"     # misfit, but no alternative the data cannot
 ESTIMATING = "estimating"           # not a state of a result: what a page says while the refits run
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class Member:
     effects: tuple[str, ...]
     chi2: float
     values: dict[str, float]
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, kw_only=True)
 class ModelPart:
     """What the model part of a result's uncertainties came to (module doc): kept with the result, so that a
     change of Sd (derived parameters only) recomputes the parts from the same members without refitting."""
@@ -161,7 +161,7 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
     drop_degenerate: leave out a fit whose RE, CMES, LCES, RES or Bl ended on a bound, or whose blocked impedance
     is resistive at the lowest line (on magnitude-only curves leach's K*w^n, n small, can take RE's place:
     no driver is like that)."""
-    fits = [Member(fit.model.effect_ids, fit.chi2, dict(fit.values))]
+    fits = [Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(fit.values))]
     for model in alternative_models(fit.model):
         try:
             other = fit_with(fit.method, data, model, cancel=cancel)
@@ -172,7 +172,7 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
         if drop_degenerate and degenerate(other, data):
             continue
         if math.isfinite(other.chi2):
-            fits.append(Member(model.effect_ids, other.chi2, dict(other.values)))
+            fits.append(Member(effects=model.effect_ids, chi2=other.chi2, values=dict(other.values)))
     best = min(m.chi2 for m in fits)
     return [m for m in fits if m.chi2 <= INDISTINCT_FACTOR * best]
 
@@ -186,22 +186,22 @@ def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event |
     fit and the members, the reported fit first even when the data reject it (one alternative the data prefer
     is then enough)."""
     if describes_the_data(fit) and not always:
-        return ModelPart(NOT_NEEDED)
+        return ModelPart(state=NOT_NEEDED)
     started = time.perf_counter()
     drop = always if drop_degenerate is None else drop_degenerate
     indistinct = members(fit, data, cancel, drop_degenerate=drop) + _band_members(fit, other_bands, cancel)
     seconds = time.perf_counter() - started
     if ensemble:
-        reported = Member(fit.model.effect_ids, fit.chi2, dict(fit.values))
+        reported = Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(fit.values))
         others = [m for m in indistinct if m.effects != reported.effects]
         if not others:
-            return ModelPart(NOT_ESTIMATED, seconds=seconds)
-        return ModelPart(ESTIMATED, (reported, *others), seconds, ensemble=True)
+            return ModelPart(state=NOT_ESTIMATED, seconds=seconds)
+        return ModelPart(state=ESTIMATED, members=(reported, *others), seconds=seconds, ensemble=True)
     if len(indistinct) < 2:
         # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
         # the model part is not estimated, which is not the same as zero.
-        return ModelPart(NOT_ESTIMATED, seconds=seconds)
-    return ModelPart(ESTIMATED, tuple(indistinct), seconds)
+        return ModelPart(state=NOT_ESTIMATED, seconds=seconds)
+    return ModelPart(state=ESTIMATED, members=tuple(indistinct), seconds=seconds)
 
 
 def model_spread(fit: FitResult, data: FitData, sd_m2: float | None,
@@ -235,7 +235,7 @@ def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.
             if cancel is not None and cancel.is_set():
                 raise
             continue
-        out.append(Member(fit.model.effect_ids, fit.chi2, dict(other.values)))
+        out.append(Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(other.values)))
     return out
 
 

@@ -5,7 +5,6 @@ import argparse
 
 from analysis.bounds import ADDED_MASS_G
 from analysis.model.defaults import ADDED_MASS_EFFECTS
-from analysis.result_text import format_value
 from app.cli.curves import add_range_options, fit_range
 from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects
 from app.cli.output import print_json
@@ -56,31 +55,12 @@ def run(args: argparse.Namespace) -> int:
         checks.append(am.single_added_mass(curves[0].impedance, c.impedance, c.added_mass_kg, effects, args.sd,
                                            f_range))
     if args.json:
-        doc = am.added_mass_json(primary)
-        doc["validity"] = {"overall": "unknown", "note": "imported curves: no per-line noise, no validity checks",
-                           "import": notes}
-        doc["cross_checks"] = [am.added_mass_json(r) for r in checks]
-        print_json(doc)
+        print_json(am.added_mass_document(primary, checks, notes))
         return 0
     for result in [primary, *checks]:
-        print(_format_added_mass(result))
+        print(result.report())
         print()
     for note in notes:
         print(f"  {note}")
     return 0
 
-
-def _format_added_mass(result) -> str:
-    from analysis.added_mass import REPORTED
-    lines = [f"{result.method}", f"{'parameter':<10}{'value':>14}  {'1-sigma':>10}  unit"]
-    for name in REPORTED:
-        p = result.parameters.get(name)
-        if p is None or p.value is None:
-            continue
-        value, std = format_value(p)
-        lines.append(f"{name:<10}{value:>14}  {std:>10}  {p.display_unit}")
-    if result.fit is not None:
-        chi = ", ".join(f"{k} {v:.3g}" for k, v in result.fit.chi2_red_by_channel().items())
-        lines.append(f"model: {result.fit.model.describe()}   reduced chi^2: {chi}")
-    lines += [f"  {n}" for n in result.notes]
-    return "\n".join(lines)

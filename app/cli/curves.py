@@ -6,9 +6,9 @@ The analysis modules are imported inside the commands: building the parser
 from __future__ import annotations
 
 import argparse
+import dataclasses
 
 from analysis.bounds import FREQUENCY
-from analysis.result_text import format_result
 from app.cli.options import CliError, model_effects, number
 from app.cli.output import print_json
 
@@ -73,7 +73,7 @@ def load_curves(args: argparse.Namespace):
 
 def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.curves.fitting import curve_json, fit_curves
-    from analysis.curves.reference import compare_with_reference, comparison_words
+    from analysis.curves.reference import compare_with_reference
     from analysis.fit.model_uncertainty import model_uncertainty
     curves = load_curves(args)
     # No --model, no --method: fit_curves chooses (magnitude-only curves have their own defaults).
@@ -81,20 +81,15 @@ def analyze_curves(args: argparse.Namespace) -> int:
     fitted = fit_curves(curves.impedance, curves.displacement, effects, args.sd, curves.fit_range, curves.notes,
                         method=getattr(args, "method", None))
     result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)
-    beside = compare_with_reference(result.fit, curves.references)
+    # The files and the exporting tool's own fits go with the result, as the GUI's (app.jobs.curves): its report
+    # then says the tool's fit beside linpar's.
+    result = dataclasses.replace(result, files=curves.files, references=curves.references)
     if args.json:
         doc = curve_json(result)
+        beside = compare_with_reference(result.fit, curves.references)
         if beside:
             doc["reference_fit"] = beside
         print_json(doc)
         return 0
-    print(format_result(result))
-    ranges = ", ".join(f"{name} {lo:g}-{hi:g} Hz" for name, (lo, hi) in result.ranges.items())
-    errors = ", ".join(f"{k} {v:.2g} %" for k, v in result.validity.fit_error_percent.items())
-    print(f"fitted: {ranges}; fit error: {errors} (rms misfit of each curve)")
-    print(f"note: {result.validity.imported.note}; {result.validity.imported.uncertainties}")
-    for name, c in beside.items():
-        print(comparison_words(name, c))
-    for note in result.notes:
-        print(f"  {note}")
+    print(result.report())
     return 0

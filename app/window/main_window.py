@@ -243,7 +243,7 @@ class MainWindow(QMainWindow):
             # `then` gets the result as it was, so that the archive's store estimates the part itself.
             from analysis.fit.model_uncertainty import NOT_ESTIMATED, ModelPart, with_estimated
             why = "cancelled" if final is None else f"the refits failed: {final}"
-            part = ModelPart(NOT_ESTIMATED, why=why)
+            part = ModelPart(state=NOT_ESTIMATED, why=why)
             done = dataclasses.replace(outcome, result=with_estimated(outcome.result, part))
             self.results.show_model_part(done)
             self.wizard.model_part_arrived(done)

@@ -19,7 +19,7 @@ from typing import Callable
 
 import numpy as np
 
-from instruments.audio.captured import CLIP_LEVEL, CapturedSignals, CaptureStats
+from instruments.audio.captured import CLIP_LEVEL, CaptureEnd, CapturedSignals, CaptureStats
 from instruments.audio.errors import AudioError, CaptureCancelled
 from instruments.audio.interface import AudioInterface
 from instruments.audio.periods import PeriodCollector
@@ -66,7 +66,9 @@ def capture(audio: AudioInterface, excitation_waveform: np.ndarray, n_periods: i
         if failure is None:
             _fade_out(audio, fade / fs)
         audio.stop()
-    result = _result(audio, collector, excitation, "complete" if collector.done else (failure or "cancelled"))
+    ended_by = (CaptureEnd.COMPLETE if collector.done else CaptureEnd.CANCELLED if failure is None
+                else CaptureEnd.FAILED)
+    result = _result(audio, collector, excitation, ended_by, failure or "")
     if failure is not None:
         raise AudioError(f"{failure}; kept {result.n_periods} of {n_periods} periods", partial=result)
     if not collector.done:
@@ -104,7 +106,8 @@ def _fade_out(audio, fade_s: float) -> None:
         audio.read_blocks(0.02)   # keep the queue drained, so no block is dropped and counted
 
 
-def _result(audio, collector: PeriodCollector, excitation: LoopedExcitation, ended_by: str) -> CapturedSignals:
+def _result(audio, collector: PeriodCollector, excitation: LoopedExcitation, ended_by: CaptureEnd,
+            failure: str) -> CapturedSignals:
     cm, cal, fs = audio.channel_map, audio.calibration, audio.sample_rate
     raw = collector.data()
     signals: dict[str, np.ndarray] = {}
@@ -128,6 +131,7 @@ def _result(audio, collector: PeriodCollector, excitation: LoopedExcitation, end
         input_underflows=counters.input_underflows, output_underflows=counters.output_underflows,
         output_overflows=counters.output_overflows, restarts=collector.restarts,
         output_clipped_samples=excitation.clipped_per_period, output_peak_fs=excitation.requested_peak_fs,
-        clipped_inputs=tuple(clipped), full_scale_fraction=tuple(peaks), silent_channels=tuple(silent), device=audio.describe(), ended_by=ended_by)
-    return CapturedSignals(fs, collector.period, signals["voltage"], signals["current"],
-                           signals.get("displacement"), stats)
+        clipped_inputs=tuple(clipped), full_scale_fraction=tuple(peaks), silent_channels=tuple(silent),
+        device=audio.describe(), ended_by=ended_by, failure=failure)
+    return CapturedSignals(sample_rate=fs, period_samples=collector.period, voltage=signals["voltage"],
+                           current=signals["current"], displacement=signals.get("displacement"), stats=stats)

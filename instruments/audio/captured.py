@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from enum import StrEnum
 from typing import Any, Mapping
 
 import numpy as np
@@ -9,7 +10,15 @@ import numpy as np
 CLIP_LEVEL = 0.999   # |sample| at or above this (FS) counts as clipped
 
 
-@dataclass(frozen=True, slots=True)
+class CaptureEnd(StrEnum):
+    """How a capture ended (instruments.audio.capture_loop.capture)."""
+
+    COMPLETE = "complete"
+    CANCELLED = "cancelled"
+    FAILED = "failed"           # CaptureStats.failure says what went wrong
+
+
+@dataclass(frozen=True, slots=True, kw_only=True)
 class CaptureStats:
     """How a capture went. Counts are samples unless named otherwise."""
 
@@ -34,7 +43,8 @@ class CaptureStats:
     full_scale_fraction: tuple[tuple[str, float], ...]   # (signal, peak |sample| / FS) in kept periods
     silent_channels: tuple[str, ...]              # signals exactly zero in every kept sample
     device: str = ""
-    ended_by: str = "complete"
+    ended_by: CaptureEnd = CaptureEnd.COMPLETE
+    failure: str = ""             # FAILED: the AudioError's words (the device stopped, too many dropouts, ...)
 
     @property
     def xruns(self) -> int:
@@ -64,7 +74,11 @@ class CaptureStats:
         return out
 
     def as_dict(self) -> dict[str, Any]:
+        """Every count, for the sidecar's "audio_capture" object. Its "ended_by" is "complete", "cancelled" or,
+        for a failed capture, the failure's words (as the sidecars written before CaptureEnd say it)."""
         d = asdict(self)
+        failure = d.pop("failure")
+        d["ended_by"] = failure if self.ended_by is CaptureEnd.FAILED else str(self.ended_by)
         d["clipped_inputs"] = dict(self.clipped_inputs)
         d["full_scale_fraction"] = dict(self.full_scale_fraction)
         d["silent_channels"] = list(self.silent_channels)
@@ -83,7 +97,7 @@ class CaptureStats:
                 "dropouts": {signal: 0 for signal, _ in self.clipped_inputs}, "xruns": 0}
 
 
-@dataclass(frozen=True, slots=True, eq=False)
+@dataclass(frozen=True, slots=True, eq=False, kw_only=True)
 class CapturedSignals:
     """Whole periods in SI units: voltage (V), current (A), displacement (m) or None. Read-only."""
 

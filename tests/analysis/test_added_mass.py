@@ -106,7 +106,7 @@ def test_refusals():
 def _result(**values_and_stds) -> AddedMassResult:
     units = {"Bl": ("T*m", 1.0), "Mms": ("kg", 1e3), "Cms": ("m/N", 1e3)}
     params = {n: ParameterValue(n, v, s, units[n][0], units[n][0], units[n][1]) for n, (v, s) in values_and_stds.items()}
-    return AddedMassResult("test", params, (M1,))
+    return AddedMassResult(method="test", parameters=params, masses_kg=(M1,))
 
 
 @pytest.mark.parametrize("added, laser, severity", [
@@ -127,3 +127,10 @@ def test_agreement_with_the_laser_is_graded(added, laser, severity):
 def test_laser_values_may_be_plain_numbers_and_missing_ones_are_skipped():
     findings = compare_with_laser(_result(Bl=(7.0, 0.02), Mms=(15e-3, 1e-4)), {"Mms": (15.3e-3, 0.1e-3), "Bl": None})
     assert [f.parameter for f in findings] == ["Mms"] and findings[0].as_json()["severity"] == "green"
+
+
+def test_added_mass_result_is_built_by_keyword_only():
+    import dataclasses
+
+    from analysis.added_mass import AddedMassResult
+    assert all(field.kw_only for field in dataclasses.fields(AddedMassResult))

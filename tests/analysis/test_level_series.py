@@ -164,3 +164,10 @@ def test_simulated_levels_are_checked():
 def test_parameter_values_keep_their_units(series):
     p = series.levels[0].parameters["Cms"]
     assert isinstance(p, ParameterValue) and p.unit == "m/N" and p.display_unit == "mm/N"
+
+
+def test_level_is_built_by_keyword_only():
+    import dataclasses
+
+    from analysis.level_series import Level
+    assert all(field.kw_only for field in dataclasses.fields(Level))

@@ -91,3 +91,10 @@ def test_a_real_impedance_covers_the_advanced_fit_of_another_tool():
     assert abs(p["RE"].value - 5.7212) > 10 * p["RE"].std_noise
     for name, reference in (("RE", 5.7212), ("fs", 44.985)):
         assert abs(p[name].value - reference) <= 2 * p[name].std, name
+
+
+def test_model_part_is_built_by_keyword_only():
+    import dataclasses
+
+    from analysis.fit.model_uncertainty import ModelPart
+    assert all(field.kw_only for field in dataclasses.fields(ModelPart))

@@ -37,3 +37,13 @@ def test_the_eight_parameters_within_5_percent_and_their_std_covers_the_truth(an
         assert p["std"] < 0.1 * abs(p["value"]), key                 # and not so wide that it says nothing
     # The export's own fitted curves (LPM's "Fitted" columns) beside linpar's.
     assert set(doc["reference_fit"]) == {"impedance", "displacement"}
+
+
+def test_the_text_says_the_exports_own_fit_beside_linpars_before_the_notes(tmp_path, capsys):
+    z, hx = write_exports(tmp_path, "woofer")
+    assert main(["analyze", "--impedance", str(z), "--hx", str(hx)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    note = next(i for i, line in enumerate(lines) if line.startswith("note: "))
+    said = [line.split(",")[0] for line in lines[note + 1:note + 3]]
+    assert said == ["the export's own fit of impedance", "the export's own fit of displacement"]
+    assert lines[note + 3].startswith("  ")          # then the notes on the curves
