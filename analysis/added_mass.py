@@ -130,8 +130,9 @@ def _pv(name: str, x) -> ParameterValue:
     unit, display, scale = _units(name)
     if hasattr(x, "nominal_value"):
         std = float(x.std_dev)
-        return ParameterValue(name, float(x.nominal_value), std if np.isfinite(std) else None, unit, display, scale)
-    return ParameterValue(name, float(x), None, unit, display, scale)
+        return ParameterValue(name=name, value=float(x.nominal_value), std=std if np.isfinite(std) else None,
+                              unit=unit, display_unit=display, display_scale=scale)
+    return ParameterValue(name=name, value=float(x), std=None, unit=unit, display_unit=display, display_scale=scale)
 
 
 def _effects(effects: Sequence[Effect] | str | None) -> tuple[Effect, ...]:

@@ -33,7 +33,7 @@ NO_DISPLACEMENT = ("not identifiable without displacement: Bl only appears in Hx
 NO_SD = "needs Sd: give the effective radiating area (--sd, or the driver's diaphragm diameter)"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ParameterValue:
     name: str
     value: float | None
@@ -137,42 +137,52 @@ def parameter_table(fit: FitResult, sd_m2: float | None,
     """
     table: dict[str, ParameterValue] = {}
     for spec in fit.model.param_specs:
-        table[spec.name] = ParameterValue(spec.name, fit.values[spec.name], fit.stderr.get(spec.name),
-                                          spec.unit, spec.display_unit, spec.display_scale, fitted=True)
+        table[spec.name] = ParameterValue(name=spec.name, value=fit.values[spec.name], std=fit.stderr.get(spec.name),
+                                          unit=spec.unit, display_unit=spec.display_unit,
+                                          display_scale=spec.display_scale, fitted=True)
     has_bl = fit.model.with_displacement
     if not has_bl:
-        table["Bl"] = ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, no_displacement)
+        table["Bl"] = ParameterValue(name="Bl", value=None, std=None, unit="T*m", display_unit="T*m",
+                                     display_scale=1.0, reason=no_displacement)
     p = _correlated(fit)
     for d in DERIVED:
         if d.needs_bl and not has_bl:
-            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
-                                           no_displacement)
+            table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
+                                           display_unit=d.display_unit, display_scale=d.display_scale,
+                                           reason=no_displacement)
             continue
         if d.needs_sd and not sd_m2:
-            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale, NO_SD)
+            table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
+                                           display_unit=d.display_unit, display_scale=d.display_scale, reason=NO_SD)
             continue
         try:
             value, std = _split(d.formula(p, sd_m2))
         except (ValueError, ZeroDivisionError, OverflowError) as exc:     # math of extreme fitted values
-            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
-                                           f"cannot be computed from the fitted values ({exc})")
+            table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
+                                           display_unit=d.display_unit, display_scale=d.display_scale,
+                                           reason=f"cannot be computed from the fitted values ({exc})")
             continue
         if not math.isfinite(value):
-            table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale,
-                                           f"cannot be computed from the fitted values ({value})")
+            table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
+                                           display_unit=d.display_unit, display_scale=d.display_scale,
+                                           reason=f"cannot be computed from the fitted values ({value})")
             continue
-        table[d.name] = ParameterValue(d.name, value, std, d.unit, d.display_unit, d.display_scale)
+        table[d.name] = ParameterValue(name=d.name, value=value, std=std, unit=d.unit, display_unit=d.display_unit,
+                                       display_scale=d.display_scale)
     return table
 
 
 def unmeasured_table(model, reason: str) -> dict[str, ParameterValue]:
     """Every parameter of `model` (an analysis.model.composed.Model) and the derived ones, each "not measured: reason"."""
-    table = {spec.name: ParameterValue(spec.name, None, None, spec.unit, spec.display_unit, spec.display_scale,
-                                       reason)
+    table = {spec.name: ParameterValue(name=spec.name, value=None, std=None, unit=spec.unit,
+                                       display_unit=spec.display_unit, display_scale=spec.display_scale,
+                                       reason=reason)
              for spec in model.param_specs}
-    table.setdefault("Bl", ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, reason))
+    table.setdefault("Bl", ParameterValue(name="Bl", value=None, std=None, unit="T*m", display_unit="T*m",
+                                          display_scale=1.0, reason=reason))
     for d in DERIVED:
-        table[d.name] = ParameterValue(d.name, None, None, d.unit, d.display_unit, d.display_scale, reason)
+        table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit, display_unit=d.display_unit,
+                                       display_scale=d.display_scale, reason=reason)
     return table
 
 

@@ -253,12 +253,14 @@ class StoredResult:
             if scale is None:
                 raise ResultsFormatError(f"{where}display_scale: expected a finite number")
             reason = p.get("reason")
-            parameters[name] = ParameterValue(name, _number(p.get("value"), where + "value"),
-                                              _number(p.get("std"), where + "std"), _get(p, "unit", str, where),
-                                              _get(p, "display_unit", str, where), scale,
-                                              None if reason is None else str(reason), bool(p.get("fitted", False)),
-                                              _number(p.get("std_noise"), where + "std_noise"),
-                                              _number(p.get("std_model"), where + "std_model"))
+            parameters[name] = ParameterValue(name=name, value=_number(p.get("value"), where + "value"),
+                                              std=_number(p.get("std"), where + "std"),
+                                              unit=_get(p, "unit", str, where),
+                                              display_unit=_get(p, "display_unit", str, where), display_scale=scale,
+                                              reason=None if reason is None else str(reason),
+                                              fitted=bool(p.get("fitted", False)),
+                                              std_noise=_number(p.get("std_noise"), where + "std_noise"),
+                                              std_model=_number(p.get("std_model"), where + "std_model"))
         model = _get(doc, "model", dict, "")
         effects = tuple(str(e) for e in _get(model, "effects", list, "model."))
         values = {}

@@ -23,7 +23,8 @@ def split_parameters(parameters: Mapping[str, ParameterValue], sd_m2: float | No
     """(the Thiele-Small set in reading order with Sd among them, the model's internal quantities)."""
     named = dict(parameters)
     if sd_m2:
-        named["Sd"] = ParameterValue("Sd", sd_m2, None, "m^2", "cm²", 1e4, reason=SD_NOTE)
+        named["Sd"] = ParameterValue(name="Sd", value=sd_m2, std=None, unit="m^2", display_unit="cm²",
+                                     display_scale=1e4, reason=SD_NOTE)
     customer = [named[n] for n in THIELE_SMALL if n in named]
     internal = [p for n, p in named.items() if n not in THIELE_SMALL]
     return customer, internal

@@ -54,7 +54,8 @@ def ordered_rows(parameters: Mapping[str, ParameterValue], sd_m2: float | None =
     """Thiele-Small parameters first, then a section title (a str) and the model's internal quantities."""
     named = dict(parameters)
     if sd_m2:
-        named["Sd"] = ParameterValue("Sd", sd_m2, None, "m^2", "cm²", 1e4)
+        named["Sd"] = ParameterValue(name="Sd", value=sd_m2, std=None, unit="m^2", display_unit="cm²",
+                                     display_scale=1e4)
     rows: list = [named[n] for n in THIELE_SMALL if n in named]
     internal = [p for n, p in named.items() if n not in THIELE_SMALL]
     if internal:

@@ -105,7 +105,8 @@ def test_refusals():
 
 def _result(**values_and_stds) -> AddedMassResult:
     units = {"Bl": ("T*m", 1.0), "Mms": ("kg", 1e3), "Cms": ("m/N", 1e3)}
-    params = {n: ParameterValue(n, v, s, units[n][0], units[n][0], units[n][1]) for n, (v, s) in values_and_stds.items()}
+    params = {n: ParameterValue(name=n, value=v, std=s, unit=units[n][0], display_unit=units[n][0],
+                                display_scale=units[n][1]) for n, (v, s) in values_and_stds.items()}
     return AddedMassResult(method="test", parameters=params, masses_kg=(M1,))
 
 
@@ -117,8 +118,9 @@ def _result(**values_and_stds) -> AddedMassResult:
     ((7.00, None), (7.60, None), "red"),        # no sigma known: the percentages decide
 ])
 def test_agreement_with_the_laser_is_graded(added, laser, severity):
-    findings = compare_with_laser(_result(Bl=added), {"Bl": ParameterValue("Bl", laser[0], laser[1], "T*m",
-                                                                            "T*m", 1.0)})
+    findings = compare_with_laser(_result(Bl=added), {"Bl": ParameterValue(name="Bl", value=laser[0], std=laser[1],
+                                                                           unit="T*m", display_unit="T*m",
+                                                                           display_scale=1.0)})
     assert [f.code for f in findings] == ["added-mass-disagrees"]
     assert findings[0].severity == severity and findings[0].parameter == "Bl"
     assert "%" in findings[0].message

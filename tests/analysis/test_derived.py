@@ -1,8 +1,10 @@
 """Derived parameters: the paper's Table I, uncertainty propagation, what cannot be identified."""
+import dataclasses
+
 import numpy as np
 import pytest
 
-from analysis.derived import derived_from_values, parameter_table
+from analysis.derived import ParameterValue, derived_from_values, parameter_table
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData, fit_model
 from analysis.model.composed import Model
@@ -77,3 +79,10 @@ def test_sensitivity_matches_the_efficiency_formula():
     assert d["SPL_2.83V_1m"] - d["SPL_1W_1m"] == pytest.approx(10 * np.log10(2.83**2 / 3.02), abs=1e-9)
     # eta0 = 4 pi^2 fs^3 Vas / (c^3 Qes): the textbook form agrees
     assert d["eta0"] == pytest.approx(4 * np.pi**2 * d["fs"] ** 3 * d["Vas"] / (343.0**3 * d["Qes"]), rel=1e-9)
+
+
+def test_a_parameter_value_is_built_by_keyword_only():
+    """value, std and the display scale are all numbers: by position they are easy to swap unseen."""
+    assert all(field.kw_only for field in dataclasses.fields(ParameterValue))
+    with pytest.raises(TypeError):
+        ParameterValue("RE", 3.0, 0.01, "ohm", "ohm", 1.0)      # noqa: the positional form, refused

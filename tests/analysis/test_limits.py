@@ -20,8 +20,8 @@ def limits_doc(**parameters):
 
 def pv(name, value, unit, display_unit, scale, reason=None, rel_std=0.001):
     """A parameter measured to 0.1 % (1 sigma), well inside the tolerances below: its interval decides as its value."""
-    return ParameterValue(name, value, None if value is None else rel_std * abs(value), unit, display_unit, scale,
-                          reason)
+    return ParameterValue(name=name, value=value, std=None if value is None else rel_std * abs(value), unit=unit,
+                          display_unit=display_unit, display_scale=scale, reason=reason)
 
 
 PARAMS = {"RE": pv("RE", 3.02, "ohm", "ohm", 1.0), "fs": pv("fs", 70.5, "Hz", "Hz", 1.0),
@@ -121,7 +121,7 @@ def judged_re(tmp_path, value, std, validity="green", **extra):
     """The verdict of an RE of `value` +- `std` ohm against 3.0 ohm +- 5 % (2.85 .. 3.15)."""
     doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"})
     doc.update(extra)
-    params = {"RE": ParameterValue("RE", value, std, "ohm", "ohm", 1.0)}
+    params = {"RE": ParameterValue(name="RE", value=value, std=std, unit="ohm", display_unit="ohm", display_scale=1.0)}
     # A validity as a stored results document holds it (or its overall light alone).
     validity = validity if isinstance(validity, str) else ResultValidity.from_json(validity)
     return judge_result(load_limits(write(tmp_path, doc)), params, validity)
@@ -145,8 +145,10 @@ def test_a_parameter_is_judged_by_its_interval_pass_fail_or_uncertain_across_a_l
 
 def test_one_failing_parameter_fails_the_unit_whatever_the_others_uncertainty(tmp_path):
     doc = limits_doc(RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"}, fs={"min": 80, "unit": "Hz"})
-    params = {"RE": ParameterValue("RE", 3.14, 0.02, "ohm", "ohm", 1.0),      # straddles
-              "fs": ParameterValue("fs", 70.0, 0.5, "Hz", "Hz", 1.0)}          # wholly below 80
+    params = {"RE": ParameterValue(name="RE", value=3.14, std=0.02, unit="ohm", display_unit="ohm",      # straddles
+                                   display_scale=1.0),
+              "fs": ParameterValue(name="fs", value=70.0, std=0.5, unit="Hz", display_unit="Hz",         # below 80
+                                   display_scale=1.0)}
     judged = judge_result(load_limits(write(tmp_path, doc)), params, "green")
     assert judged["verdict"] == "fail" and "fs 10 Hz below min" in judged["why"] and "RE" not in judged["why"]
 

@@ -7,8 +7,9 @@ from analysis.repeatability import format_spread, repeatability
 
 
 def table(**values):
-    return {n: ParameterValue(n, v, None if v is None else 0.01 * abs(v), "kg" if n == "Mms" else "T*m",
-                              "g" if n == "Mms" else "T*m", 1e3 if n == "Mms" else 1.0)
+    return {n: ParameterValue(name=n, value=v, std=None if v is None else 0.01 * abs(v),
+                              unit="kg" if n == "Mms" else "T*m", display_unit="g" if n == "Mms" else "T*m",
+                              display_scale=1e3 if n == "Mms" else 1.0)
             for n, v in values.items()}
 
 

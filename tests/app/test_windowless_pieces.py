@@ -18,7 +18,8 @@ from app.results.curves import aligned_phase_deg
     (2.5, None, 1.0, ("2.5", "–")),
 ])
 def test_format_value_rounds_to_the_sigma(value, std, scale, expected):
-    assert format_value(ParameterValue("x", value, std, "u", "u", scale)) == expected
+    assert format_value(ParameterValue(name="x", value=value, std=std, unit="u", display_unit="u",
+                                       display_scale=scale)) == expected
 
 
 @pytest.mark.parametrize("value, std, expected", [
@@ -32,11 +33,13 @@ def test_format_value_rounds_to_the_sigma(value, std, scale, expected):
     (-9e-9, 1.9, ("0.0", "1.9")),
 ])
 def test_short_values_keep_what_the_sigma_supports_at_most_four_digits(value, std, expected):
-    assert short_value(ParameterValue("x", value, std, "u", "u", 1.0)) == expected
+    shown = ParameterValue(name="x", value=value, std=std, unit="u", display_unit="u", display_scale=1.0)
+    assert short_value(shown) == expected
 
 
 def test_missing_value_formats_empty():
-    assert format_value(ParameterValue("Bl", None, None, "T*m", "T*m", 1.0, "why")) == ("", "")
+    assert format_value(ParameterValue(name="Bl", value=None, std=None, unit="T*m", display_unit="T*m",
+                                       display_scale=1.0, reason="why")) == ("", "")
 
 
 @pytest.mark.parametrize("freq, text", [(10, "10"), (20, "20"), (50, "50"), (300, ""), (1000, "1k"),

@@ -64,7 +64,8 @@ parameter_tables = st.one_of(
 documents = st.fixed_dictionaries(
     {"format": st.sampled_from(["linpar-limits/1"] * 4 + ["linpar-limits/2", None]), "parameters": parameter_tables},
     optional={"name": anything})
-PARAMETERS = {name: ParameterValue(name, 1.0, 0.01, si, customary, scale) for name, (si, customary, scale)
+PARAMETERS = {name: ParameterValue(name=name, value=1.0, std=0.01, unit=si, display_unit=customary,
+                                   display_scale=scale) for name, (si, customary, scale)
               in UNITS.items()}
 
 

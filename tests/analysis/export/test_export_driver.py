@@ -76,7 +76,8 @@ def _marks(fields: dict[str, str]) -> dict[str, str]:
 
 def _known(values: dict[str, tuple[float, str]], sd_m2: float, model: dict[str, float]) -> StoredResult:
     """A result with chosen SI values and the textbook model (RE + s LE)."""
-    params = {n: ParameterValue(n, v, None, u, u, 1.0) for n, (v, u) in values.items()}
+    params = {n: ParameterValue(name=n, value=v, std=None, unit=u, display_unit=u, display_scale=1.0)
+              for n, (v, u) in values.items()}
     return StoredResult(parameters=params, effects=(), with_displacement=True, values=model, model_info={},
                         validity=ResultValidity(overall="ok"), sd_m2=sd_m2, settings={})
 

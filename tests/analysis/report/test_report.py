@@ -300,7 +300,7 @@ def test_customer_numbers_never_read_as_pythons_exponent():
     from analysis.derived import ParameterValue
     from analysis.report.content import _chi2_text
     from analysis.report.numbers import parameter_cells, readable_number
-    le = ParameterValue("LE", 0.11e-3, 0.11e-3, "H", "mH", 1e3)
+    le = ParameterValue(name="LE", value=0.11e-3, std=0.11e-3, unit="H", display_unit="mH", display_scale=1e3)
     assert parameter_cells(le)[3] == "100 %"
     assert readable_number(123.0) == "120" and readable_number(0.0025) == "0.0025"
     assert readable_number(2.75e8, 3) == "2.75 × 10⁸" and readable_number(4.2e-6) == "4.2 × 10⁻⁶"
