@@ -17,6 +17,7 @@ catalogue explained.
 """
 from __future__ import annotations
 
+import collections
 import dataclasses
 import threading
 from concurrent.futures import Executor
@@ -26,7 +27,7 @@ from typing import Callable
 
 from analysis.diagnosis import acceptance, jobs, noise_floor, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
-from analysis.diagnosis.sites import SiteResult, first_among_tied, localise, usable_sites
+from analysis.diagnosis.sites import SiteResult, first_among_tied, fit_site, localise, usable_sites
 from analysis.diagnosis.starts import best_starts, residual_context, same_compliance_at_fs, screen_calls
 from analysis.effects import Effect, available_effects
 from analysis.effects.base import Site
@@ -164,13 +165,15 @@ def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
 
 
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
-                    cancel: threading.Event | None = None, costs: dict[str, float] | None = None
-                    ) -> tuple[Candidate, ...]:
+                    cancel: threading.Event | None = None, costs: dict[str, float] | None = None,
+                    passing: Callable[[Site], None] | None = None) -> tuple[Candidate, ...]:
     """Every candidate refitted, warm-started from `current`, flagged and ranked by delta BIC (best first).
 
     Their assessment applies rules 1 and 2 of the acceptance rule; rule 3
     (the site's correction) is applied by the greedy path to those that pass.
     `costs`: what each effect's refit cost before (by effect id), to hand the costliest to the pool first.
+    `passing`: told the site of each single candidate that passes rules 1 and 2 as soon as it does (on the
+    pool, while other refits still run), so that rule 3's site fit can start behind them.
     """
     moves = candidate_models(current.model)
     ctx = residual_context(data, current)
@@ -204,22 +207,33 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     screened = best_starts(screen_owners, screen_handles)
     narrow_calls, narrow_owners = refit_calls(sorted(screened_moves), screened)
     narrow_handles = jobs.submit(narrow_calls, executor, cancel)
+    owned = sorted(zip(plain_owners + narrow_owners, plain_handles + narrow_handles), key=lambda pair: pair[0])
+    calls_left = collections.Counter(plain_owners + narrow_owners)
     outcomes: dict[int, tuple[FitResult | None, str | None]] = {}
-    for index, handle in sorted(zip(plain_owners + narrow_owners, plain_handles + narrow_handles),
-                                key=lambda pair: pair[0]):
+    judged: dict[int, Candidate] = {}
+    for call in jobs.as_ready([handle for _, handle in owned]):
+        index, handle = owned[call]
         fit, error = handle.outcome()
         kept = outcomes.get(index)
         if kept is None or kept[0] is None or (fit is not None and fit.chi2 < kept[0].chi2):
             outcomes[index] = (fit, error)
-    candidates = []
-    for index, (action, effect, replaces, _) in enumerate(moves):
-        fit, error = outcomes[index]
-        flags = acceptance.candidate_flags(current, fit, effect)
-        candidates.append(Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
-                                    delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
-                                    flags=flags, assessment=acceptance.assess(current, fit, effect, flags)))
+        calls_left[index] -= 1
+        if calls_left[index] == 0:
+            judged[index] = _judged(current, moves[index], *outcomes[index])
+            if passing is not None and judged[index].accepted:
+                passing(judged[index].effect.site)
+    candidates = [judged[index] for index in range(len(moves))]
     candidates += pairs.rank_pairs(data, current, candidates, _refit, jobs.run, executor, cancel, Candidate)
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
+
+
+def _judged(current: FitResult, move, fit: FitResult | None, error: str | None) -> Candidate:
+    """A single candidate, flagged and assessed by rules 1 and 2."""
+    action, effect, replaces, _ = move
+    flags = acceptance.candidate_flags(current, fit, effect)
+    return Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
+                     delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
+                     flags=flags, assessment=acceptance.assess(current, fit, effect, flags))
 
 
 class _SiteFits:
@@ -228,11 +242,27 @@ class _SiteFits:
     def __init__(self, data: FitData, fit: FitResult, executor: Executor | None):
         self.data, self.fit, self.executor = data, fit, executor
         self.done: dict[Site, SiteResult] = {}
+        self.started: dict[Site, object] = {}    # handed to the pool, not yet waited for
+
+    def start(self, site: Site) -> None:
+        """Hand `site`'s fit to the pool now (without a pool: nothing, need() fits it)."""
+        if self.executor is not None and site not in self.done and site not in self.started:
+            self.started[site] = self.executor.submit(fit_site, self.data, self.fit, site)
 
     def need(self, sites) -> None:
         wanted = tuple(s for s in dict.fromkeys(sites) if s not in self.done)
-        if wanted:
-            self.done.update((r.site, r) for r in localise(self.data, self.fit, self.executor, sites=wanted))
+        for site in wanted:
+            self.start(site)
+        for site in [s for s in self.started if s in wanted]:
+            self.done[site] = self.started.pop(site).result()
+        left = tuple(s for s in wanted if s not in self.done)
+        if left:
+            self.done.update((r.site, r) for r in localise(self.data, self.fit, self.executor, sites=left))
+
+    def collected(self) -> dict[Site, SiteResult]:
+        """Every site fitted, those started included."""
+        self.need(tuple(self.started))
+        return self.done
 
 
 def choose(current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
@@ -296,7 +326,7 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
                 break
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
-        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps))
+        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps), passing=sites.start)
         ranked, best = choose(current, ranked, sites)
         if best is None:    # the candidates rule 3 refused, tried with what acts on the channel they left
             refused = pairs.rank_pairs(data, current, ranked, _refit, jobs.run, executor, cancel, Candidate,
@@ -323,7 +353,7 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     if progress:
         progress("looking for the site of the misfit left")
     final = result.final
-    known = sites.done if final is sites.fit else None
+    known = sites.collected() if final is sites.fit else None
     located = localise(data, final, executor, known=known, cancel=cancel)
     taken = {site for step in result.steps if step.chosen is not None for site in _sites_of(step.chosen)}
     return dataclasses.replace(result, sites=first_among_tied(located, taken))

@@ -13,13 +13,15 @@ the same arguments, so the same numbers.
 """
 from __future__ import annotations
 
+import itertools
 import threading
 from concurrent.futures import Executor
-from typing import Callable, Sequence
+from typing import Callable, Iterator, Sequence
 
 from analysis.fit.least_squares import FitError, FitResult
 
 Outcome = tuple[FitResult | None, str | None]
+_TURNS = itertools.count()   # the order calls were handed to a pool in (next() on a count is atomic in CPython)
 # (function, its arguments, its estimated cost): only the order of the costs matters.
 Call = tuple[Callable, tuple, float]
 
@@ -48,13 +50,17 @@ class _Deferred:
 
 
 class _Submitted:
-    """A call handed to the pool."""
+    """A call handed to the pool, the `turn`-th handed over (by this process)."""
 
-    def __init__(self, future):
-        self.future = future
+    def __init__(self, future, turn: int):
+        self.future, self.turn = future, turn
 
     def outcome(self) -> Outcome:
         return outcome(self.future.result)
+
+    def ready(self) -> bool:
+        done = getattr(self.future, "done", None)
+        return done is not None and done()
 
 
 def submit(calls: Sequence[Call], executor: Executor | None, cancel: threading.Event | None) -> list:
@@ -65,8 +71,27 @@ def submit(calls: Sequence[Call], executor: Executor | None, cancel: threading.E
     handles: list = [None] * len(calls)
     for index in sorted(range(len(calls)), key=lambda i: -calls[i][2]):
         fn, args, _ = calls[index]
-        handles[index] = _Submitted(executor.submit(fn, *args))
+        handles[index] = _Submitted(executor.submit(fn, *args), next(_TURNS))
     return handles
+
+
+def as_ready(handles: Sequence) -> Iterator[int]:
+    """The indices of `handles` (of one or more hand-overs), each once, about as their outcomes come back.
+
+    On the pool: every handle already done, then the earliest handed over of the rest (the pool starts them
+    in that order) once it is done, and so on; the caller can act on an outcome while the pool works on the
+    others. Without a pool: in their order, each run when its index is taken (the calls of before, in their
+    order, so the same numbers).
+    """
+    if not all(isinstance(h, _Submitted) for h in handles):
+        yield from range(len(handles))
+        return
+    waiting = sorted(range(len(handles)), key=lambda i: handles[i].turn)
+    while waiting:
+        done = [i for i in waiting if handles[i].ready()] or waiting[:1]
+        for i in done:
+            waiting.remove(i)
+            yield i
 
 
 def run(calls, executor: Executor | None, cancel: threading.Event | None) -> list[Outcome]:

@@ -48,6 +48,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from analysis.diagnosis.chance import within_chance
+from analysis.diagnosis.site_algebra import effective_dof, h_std, linearised_start
 from analysis.diagnosis.site_correction import SiteCorrection, coefficient_names, misfit_spans, site_correction
 from analysis.effects.base import Site
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, channel_sigmas
@@ -193,7 +194,7 @@ class _SiteProblem:
 
     def residual(self, x: np.ndarray) -> np.ndarray:
         coef = x[self.k:]
-        # einsum, not BLAS (see _gram): a product this small costs BLAS's threads far more than the work.
+        # einsum, not BLAS (see site_algebra.gram): a product this small costs BLAS's threads far more than the work.
         pen = np.concatenate([np.einsum("ij,j->i", self.penalty, coef[: self.n_basis]),
                               np.einsum("ij,j->i", self.penalty, coef[self.n_basis:])])
         return np.concatenate([self._data_residual(self.predictions(self.values(x))), pen])
@@ -238,7 +239,7 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
         f_hi = float(np.clip(COMPLIANCE_TOP_OVER_FS * resonance_frequency(values), 2.0 * f_lo, f_hi))
     dense = misfit_spans(current, f_lo, f_hi)
     problem = _SiteProblem(data, current, site_correction(site, f_lo, f_hi, scale, dense))
-    x0 = np.zeros(problem.k + 2 * problem.n_basis)
+    x0 = linearised_start(problem)
     # MINPACK's Levenberg-Marquardt: its own QR, no threaded LAPACK call per step (on a busy machine
     # OpenBLAS threads made 'trf' 15x slower), and like the model's fits it starts from the current fit.
     result = least_squares(problem.residual, x0, jac=problem.jacobian, method="lm", x_scale="jac",
@@ -251,13 +252,13 @@ def fit_site(data: FitData, current: FitResult, site: Site) -> SiteResult:
             (np.abs(pred) - tf.value.real) / problem.sigmas[name]
         chi2_by_channel[name] = (float(np.sum(np.abs(r) ** 2)), (2 if tf.has_phase else 1) * len(tf.freqs))
     chi2 = sum(c for c, _ in chi2_by_channel.values())
-    edf = _effective_dof(result.jac, problem.k, problem.n_data)
+    edf = effective_dof(result.jac, problem.k, problem.n_data)
     n = problem.n_data
     k = problem.k + edf
     chi2_red = {name: c / max(m - k * m / n, 1.0) for name, (c, m) in chi2_by_channel.items()}
     freqs = np.geomspace(*_band(data), CORRECTION_POINTS)
     shown, unit, acts_as, scale = problem.correction.shown(freqs, p)
-    std = scale * _h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
+    std = scale * h_std(result.jac, problem, freqs, max(1.0, chi2 / max(n - k, 1.0)))
     score = edf * np.log(n) + sum(m * share for name, share, m in _log_shares_left(site, current, chi2_by_channel))
     return SiteResult(site, chi2, {name: c for name, (c, _) in chi2_by_channel.items()}, chi2_red,
                       chi2 - current.chi2 + edf * np.log(n), edf, freqs, shown, unit, acts_as, bool(result.status > 0),
@@ -284,51 +285,6 @@ def _log_shares_left(site: Site, current: FitResult, chi2_by_channel: dict[str, 
     if own is None or len(terms) < 2 or within_chance(*chi2_by_channel[other[0][1]]):
         return terms
     return [(name, max(share, other[0][0]) if name == own else share, m) for name, share, m in terms]
-
-
-def _h_std(jac: np.ndarray, problem: _SiteProblem, freqs: np.ndarray, birge: float) -> np.ndarray:
-    """Standard error of h (the larger of its real and imaginary part's) at `freqs`, the model's parameters held.
-
-    Held, because the question is whether the data see the correction at a
-    frequency at all; how it shares a smooth trend with Mms or Cms (which it
-    can imitate) is another matter, and would make every point look unseen.
-    """
-    k, m = problem.k, problem.n_basis
-    J = np.asarray(jac)[:, k:]
-    covariance = _inverse(_gram(J)) * birge
-    design = problem.correction.design(freqs)
-    var_re = np.einsum("ij,jk,ik->i", design, covariance[:m, :m], design)
-    var_im = np.einsum("ij,jk,ik->i", design, covariance[m:, m:], design)
-    return np.sqrt(np.maximum(np.maximum(var_re, var_im), 0.0))
-
-
-def _effective_dof(jac: np.ndarray, n_model: int, n_data: int) -> float:
-    """Trace of the correction's hat matrix: tr((J'J + P'P)^-1 J_d'J_d) over all parameters, less the model's own."""
-    J = np.asarray(jac)
-    seen = _gram(J[:n_data])
-    total = seen + _gram(J[n_data:])
-    try:
-        hat = np.linalg.solve(total, seen)
-    except np.linalg.LinAlgError:      # the model's own parameters degenerate: the least-squares answer
-        hat = np.linalg.lstsq(total, seen, rcond=None)[0]
-    return float(max(np.trace(hat) - n_model, 0.0))
-
-
-# The matrices here are a few dozen wide. OpenBLAS spreads a product or an SVD of that size over its threads,
-# which on a busy 2-core machine costs 10-50 times the work itself (J'J 6 ms of CPU against 0.07 ms on one
-# thread, pinv 45 ms against 0.8 ms; measured with another developer's load): numpy's own loops (einsum) and
-# LU solves stay on one thread.
-def _gram(J: np.ndarray) -> np.ndarray:
-    """J'J without BLAS's threads."""
-    return np.einsum("ij,ik->jk", J, J)
-
-
-def _inverse(A: np.ndarray) -> np.ndarray:
-    """The inverse of a symmetric matrix, its pseudo-inverse when singular."""
-    try:
-        return np.linalg.inv(A)
-    except np.linalg.LinAlgError:
-        return np.linalg.pinv(A)
 
 
 def tied_sites(sites: tuple[SiteResult, ...]) -> list[SiteResult]:

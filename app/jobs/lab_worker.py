@@ -151,6 +151,10 @@ class _PollingFuture:
             except concurrent.futures.TimeoutError:
                 self._owner.check()
 
+    def done(self) -> bool:
+        """Whether the result is back (analysis.diagnosis.jobs.as_ready takes those first)."""
+        return self._future.done()
+
 
 class _CancellableExecutor:
     def __init__(self, pool: concurrent.futures.Executor, cancel: threading.Event):

@@ -68,3 +68,55 @@ def test_a_failure_after_cancel_goes_on_up_instead_of_becoming_a_failed_candidat
 def test_run_gives_the_outcomes_in_order():
     assert jobs.run([(_named, ("x",)), (_named, ("fails",))], _RecordingExecutor(), None) == \
         [("X", None), (None, "no convergence")]
+
+
+class _HeldFuture:
+    """A future the test finishes by hand (done() says whether it has)."""
+
+    def __init__(self, name: str):
+        self.name, self.finished = name, False
+
+    def done(self) -> bool:
+        return self.finished
+
+    def result(self):
+        self.finished = True        # waiting for it: the test's pool ends it then
+        return self.name
+
+
+class _HeldExecutor:
+    def __init__(self):
+        self.futures: list[_HeldFuture] = []
+
+    def submit(self, fn, *args):
+        self.futures.append(_HeldFuture(args[0]))
+        return self.futures[-1]
+
+
+def test_as_ready_takes_what_is_done_first_then_waits_in_the_order_handed_over():
+    pool = _HeldExecutor()
+    handles = jobs.submit([(_named, ("a",), 1.0), (_named, ("b",), 3.0), (_named, ("c",), 2.0),
+                           (_named, ("d",), 0.0)], pool, None)
+    by_name = {f.name: f for f in pool.futures}
+    by_name["d"].finished = True
+    order = jobs.as_ready(handles)
+    assert next(order) == 3                  # d: done before anything was asked
+    assert next(order) == 1                  # then b, handed over first, waited for
+    by_name["a"].finished = True
+    assert next(order) == 0                  # a finished meanwhile: before c, handed over earlier
+    assert list(order) == [2]
+    assert [h.outcome() for h in handles] == [("a", None), ("b", None), ("c", None), ("d", None)]
+
+
+def test_as_ready_without_a_pool_runs_each_call_in_turn_in_order():
+    ran = []
+
+    def note(name):
+        ran.append(name)
+        return name
+
+    handles = jobs.submit([(note, ("a",), 1.0), (note, ("b",), 5.0)], None, None)
+    for index in jobs.as_ready(handles):
+        assert ran == ["a", "b"][:index]
+        handles[index].outcome()
+    assert ran == ["a", "b"]
