@@ -27,6 +27,14 @@ class _RecordingExecutor:
         return future
 
 
+def _noting(ran: list):
+    """A call that notes its argument in `ran` when it runs, and returns it."""
+    def note(name):
+        ran.append(name)
+        return name
+    return note
+
+
 def _named(name: str) -> str:
     if name == "fails":
         raise FitError("no convergence")
@@ -45,11 +53,7 @@ def test_the_costliest_call_is_handed_over_first_and_outcomes_come_back_in_order
 
 def test_without_a_pool_each_call_runs_once_when_its_outcome_is_asked_for():
     ran = []
-
-    def note(name):
-        ran.append(name)
-        return name
-
+    note = _noting(ran)
     handles = jobs.submit([(note, ("a",), 1.0), (note, ("b",), 5.0)], None, None)
     assert ran == []
     assert handles[1].outcome() == ("b", None) and handles[1].outcome() == ("b", None)
@@ -110,11 +114,7 @@ def test_as_ready_takes_what_is_done_first_then_waits_in_the_order_handed_over()
 
 def test_as_ready_without_a_pool_runs_each_call_in_turn_in_order():
     ran = []
-
-    def note(name):
-        ran.append(name)
-        return name
-
+    note = _noting(ran)
     handles = jobs.submit([(note, ("a",), 1.0), (note, ("b",), 5.0)], None, None)
     for index in jobs.as_ready(handles):
         assert ran == ["a", "b"][:index]
