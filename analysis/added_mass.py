@@ -62,7 +62,7 @@ MODEL_FREE_BAND = (0.8, 1.2)     # x fs, Speakerbench's averaging band
 REPORTED = ("Bl", "Mms", "Cms", "Rms", "Vas", "fs", "Qms", "Qes", "Qts", "RE")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class MassCurve:
     impedance: TransferFunction
     added_mass_kg: float            # 0 for the free-air curve
@@ -269,7 +269,8 @@ def _fit_result(model, values, data, masses, labels, curve_impedance, result) ->
         n = len(parts) * len(tf.freqs)
         dof = max(n - k * n / n_total, 1.0)
         std = ASSUMED_RELATIVE_STD * np.abs(tf.value)
-        channels[label] = ChannelFit(label, tf.freqs, tf.value, z, std, chi2, n, chi2 / dof, tf.has_phase)
+        channels[label] = ChannelFit(name=label, freqs=tf.freqs, measured=tf.value, model=z, std=std, chi2=chi2,
+                                     n_points=n, chi2_red=chi2 / dof, has_phase=tf.has_phase)
     chi2 = sum(c.chi2 for c in channels.values())
     return FitResult(model=model, values=values, stderr={n: None for n in values}, varying=result.varying, covar=None,
                      channels=channels, chi2=chi2, n_data=n_total, success=bool(result.success),
@@ -358,7 +359,7 @@ def added_mass_json(result: AddedMassResult) -> dict:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Finding:
     code: str
     severity: str             # "green", "yellow" or "red"
@@ -406,5 +407,6 @@ def compare_with_laser(added_mass_result: AddedMassResult,
         how = f"{sigmas:.1f} combined sigmas" if sigmas is not None else "no uncertainty known"
         message = (f"{name}: added mass ({added_mass_result.method}) {a * scale:.4g} {display}, laser "
                    f"{b * scale:.4g} {display}: {percent:.1f} % apart, {how}")
-        findings.append(Finding("added-mass-disagrees", severity, name, message, sigmas, percent))
+        findings.append(Finding(code="added-mass-disagrees", severity=severity, parameter=name, message=message,
+                                sigmas=sigmas, percent=percent))
     return findings

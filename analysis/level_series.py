@@ -43,7 +43,7 @@ class LevelSeriesError(LinparError, ValueError):
     """Results that cannot make a level series (none, or one without displacement). One line."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class Drift:
     percent: float
     std: float | None          # percent
@@ -190,7 +190,7 @@ def _with_drift(level: Level, reference: Level) -> Level:
         std = None
         if level is not reference and p.std is not None and p0.std is not None and p.value != 0:
             std = 100.0 * abs(ratio) * math.hypot(p.std / p.value, p0.std / p0.value)
-        drift[name] = Drift(100.0 * (ratio - 1.0), 0.0 if level is reference else std)
+        drift[name] = Drift(percent=100.0 * (ratio - 1.0), std=0.0 if level is reference else std)
     return replace(level, drift=drift)
 
 

@@ -84,7 +84,7 @@ class CurveFitError(LinparError, ValueError):
     """The curves cannot be fitted as asked (e.g. too few lines in the chosen range)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class FitRange:
     """Frequency limits in Hz; None means no limit (hx_f_max None: HX_MAX_OVER_FS * fs)."""
 

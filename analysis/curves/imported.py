@@ -46,7 +46,8 @@ def import_curves(impedance: str | Path | None = None, *, hx: str | Path | None 
     if uiv is None and impedance is None:
         raise CurveFitError("Hx alone cannot be fitted: give the impedance curve too" if hx is not None else
                             "no curves: give an impedance curve (and an Hx curve), or uiv")
-    fit_range = FitRange(f_min, f_max, hx_f_max, None if all_lines else LINES_PER_DECADE)
+    fit_range = FitRange(f_min=f_min, f_max=f_max, hx_f_max=hx_f_max,
+                         per_decade=None if all_lines else LINES_PER_DECADE)
     if uiv is not None:
         read = read_uiv(uiv)
         return ImportedCurves(impedance=read.impedance, displacement=read.displacement, notes=(read.describe(),),

@@ -85,7 +85,7 @@ def _usable(tf: TransferFunction) -> TransferFunction:
     return tf.restricted(keep)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ChannelFit:
     name: str
     freqs: np.ndarray
@@ -358,16 +358,18 @@ def result_of(model: Model, values: dict[str, float], varying: tuple[str, ...], 
         parts = _channel_residual(model_values, tf, sigmas[name])
         chi2 = float(sum(np.sum(part**2) for part in parts))
         n_points = len(parts) * len(tf.freqs)
-        channels[name] = ChannelFit(name, tf.freqs, tf.value, model_values, sigmas[name] * np.sqrt(2.0),
-                                    chi2, n_points, 0.0, tf.has_phase)
+        channels[name] = ChannelFit(name=name, freqs=tf.freqs, measured=tf.value, model=model_values,
+                                    std=sigmas[name] * np.sqrt(2.0), chi2=chi2, n_points=n_points, chi2_red=0.0,
+                                    has_phase=tf.has_phase)
         n_total += n_points
     k = len(varying)
     chi2 = sum(ch.chi2 for ch in channels.values())
     # Parameters are shared out to channels by their share of the data.
     for name, ch in channels.items():
         dof = max(ch.n_points - k * ch.n_points / n_total, 1.0)
-        channels[name] = ChannelFit(ch.name, ch.freqs, ch.measured, ch.model, ch.std, ch.chi2, ch.n_points,
-                                    ch.chi2 / dof, ch.has_phase)
+        channels[name] = ChannelFit(name=ch.name, freqs=ch.freqs, measured=ch.measured, model=ch.model, std=ch.std,
+                                    chi2=ch.chi2, n_points=ch.n_points, chi2_red=ch.chi2 / dof,
+                                    has_phase=ch.has_phase)
     chi2_red = chi2 / max(n_total - k, 1)
     noise_known = all(data.channel(name).noise_known for name in channels)
     # Known noise: the Birge ratio, never below 1. Unknown noise: the residual's

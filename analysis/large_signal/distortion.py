@@ -33,7 +33,7 @@ SINE_PERIOD = 16384
 CHANNELS = ("current", "displacement")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class ChannelFit:
     channel: str
     time_rms_percent: float
@@ -125,9 +125,12 @@ def _channel_fit(name: str, periods: np.ndarray, simulated: np.ndarray, excited:
         band_m.append(_db((power - floor) / density) if power > 2.0 * floor else float("nan"))
         band_p.append(_db(np.mean(np.abs(model[members]) ** 2) / density))
         band_n.append(_db(np.mean(var[members]) / density))
-    return ChannelFit(name, time_rms, misfit, _db(measured / signal) if significant else float("nan"),
-                      _db(predicted / signal), _db(max(left, 0.0) / signal) if significant else float("nan"),
-                      explained, tuple(band_hz), tuple(band_m), tuple(band_p), tuple(band_n))
+    return ChannelFit(channel=name, time_rms_percent=time_rms, excited_misfit=misfit,
+                      measured_db=_db(measured / signal) if significant else float("nan"),
+                      predicted_db=_db(predicted / signal),
+                      unexplained_db=_db(max(left, 0.0) / signal) if significant else float("nan"),
+                      explained_percent=explained, bands_hz=tuple(band_hz), bands_measured_db=tuple(band_m),
+                      bands_predicted_db=tuple(band_p), bands_noise_db=tuple(band_n))
 
 
 def multitone_prediction(model: LargeSignalModel, data: RecordingData, level_rms_v: float) -> dict:

@@ -39,7 +39,7 @@ SETTING_LABELS = {
 }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Finding:
     channel: str
     severity: str
@@ -97,7 +97,8 @@ class ReportContent:
 def _lights(validity: ResultValidity) -> tuple[Light, ...]:
     lights = []
     for name, channel in validity.channels.items():
-        findings = tuple(Finding(name, str(f.severity), f.code, f.message, f.remedy) for f in channel.findings)
+        findings = tuple(Finding(channel=name, severity=str(f.severity), code=f.code, message=f.message,
+                                 remedy=f.remedy) for f in channel.findings)
         lights.append(Light(name, str(channel.status or "unknown"), findings))
     return tuple(lights)
 

@@ -26,7 +26,7 @@ def _mass_curves(args):
     from analysis.added_mass import MassCurve
     from analysis.importers import read_curve
     free = read_curve(args.free, "impedance", args.phase)
-    curves, notes = [MassCurve(free.transfer, 0.0)], [free.describe()]
+    curves, notes = [MassCurve(impedance=free.transfer, added_mass_kg=0.0)], [free.describe()]
     if len(args.mass) > 2:
         raise CliError("--mass: give one or two added masses")
     masses = [ADDED_MASS_G.parse(grams, f"--mass {grams} {path}") for grams, path in args.mass]
@@ -35,7 +35,7 @@ def _mass_curves(args):
     # Lightest first: the model-free dual-mass method takes them in that order, whatever the command line's.
     for grams, (_, path) in sorted(zip(masses, args.mass), key=lambda pair: pair[0]):
         curve = read_curve(path, "impedance", args.phase)
-        curves.append(MassCurve(curve.transfer, grams * 1e-3))
+        curves.append(MassCurve(impedance=curve.transfer, added_mass_kg=grams * 1e-3))
         notes.append(curve.describe())
     return curves, notes
 

@@ -47,7 +47,8 @@ def wants_curves(args: argparse.Namespace) -> bool:
 def fit_range(args, hx_f_max=None):
     """The range options of `linpar added-mass` (its curves are read by their own command)."""
     from analysis.curves.fitting import LINES_PER_DECADE, FitRange
-    return FitRange(args.fmin, args.fmax, hx_f_max, None if args.all_lines else LINES_PER_DECADE)
+    return FitRange(f_min=args.fmin, f_max=args.fmax, hx_f_max=hx_f_max,
+                    per_decade=None if args.all_lines else LINES_PER_DECADE)
 
 
 def load_curves(args: argparse.Namespace):

@@ -38,8 +38,9 @@ def impedance(effects, mass, freqs=FREQS, noise=0.0, seed=0):
 
 
 def curves(effects, masses=(M1, M2), noise=0.0):
-    return [MassCurve(impedance(effects, 0.0, noise=noise), 0.0)] + [
-        MassCurve(impedance(effects, m, noise=noise, seed=i + 1), m) for i, m in enumerate(masses)]
+    return [MassCurve(impedance=impedance(effects, 0.0, noise=noise), added_mass_kg=0.0)] + [
+        MassCurve(impedance=impedance(effects, m, noise=noise, seed=i + 1), added_mass_kg=m)
+        for i, m in enumerate(masses)]
 
 
 @pytest.mark.parametrize("masses", [(M1, M2), (M1,)])

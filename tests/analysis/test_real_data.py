@@ -34,7 +34,7 @@ def seas():
 
 @pytest.fixture(scope="module")
 def seas_joint(seas):
-    curves = [MassCurve(c.transfer, m) for c, m in zip(seas, (0.0, SEAS_M1, SEAS_M2))]
+    curves = [MassCurve(impedance=c.transfer, added_mass_kg=m) for c, m in zip(seas, (0.0, SEAS_M1, SEAS_M2))]
     return joint_added_mass(curves, None, SEAS_SD)
 
 
@@ -84,13 +84,14 @@ def test_seas_single_added_mass_is_further_off_than_the_dual(seas, seas_joint):
         bl_error = single.value("Bl") / SPEAKERBENCH_BL - 1
         assert -0.10 < mms_error < -0.03 and -0.05 < bl_error < -0.01, (mass, mms_error, bl_error)
         assert abs(mms_error) > 3 * dual_error
-        two_curves = joint_added_mass([MassCurve(seas[0].transfer, 0.0), MassCurve(loaded.transfer, mass)])
+        two_curves = joint_added_mass([MassCurve(impedance=seas[0].transfer, added_mass_kg=0.0),
+                                       MassCurve(impedance=loaded.transfer, added_mass_kg=mass)])
         assert two_curves.value("Bl") == pytest.approx(SPEAKERBENCH_BL, rel=0.015)
 
 
 def test_seas_plain_lr2_creep_log_misses_by_several_percent(seas):
     # Why added mass defaults to the semi-inductance: LR-2 lets the coil's losses leak into the motional branch.
-    curves = [MassCurve(c.transfer, m) for c, m in zip(seas, (0.0, SEAS_M1, SEAS_M2))]
+    curves = [MassCurve(impedance=c.transfer, added_mass_kg=m) for c, m in zip(seas, (0.0, SEAS_M1, SEAS_M2))]
     r = joint_added_mass(curves, "lr2,creep-log")
     assert abs(r.value("Bl") / SPEAKERBENCH_BL - 1) > 0.03
     r = joint_added_mass(curves, "lr2,creep-log", f_range=FitRange(f_max=2000.0))
@@ -104,7 +105,8 @@ def test_seas_added_mass_agrees_with_klippel_laser(seas_joint):
 
 def test_dayton_added_mass(dayton):
     free, loaded = (c.transfer for c in dayton)
-    joint = joint_added_mass([MassCurve(free, 0.0), MassCurve(loaded, DAYTON_M)], None, DAYTON_SD)
+    joint = joint_added_mass([MassCurve(impedance=free, added_mass_kg=0.0),
+                              MassCurve(impedance=loaded, added_mass_kg=DAYTON_M)], None, DAYTON_SD)
     single = single_added_mass(free, loaded, DAYTON_M, None, DAYTON_SD)
     for r in (joint, single):
         assert r.value("Mms") == pytest.approx(0.129, rel=0.10)       # the source's rough estimate

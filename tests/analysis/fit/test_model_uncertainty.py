@@ -21,7 +21,7 @@ from tests.builders import REAL_DATA, TYPICAL_NOISE, recording
 from tests.realistic_drivers import REALISTIC, realistic_recording
 
 LUMPED = ("RE", "Bl", "Mms", "Kms")
-AS_THE_CLI_DOES = FitRange(None, None, None, LINES_PER_DECADE)      # linpar analyze --uiv / --impedance
+AS_THE_CLI_DOES = FitRange(per_decade=LINES_PER_DECADE)      # linpar analyze --uiv / --impedance
 
 
 def z_score(p, truth):

@@ -20,7 +20,8 @@ def _channel(name: str, relative_error: np.ndarray, noise: float = 1e-3, seed: i
     measured = model * (1 + relative_error) + scatter
     chi2 = float(np.sum(np.abs((measured - model) / (std / np.sqrt(2))) ** 2))
     n = 2 * FREQS.size
-    return ChannelFit(name, FREQS, measured, model, std, chi2, n, chi2 / n)
+    return ChannelFit(name=name, freqs=FREQS, measured=measured, model=model, std=std, chi2=chi2, n_points=n,
+                      chi2_red=chi2 / n)
 
 
 def test_a_fit_at_the_noise_is_said_so():
@@ -39,8 +40,8 @@ def test_a_band_the_model_misses_is_named_with_its_size():
 
 def test_a_misfit_spread_everywhere_says_how_many_times_the_noise():
     ch = _channel("displacement", np.zeros(FREQS.size), seed=2)
-    spread = ChannelFit(ch.name, ch.freqs, ch.model + (ch.measured - ch.model) * 2.0, ch.model, ch.std,
-                        ch.chi2 * 4, ch.n_points, ch.chi2_red * 4)
+    spread = ChannelFit(name=ch.name, freqs=ch.freqs, measured=ch.model + (ch.measured - ch.model) * 2.0,
+                        model=ch.model, std=ch.std, chi2=ch.chi2 * 4, n_points=ch.n_points, chi2_red=ch.chi2_red * 4)
     assert channel_clause(spread).startswith("explains the displacement to within 2")
 
 

@@ -15,6 +15,7 @@ from analysis.recording.format import read_recording
 from app.cli import main
 from instruments.measurement.analysis_step import analyse_measurement
 from instruments.measurement.runner import default_effects
+from tests.rig_xruns import measure_until_no_xrun
 
 SHORT = ["--period", "16384", "--periods", "4"]
 
@@ -28,10 +29,10 @@ def archive_root(tmp_path_factory, monkeypatch):
 
 
 @pytest.mark.rig
-def test_measure_on_the_running_rig_writes_then_prints_what_analyze_prints(virtual_rig, tmp_path, capsys):
+def test_measure_on_the_running_rig_writes_then_prints_what_analyze_prints(virtual_rig, tmp_path):
     rig = ["--rig-name", virtual_rig.name, "--runtime-dir", str(virtual_rig.paths.directory.parent)]
-    code = main(["measure", "--out", str(tmp_path), "--name", "m", *rig, *SHORT, "--json"])
-    out, err = capsys.readouterr()
+    code, out, err, folder = measure_until_no_xrun(
+        lambda out_folder: ["measure", "--out", str(out_folder), "--name", "m", *rig, *SHORT, "--json"], tmp_path)
     assert code == 0, err
     printed = json.loads(out)
     assert set(printed) == {"parameters", "model", "validity", "archive"}
@@ -39,10 +40,10 @@ def test_measure_on_the_running_rig_writes_then_prints_what_analyze_prints(virtu
     assert f"stored in the archive {stored['root']} as {stored['id']}" in err
     assert printed["parameters"]["Bl"]["value"] == pytest.approx(5.23, rel=0.005)
     assert "delay-x" in printed["model"]["effects"]          # the serial laser's default
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.json", "m.laser.npz", "m.wav"]
-    assert f"wrote {tmp_path / 'm.wav'}" in err and "starting the virtual rig" not in err
+    assert sorted(p.name for p in folder.iterdir()) == ["m.json", "m.laser.npz", "m.wav"]
+    assert f"wrote {folder / 'm.wav'}" in err and "starting the virtual rig" not in err
     # What was printed is the analysis of what is on disk.
-    again = result_json(analyse_measurement(read_recording(tmp_path / "m"), effects=default_effects(True)))
+    again = result_json(analyse_measurement(read_recording(folder / "m"), effects=default_effects(True)))
     assert json.loads(json.dumps(again, default=lambda v: None)) == printed
     assert virtual_rig.command("ping")                        # the rig it did not start is still running
 
