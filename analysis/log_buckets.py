@@ -33,13 +33,15 @@ class LogBuckets:
     def power_mean_db(self, power: np.ndarray) -> np.ndarray:
         """10 log10 of the mean of each bucket's powers above nothing (last axis); NaN for a bucket without any
         (NaN powers, unknown, are left out too)."""
+        if power.size and power.min() > _NOTHING_POWER:
+            # The usual frame: every bin counts (a NaN makes the minimum NaN, so it takes the other path); the
+            # buckets' sizes are known, none is empty: no mask, no counts.
+            db = np.log10(np.add.reduceat(power, self.starts, axis=-1) / self._sizes)
+            db *= 10.0
+            return db
         shown = power > _NOTHING_POWER
-        if shown.all():                 # the usual frame: every bin counts, the buckets' sizes are known
-            sums = np.add.reduceat(power, self.starts, axis=-1)
-            counts = np.broadcast_to(self._sizes, sums.shape)
-        else:
-            sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
-            counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
+        sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
+        counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
         with np.errstate(invalid="ignore", divide="ignore"):
             db = 10.0 * np.log10(sums / counts)
         db[counts == 0] = np.nan

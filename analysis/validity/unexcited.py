@@ -79,16 +79,14 @@ def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.n
     if not judged or other_freqs.size == 0:
         return {}
     rows = [spectra.row(name) for name in judged]
-    residual = np.take(spectra.other_power, rows, axis=0)     # copies: the voltage's part comes off them
-    var = np.take(spectra.other_var, rows, axis=0)
-    if "voltage" in judged:
-        _remove_voltage(spectra, judged, residual, var, line_freqs, other_freqs)
+    residual, var = _residuals(spectra, judged, rows, line_freqs, other_freqs)
     r = np.add.reduceat(residual, bands, axis=-1)
     v = np.add.reduceat(var, bands, axis=-1)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(v > 0, r / v, np.where(r > 0, np.inf, 1.0))   # noise-free: 1 when empty, else inf
     worst = np.argmax(ratio, axis=-1)
-    excess = np.maximum(residual - var, 0.0).sum(axis=-1)
+    excess = np.subtract(residual, var)
+    excess = np.maximum(excess, 0.0, out=excess).sum(axis=-1)
     out = {}
     for i, name in enumerate(judged):
         band = int(worst[i])
@@ -102,19 +100,36 @@ def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.n
     return out
 
 
-def _remove_voltage(spectra: LineSpectra, judged: list[str], residual: np.ndarray, var: np.ndarray,
-                    line_freqs: np.ndarray, other_freqs: np.ndarray) -> None:
-    """R_k and V_k of the current and the displacement where the voltage carries (in place, rows of `judged`)."""
+def _residuals(spectra: LineSpectra, judged: list[str], rows: list[int], line_freqs: np.ndarray,
+               other_freqs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """|R_k|^2 and V_k of the channels `judged` (rows `rows`): the gathered powers and variances themselves when
+    nothing comes off them (the usual frame: no copy), else copies with the voltage's part removed."""
+    removed = _voltage_parts(spectra, judged, line_freqs, other_freqs) if "voltage" in judged else []
+    if not removed and rows == list(range(len(spectra.signals))):
+        return spectra.other_power, spectra.other_var
+    residual = np.take(spectra.other_power, rows, axis=0)
+    var = np.take(spectra.other_var, rows, axis=0)
+    for name, carries, residual_there, var_added in removed:
+        i = judged.index(name)
+        residual[i][carries] = residual_there
+        var[i][carries] += var_added
+    return residual, var
+
+
+def _voltage_parts(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarray,
+                   other_freqs: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
+    """For the current and the displacement among `judged`, where the voltage carries: the lines, |R_k|^2 there
+    and what the voltage's noise adds to V_k there (|H_k|^2 <var_U>_k). Empty where nothing carries."""
     voltage = spectra.row("voltage")
-    u = spectra.other[voltage]
     u_var = pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL)
     carries = spectra.other_power[voltage] > _VOLTAGE_CARRIES * u_var
     names = [name for name in judged if name != "voltage"]
     if not names or not carries.any():
-        return
+        return []
     u_lines = spectra.lines[voltage]
     h_all = _transfers(spectra, names, u_lines, line_freqs, other_freqs[carries])
-    u_carries, u_var_carries = u[carries], u_var[carries]
+    u_carries, u_var_carries = spectra.other[voltage][carries], u_var[carries]
+    parts = []
     for name in names:
         row = spectra.row(name)
         h = h_all.get(name)
@@ -125,17 +140,16 @@ def _remove_voltage(spectra: LineSpectra, judged: list[str], residual: np.ndarra
             if ok.sum() < 2:
                 continue
             h = interpolated_transfer(line_freqs[ok], h_lines[ok], other_freqs[carries])
-        i = judged.index(name)
         y = spectra.other[row][carries] - h * u_carries
-        residual[i][carries] = y.real**2 + y.imag**2
-        var[i][carries] += np.abs(h) ** 2 * u_var_carries
+        parts.append((name, carries, y.real**2 + y.imag**2, np.abs(h) ** 2 * u_var_carries))
+    return parts
 
 
 def _transfers(spectra: LineSpectra, names: list[str], u_lines: np.ndarray, line_freqs: np.ndarray,
                freqs: np.ndarray) -> dict[str, np.ndarray]:
     """H = Y/U of the channels `names` at `freqs`, from one spline of their columns (the same values as a
     spline each, at half the cost). Empty unless there are two of them, every one is finite at every excited
-    line and there are enough lines for a spline; _remove_voltage then interpolates each on its own."""
+    line and there are enough lines for a spline; _voltage_parts then interpolates each on its own."""
     if len(names) < 2 or line_freqs.size < 4:
         return {}
     with np.errstate(divide="ignore", invalid="ignore"):
