@@ -57,11 +57,12 @@ class LineSpectra:
     def gathered(cls, signals: tuple[str, ...], lines: np.ndarray, line_var: np.ndarray, other: np.ndarray,
                  other_var: np.ndarray) -> "LineSpectra":
         """The gathered arrays (owned: the variances are floored in place) with their floors applied."""
-        for row, strongest in enumerate(np.max(np.abs(lines), axis=-1, initial=0.0)):
-            floor = (ROUNDING * float(strongest)) ** 2
-            if not floor <= 0.0:        # a NaN line makes every variance NaN (np.maximum), as it always did
-                np.maximum(line_var[row], floor, out=line_var[row])
-                np.maximum(other_var[row], floor, out=other_var[row])
+        # One floor per channel, in one call for all: a zero floor (a silent channel) leaves its variances as
+        # they are, a NaN one (a NaN line) makes them NaN, as np.maximum always did here.
+        floor = np.array([[(ROUNDING * float(strongest)) ** 2]
+                          for strongest in np.max(np.abs(lines), axis=-1, initial=0.0)])
+        np.maximum(line_var, floor, out=line_var)
+        np.maximum(other_var, floor, out=other_var)
         other_power = np.square(other.real)
         other_power += np.square(other.imag)
         return cls(tuple(signals), lines, line_var, other, other_var, other_power)

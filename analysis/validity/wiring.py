@@ -41,11 +41,12 @@ def copy_findings(lines: Mapping[str, np.ndarray], silent: set[str], th: Validit
     """The channel-copy finding of each channel that copies another (at most one per channel), from each
     channel's coherent mean at the excited lines."""
     found: dict[str, Finding] = {}
+    power = {name: float(np.sum(np.abs(x) ** 2)) for name, x in lines.items()}    # each channel's once
     for reference, suspect in PAIRS:
         if suspect in found or reference not in lines or suspect not in lines or {reference, suspect} & silent:
             continue
         x, y = lines[reference], lines[suspect]
-        x_power, y_power = float(np.sum(np.abs(x) ** 2)), float(np.sum(np.abs(y) ** 2))
+        x_power, y_power = power[reference], power[suspect]
         if not (x_power > 0 and y_power > 0 and np.isfinite(x_power) and np.isfinite(y_power)):
             continue
         gain = complex(np.sum(np.conj(x) * y) / x_power)
