@@ -26,7 +26,7 @@ from analysis.spectra import ChannelSpectrum
 ROUNDING = 1e-12
 
 
-@dataclass(frozen=True, slots=True, eq=False)
+@dataclass(frozen=True, slots=True, eq=False, kw_only=True)
 class LineSpectra:
     signals: tuple[str, ...]
     lines: np.ndarray           # (channels, excited) complex: the coherent mean at the excited lines
@@ -65,7 +65,8 @@ class LineSpectra:
         np.maximum(other_var, floor, out=other_var)
         other_power = np.square(other.real)
         other_power += np.square(other.imag)
-        return cls(tuple(signals), lines, line_var, other, other_var, other_power)
+        return cls(signals=tuple(signals), lines=lines, line_var=line_var, other=other, other_var=other_var,
+                   other_power=other_power)
 
     def row(self, name: str) -> int:
         return self.signals.index(name)

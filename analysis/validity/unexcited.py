@@ -35,7 +35,7 @@ _VOLTAGE_CARRIES = 10.0
 _VOLTAGE_POOL = 33
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, kw_only=True)
 class UnexcitedMeasure:
     """One channel's worst band: D_b in dB, the excess over the noise re the excited lines, the band's ends."""
 
@@ -95,8 +95,8 @@ def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.n
         with np.errstate(divide="ignore"):
             re_signal = float(10.0 * np.log10(float(excess[i]) / signal_power)) if signal_power > 0 else float("inf")
         stop = bands[band + 1] if band + 1 < bands.size else other_freqs.size
-        out[name] = UnexcitedMeasure(float(10.0 * np.log10(ratio[i, band])), re_signal,
-                                     float(other_freqs[bands[band]]), float(other_freqs[stop - 1]))
+        out[name] = UnexcitedMeasure(distortion_db=float(10.0 * np.log10(ratio[i, band])), re_signal_db=re_signal,
+                                     lo_hz=float(other_freqs[bands[band]]), hi_hz=float(other_freqs[stop - 1]))
     return out
 
 
