@@ -4,7 +4,7 @@ A live panel about 1000 pixels wide cannot show the ~13,500 bins of a
 65,536-sample period; drawing them all cost ~100 ms a repaint. So the noise
 floor and the noise + distortion are reduced to a few hundred log-spaced
 buckets, each the power mean of its bins: what the validity check compares
-band by band (analysis.validity.spectral). Noise alone puts the two on top
+band by band (analysis.validity.unexcited). Noise alone puts the two on top
 of each other; one product 30 dB over the floor among ten bins still stands
 20 dB out. The grouping depends on the frequencies only, so it is worked out
 once per measurement and each frame costs one sum per bucket.
