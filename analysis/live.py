@@ -40,7 +40,9 @@ from analysis.recording.format import UNITS
 from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.findings import Finding, worst
-from analysis.validity.spectral import SIGNALS, distortion_bands, spectral_checks
+from analysis.validity.line_spectra import LineSpectra
+from analysis.validity.spectral import SIGNALS, line_checks
+from analysis.validity.unexcited import distortion_bands
 
 UNKNOWN = "unknown"
 DB_FLOOR = -400.0
@@ -91,9 +93,9 @@ class LiveAccumulator:
         self._excited = excited - self._lo
         self._unexcited = np.setdiff1d(span, excited, assume_unique=True) - self._lo
         bin_width = self.sample_rate / self.period_samples
-        self._bin_width = bin_width
         self._line_freqs = _frozen(excited * bin_width)
         other_freqs = (self._unexcited + self._lo) * bin_width
+        self._other_freqs = _frozen(other_freqs)
         self._bands = distortion_bands(other_freqs, thresholds.distortion_band_octaves,
                                        thresholds.distortion_min_bins)
         self._other_buckets = LogBuckets(other_freqs, display_buckets) if other_freqs.size else None
@@ -101,6 +103,9 @@ class LiveAccumulator:
         self._x_row = self.signals.index("displacement") if "displacement" in self.signals else None
         self._mean = np.zeros((len(self.signals), span.size), dtype=np.complex128)
         self._m2 = np.zeros((len(self.signals), span.size))
+        # Kept for Welford's update and the variance of the mean: no band-sized temporaries per period.
+        self._step = np.empty((2, len(self.signals), span.size))
+        self._var = np.empty((len(self.signals), span.size))
         self._x_mean = np.zeros(self.period_samples)
         self._data = np.empty((len(self.signals), self.period_samples))
         self._x_step = np.empty(self.period_samples)
@@ -137,7 +142,10 @@ class LiveAccumulator:
         self._n = n
         # In place, no temporaries of the band's size: X - mean_new = d (1 - 1/n), so M2 += |d|^2 (n-1)/n.
         delta -= self._mean
-        self._m2 += (delta.real**2 + delta.imag**2) * ((n - 1) / n)
+        power, imag_power = np.square(delta.real, out=self._step[0]), np.square(delta.imag, out=self._step[1])
+        power += imag_power
+        power *= (n - 1) / n
+        self._m2 += power
         delta *= 1.0 / n
         self._mean += delta
         return self._frame()
@@ -164,16 +172,19 @@ class LiveAccumulator:
         return self._data
 
     def _var_mean(self) -> np.ndarray:
+        """The variance of the mean, in the kept buffer (the next period overwrites it)."""
         if self._n < 2:
-            return np.full(self._m2.shape, np.nan)
-        return self._m2 / (self._n * (self._n - 1))
+            self._var.fill(np.nan)
+            return self._var
+        return np.divide(self._m2, self._n * (self._n - 1), out=self._var)
 
     def _frame(self) -> LiveFrame:
         var = self._var_mean()
-        power = self._mean.real**2 + self._mean.imag**2
-        line_db = _db_of_power(power[:, self._excited])
+        # The excited and unexcited lines gathered once, for the panels' arrays and every check.
+        lines = LineSpectra.of_band(self.signals, self._mean, var, self._excited, self._unexcited)
+        line_db = _db_of_power(np.square(lines.lines.real) + np.square(lines.lines.imag))
         if self._other_buckets is not None:
-            other_db = self._other_buckets.power_mean_db(power[:, self._unexcited])
+            other_db = self._other_buckets.power_mean_db(lines.other_power)
         else:
             other_db = np.zeros((len(self.signals), 0))
         if self._n >= 2:
@@ -182,10 +193,7 @@ class LiveAccumulator:
             noise_db = np.full((len(self.signals), self._noise_buckets.starts.size), np.nan)
         checks = {}
         if self._n >= 2:
-            spectra = {name: ChannelSpectrum(name, UNITS[name], self._mean[row], var[row])
-                       for row, name in enumerate(self.signals)}
-            checks = spectral_checks(spectra, self._excited, self._unexcited, self._bin_width, self.thresholds,
-                                     self._bands, first_bin=self._lo)
+            checks = line_checks(lines, self._line_freqs, self._other_freqs, self.thresholds, self._bands)
         channels = {}
         for row, name in enumerate(self.signals):
             findings, measures = checks.get(name, ([], {}))

@@ -4,7 +4,7 @@ A live panel about 1000 pixels wide cannot show the ~13,500 bins of a
 65,536-sample period; drawing them all cost ~100 ms a repaint. So the noise
 floor and the noise + distortion are reduced to a few hundred log-spaced
 buckets, each the power mean of its bins: what the validity check compares
-band by band (analysis.validity.spectral). Noise alone puts the two on top
+band by band (analysis.validity.unexcited). Noise alone puts the two on top
 of each other; one product 30 dB over the floor among ten bins still stands
 20 dB out. The grouping depends on the frequencies only, so it is worked out
 once per measurement and each frame costs one sum per bucket.
@@ -33,13 +33,15 @@ class LogBuckets:
     def power_mean_db(self, power: np.ndarray) -> np.ndarray:
         """10 log10 of the mean of each bucket's powers above nothing (last axis); NaN for a bucket without any
         (NaN powers, unknown, are left out too)."""
+        if power.size and power.min() > _NOTHING_POWER:
+            # The usual frame: every bin counts (a NaN makes the minimum NaN, so it takes the other path); the
+            # buckets' sizes are known, none is empty: no mask, no counts.
+            db = np.log10(np.add.reduceat(power, self.starts, axis=-1) / self._sizes)
+            db *= 10.0
+            return db
         shown = power > _NOTHING_POWER
-        if shown.all():                 # the usual frame: every bin counts, the buckets' sizes are known
-            sums = np.add.reduceat(power, self.starts, axis=-1)
-            counts = np.broadcast_to(self._sizes, sums.shape)
-        else:
-            sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
-            counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
+        sums = np.add.reduceat(np.where(shown, power, 0.0), self.starts, axis=-1)
+        counts = np.add.reduceat(shown.astype(np.int64), self.starts, axis=-1)
         with np.errstate(invalid="ignore", divide="ignore"):
             db = 10.0 * np.log10(sums / counts)
         db[counts == 0] = np.nan

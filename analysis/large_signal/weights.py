@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from analysis.spectra import pooling_window
-from analysis.validity.spectral import pooled_mean
+from analysis.validity.pooling import pooled_mean
 
 MISFIT_BANDS_PER_OCTAVE = 3.0
 MISFIT_SIGMAS = 4.0

@@ -24,7 +24,6 @@ from typing import Mapping
 
 import numpy as np
 
-from analysis.spectra import ChannelSpectrum
 from analysis.thresholds import ValidityThresholds
 from analysis.validity.findings import CHANNEL_COPY, Finding, Severity
 
@@ -38,15 +37,16 @@ _REMEDY = {
 }
 
 
-def copy_findings(channels: Mapping[str, ChannelSpectrum], excited: np.ndarray, silent: set[str],
-                  th: ValidityThresholds) -> dict[str, Finding]:
-    """The channel-copy finding of each channel that copies another (at most one per channel)."""
+def copy_findings(lines: Mapping[str, np.ndarray], silent: set[str], th: ValidityThresholds) -> dict[str, Finding]:
+    """The channel-copy finding of each channel that copies another (at most one per channel), from each
+    channel's coherent mean at the excited lines."""
     found: dict[str, Finding] = {}
+    power = {name: float(np.sum(np.abs(x) ** 2)) for name, x in lines.items()}    # each channel's once
     for reference, suspect in PAIRS:
-        if suspect in found or reference not in channels or suspect not in channels or {reference, suspect} & silent:
+        if suspect in found or reference not in lines or suspect not in lines or {reference, suspect} & silent:
             continue
-        x, y = channels[reference].mean[excited], channels[suspect].mean[excited]
-        x_power, y_power = float(np.sum(np.abs(x) ** 2)), float(np.sum(np.abs(y) ** 2))
+        x, y = lines[reference], lines[suspect]
+        x_power, y_power = power[reference], power[suspect]
         if not (x_power > 0 and y_power > 0 and np.isfinite(x_power) and np.isfinite(y_power)):
             continue
         gain = complex(np.sum(np.conj(x) * y) / x_power)

@@ -102,3 +102,33 @@ def test_rows_in_signal_order_and_reset():
         acc.add_period(np.zeros((2, 100)))
     with pytest.raises(ValueError, match="lacks"):
         acc.add_period({"voltage": np.zeros(MT.period_samples)})
+
+
+@pytest.mark.parametrize("fault, channel, code", [("amplifier_clipping", "voltage", "distortion-high"),
+                                                  ("nonlinear_range", "current", "distortion-high"),
+                                                  ("current_disconnected", "current", "no-signal")])
+def test_every_frame_judges_as_the_whole_recording_s_checks_on_the_same_spectra(fault, channel, code):
+    # A frame gathers its band's lines itself and runs the checks on all channels at once; the whole
+    # recording's path gathers them from each channel's spectrum. Same spectra, same findings and numbers.
+    from analysis.validity.spectral import spectral_checks
+    from analysis.thresholds import DEFAULT_THRESHOLDS
+    from instruments.simulation import faults
+    rec = getattr(faults, fault)()
+    excited = np.asarray(rec.excited_bins)
+    lo = int(excited[0])
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, excited)
+    band_excited = excited - lo
+    band_unexcited = np.setdiff1d(np.arange(excited[-1] - lo + 1), band_excited)
+    seen = set()
+    for p in range(rec.n_periods):
+        frame = acc.add_period(_periods(rec, p))
+        if p == 0:
+            continue
+        checks = spectral_checks(acc.channel_spectra(), band_excited, band_unexcited,
+                                 rec.sample_rate / rec.period_samples, DEFAULT_THRESHOLDS, first_bin=lo)
+        for name, live in frame.channels.items():
+            findings, measures = checks[name]
+            assert live.findings == tuple(findings), (p, name)
+            assert dict(live.measures) == measures, (p, name)
+            seen |= {(name, f.code) for f in live.findings}
+    assert (channel, code) in seen              # the fault is judged, not only two empty lists compared

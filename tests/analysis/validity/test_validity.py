@@ -172,7 +172,7 @@ def test_lines_without_any_noise_do_not_blind_the_laser_band_estimate():
 
 @pytest.mark.parametrize("n, window", [(1, 5), (2, 5), (3, 5), (4, 33), (40, 5), (40, 33), (200, 4)])
 def test_the_pooled_mean_is_each_centred_window_s_mean_even_around_huge_values(n, window):
-    from analysis.validity.spectral import pooled_mean
+    from analysis.validity.pooling import pooled_mean
     rng = np.random.default_rng(n)
     values = rng.uniform(1.0, 2.0, n)
     values[n // 2] = 1e30                    # a line far above the rest must not spoil the others
