@@ -6,9 +6,7 @@ draws: the parameter table, the dense model curves and the residual in words.
 """
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
-import threading
 from dataclasses import dataclass
 
 from analysis.derived import parameter_table
@@ -21,14 +19,11 @@ from analysis.effects import Effect
 from analysis.fit.error import band_text
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, fit_model
 from analysis.model.composed import Model
-from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
 from analysis.validity.fit import rejudged
+from app.jobs.background_pool import PoolCancelled, background_pool
 from app.jobs.book import Job, JobRunner
 from app.results.curves import ResultCurves, result_curves
-
-
-CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
 
 
 @dataclass(frozen=True, slots=True)
@@ -128,50 +123,6 @@ def diagnosis_outcome(base: AnalysisResult, result: Diagnosis, follow: bool) -> 
                             result.sites, result.step_cap_reached, verdict_headline(result))
 
 
-class DiagnosisCancelled(Exception):
-    """Deliberately not a FitError: rank_candidates records those as failed candidates and goes on."""
-
-
-class _PollingFuture:
-    """A pool future whose result() wakes up to look at the cancel flag.
-
-    rank_candidates waits on each refit with result() and no timeout, and an
-    Event cannot be sent to the worker processes: without this a cancelled
-    diagnosis would run every remaining refit to the end.
-    """
-
-    def __init__(self, future: concurrent.futures.Future, owner: "_CancellableExecutor"):
-        self._future = future
-        self._owner = owner
-
-    def result(self, timeout=None):
-        while True:
-            try:
-                return self._future.result(timeout=CANCEL_POLL_S)
-            except concurrent.futures.TimeoutError:
-                self._owner.check()
-
-    def done(self) -> bool:
-        """Whether the result is back (analysis.diagnosis.jobs.as_ready takes those first)."""
-        return self._future.done()
-
-
-class _CancellableExecutor:
-    def __init__(self, pool: concurrent.futures.Executor, cancel: threading.Event):
-        self._pool = pool
-        self._cancel = cancel
-
-    def check(self) -> None:
-        if self._cancel.is_set():
-            # Refits not yet started are dropped; the one or two running finish in well under a second.
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            raise DiagnosisCancelled("diagnosis cancelled")
-
-    def submit(self, fn, *args, **kwargs) -> _PollingFuture:
-        self.check()
-        return _PollingFuture(self._pool.submit(fn, *args, **kwargs), self)
-
-
 def _refit(job: Job, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabFit:
     job.say(f"fitting {model.describe()}")
     fit = fit_model(data, model, start=start, cancel=job.cancel_event)
@@ -188,8 +139,7 @@ def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, f
     (it still counts as the path's first step, for the verdict).
     """
     begin = taken.fitted.fit if taken is not None else start
-    with fit_executor(background=True) as pool:        # the window keeps the cores it needs
-        executor = None if pool is None else _CancellableExecutor(pool, job.cancel_event)
+    with background_pool(job.cancel_event) as executor:       # the window keeps the cores (and the GIL) it needs
         result = diagnose(data, begin.model, executor=executor, cancel=job.cancel_event, start_fit=begin,
                           progress=job.say, max_steps=MAX_STEPS, follow=follow)
     job.check()
@@ -203,7 +153,7 @@ def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, f
 
 
 class LabWorker(JobRunner):
-    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, DiagnosisCancelled)
+    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, PoolCancelled)
 
     def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> Job:
         start = dict(start)

@@ -16,6 +16,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 import analysis.diagnosis.candidates
+import app.jobs.background_pool
 import app.jobs.lab_worker
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
@@ -249,7 +250,7 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
         with OneThreadPool(max_workers=1) as pool:
             yield pool
     monkeypatch.setattr(analysis.diagnosis.candidates, "_refit", slow_refit)
-    monkeypatch.setattr(app.jobs.lab_worker, "fit_executor", one_process_pool)
+    monkeypatch.setattr(app.jobs.background_pool, "fit_executor", one_process_pool)
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: bool(calls), timeout=wait_ms(10))
     with qtbot.waitSignal(lab.job_cancelled, timeout=wait_ms(10)):
