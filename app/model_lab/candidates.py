@@ -12,7 +12,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLab
 
 from analysis.diagnosis import acceptance
 from analysis.diagnosis.words import VERDICT_TITLES
-from app.jobs.lab_worker import CandidateRow, DiagnosisOutcome
+from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome
 from app.model_lab.catalogue import category_title
 
 # The reduced chi^2 per channel is in the Fit cell's tooltip: the columns must fit a 1280 px screen.

@@ -21,6 +21,7 @@ import app.jobs.lab_worker
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit.least_squares import FitCancelled, FitError
+from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app.widgets import style
@@ -204,6 +205,31 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
     assert len(threads) == 2
     assert all(t is not threading.main_thread() for t in threads)
     assert threading.current_thread() is threading.main_thread()
+
+
+@pytest.mark.skipif(worker_count() < 2, reason="one core: no pool, the diagnosis runs in the job's thread")
+def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, lab, monkeypatch):
+    """Nothing of it holds the GIL in the GUI process but the hand-over (app.jobs.background_pool)."""
+    handed = []
+    real = app.jobs.lab_worker.background_pool
+
+    class Counting:
+        def __init__(self, executor):
+            self.executor = executor
+
+        def submit(self, fn, *args):
+            handed.append(fn.__name__)
+            return self.executor.submit(fn, *args)
+
+    @contextlib.contextmanager
+    def counting_pool(cancel):
+        with real(cancel) as executor:
+            yield Counting(executor)
+    monkeypatch.setattr(app.jobs.lab_worker, "background_pool", counting_pool)
+    outcome = _diagnose(qtbot, lab)
+    assert handed[-1] == "diagnosis_outcome" and handed.count("diagnosis_outcome") == 1
+    assert handed.count("_refit") >= len(analysis.diagnosis.candidates.candidate_models(lab.current.fitted.fit.model))
+    assert outcome.candidates and all(c.fitted is not None or c.error for c in outcome.candidates)
 
 
 def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
