@@ -16,7 +16,8 @@ to run (the GIL held by the GUI or the measurement).
 
 Then a diagnosis in the Model lab of a recording whose laser lags by 100 us
 (every candidate refitted in worker processes, the table filled at the end):
-the longest stall from the click until the candidates are shown. Last, how
+the longest stall from the click until the candidates are shown, then the same for a second diagnosis,
+whose table replaces the first's. Last, how
 long a click from the Measure page to the Results page or the Model lab
 holds the GUI thread until the page is painted.
 """
@@ -302,17 +303,23 @@ def _diagnosing(app, window, folder: Path) -> list[Row]:
     _wait(app, lambda: False, 0.5)          # the page's first paint is the tab switch's, not the diagnosis's
     done = []
     lab.diagnosis_shown.connect(done.append)
-    with StallMeter() as meter:
-        started = time.monotonic()
-        lab.candidates.diagnose_button.click()
-        ok = _wait(app, lambda: done)
-        took = time.monotonic() - started
-        _wait(app, lambda: False, 0.3)          # what the GUI does right after showing the table counts too
-    if not ok:
-        return [Row("gui: the diagnosis did not finish in time", 0.0, "", "", False)]
+    runs = []
+    for _ in range(2):          # the second fills a table that holds the first's candidates
+        with StallMeter() as meter:
+            started = time.monotonic()
+            lab.candidates.diagnose_button.click()
+            ok = _wait(app, lambda: len(done) > len(runs))
+            took = time.monotonic() - started
+            _wait(app, lambda: False, 0.3)          # what the GUI does right after showing the table counts too
+        if not ok:
+            return [Row("gui: the diagnosis did not finish in time", 0.0, "", "", False)]
+        runs.append((took, meter))
+    (took, meter), (_, again) = runs
     return [Row("gui: diagnosis in the Model lab, click to candidates shown", took, "s", "", None),
             at_most("gui: longest event-loop stall during the diagnosis", meter.stall_ms, "ms", STALL_LIMIT_MS),
-            Row(CPU_ROW, meter.stall_cpu_ms, "ms", "", None)]
+            Row(CPU_ROW, meter.stall_cpu_ms, "ms", "", None),
+            at_most("gui: longest event-loop stall during a second diagnosis", again.stall_ms, "ms", STALL_LIMIT_MS),
+            Row(CPU_ROW, again.stall_cpu_ms, "ms", "", None)]
 
 
 def _switching(app, window) -> list[Row]:

@@ -46,6 +46,7 @@ import dataclasses
 import math
 import threading
 import time
+from concurrent.futures import Executor
 from typing import Mapping
 
 import numpy as np
@@ -155,19 +156,16 @@ def alternative_models(model: Model) -> list[Model]:
 
 
 def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None,
-            drop_degenerate: bool = False) -> list[Member]:
+            drop_degenerate: bool = False, executor: Executor | None = None) -> list[Member]:
     """The user's fit and the alternatives' fits that describe the data about as well (module doc).
 
     drop_degenerate: leave out a fit whose RE, CMES, LCES, RES or Bl ended on a bound, or whose blocked impedance
     is resistive at the lowest line (on magnitude-only curves leach's K*w^n, n small, can take RE's place:
-    no driver is like that)."""
+    no driver is like that). `executor`: a pool the alternatives are fitted on (the same fits, so the same numbers)."""
     fits = [Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(fit.values))]
-    for model in alternative_models(fit.model):
-        try:
-            other = fit_with(fit.method, data, model, cancel=cancel)
-        except FitError:
-            if cancel is not None and cancel.is_set():
-                raise
+    models = alternative_models(fit.model)
+    for model, other in zip(models, _refits(fit.method, [(data, model, None) for model in models], cancel, executor)):
+        if other is None:
             continue        # an alternative that does not converge is not one the data cannot reject
         if drop_degenerate and degenerate(other, data):
             continue
@@ -179,17 +177,18 @@ def members(fit: FitResult, data: FitData, cancel: threading.Event | None = None
 
 def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event | None = None, always: bool = False,
                         other_bands: tuple[FitData, ...] = (), drop_degenerate: bool | None = None,
-                        ensemble: bool = False) -> ModelPart:
+                        ensemble: bool = False, executor: Executor | None = None) -> ModelPart:
     """The refits' outcome (module doc): NOT_NEEDED when the model describes the data (nothing is refitted),
     unless `always`; `other_bands` as model_spread's; degenerate alternatives dropped (members) when
     `drop_degenerate` (None: when `always`). `ensemble` (a recording's): the spread is the std over the reported
     fit and the members, the reported fit first even when the data reject it (one alternative the data prefer
-    is then enough)."""
+    is then enough). `executor`: a pool the refits run on (members)."""
     if describes_the_data(fit) and not always:
         return ModelPart(state=NOT_NEEDED)
     started = time.perf_counter()
     drop = always if drop_degenerate is None else drop_degenerate
-    indistinct = members(fit, data, cancel, drop_degenerate=drop) + _band_members(fit, other_bands, cancel)
+    indistinct = (members(fit, data, cancel, drop_degenerate=drop, executor=executor)
+                  + _band_members(fit, other_bands, cancel, executor))
     seconds = time.perf_counter() - started
     if ensemble:
         reported = Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(fit.values))
@@ -225,18 +224,33 @@ def degenerate(other: FitResult, data: FitData) -> bool:
     return excess > DC_EXCESS * other.values["RE"]
 
 
-def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.Event | None) -> list[Member]:
+def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.Event | None,
+                  executor: Executor | None = None) -> list[Member]:
     """The user's model fitted over each other band (no chi^2 to compare: the bands hold different lines)."""
-    out = []
-    for data in bands:
-        try:
-            other = fit_with(fit.method, data, fit.model, start=fit.values, cancel=cancel)
-        except FitError:
-            if cancel is not None and cancel.is_set():
-                raise
-            continue
-        out.append(Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(other.values)))
-    return out
+    others = _refits(fit.method, [(data, fit.model, fit.values) for data in bands], cancel, executor)
+    return [Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(other.values))
+            for other in others if other is not None]
+
+
+def _refits(method: str, calls: list[tuple], cancel: threading.Event | None,
+            executor: Executor | None) -> list[FitResult | None]:
+    """fit_with(method, data, model, start) for each (data, model, start), None for a fit that did not converge.
+
+    On `executor` every call is handed over at once and its result waited for in order; a worker process cannot
+    see `cancel`, so the executor's own wait must end on it (app.jobs.background_pool)."""
+    if executor is None:
+        return [_converged(lambda c=call: fit_with(method, *c, cancel=cancel), cancel) for call in calls]
+    futures = [executor.submit(fit_with, method, *call) for call in calls]
+    return [_converged(future.result, cancel) for future in futures]
+
+
+def _converged(fitting, cancel: threading.Event | None) -> FitResult | None:
+    try:
+        return fitting()
+    except FitError:
+        if cancel is not None and cancel.is_set():
+            raise
+        return None
 
 
 def _with_derived(values: Mapping[str, float], sd_m2: float | None) -> dict[str, float]:
@@ -261,12 +275,13 @@ def with_model_part(parameters: Mapping[str, ParameterValue], spread: Mapping[st
     return out
 
 
-def model_uncertainty(result, cancel: threading.Event | None = None):
+def model_uncertainty(result, cancel: threading.Event | None = None, executor: Executor | None = None):
     """`result` (an analysis.pipeline.AnalysisResult, or an analysis.curves.fitting.CurveAnalysis) with each parameter's
     model part (module doc), the alternatives fitted by the result's own method.
 
     The same result when nothing was fitted or when it already carries its model part (every output calls
-    this: the refits run once); the refits honour `cancel` (FitCancelled)."""
+    this: the refits run once); the refits honour `cancel` (FitCancelled), on `executor` when there is one
+    (a process pool: the GUI's, so that its thread only waits)."""
     if result.fit is None or getattr(result, "model_part", None) is not None:
         return result
     data = getattr(result, "data", None) or FitData.from_spectra(result.spectra)
@@ -274,7 +289,7 @@ def model_uncertainty(result, cancel: threading.Event | None = None):
     always = getattr(result, "model_part_always", False)
     recorded = hasattr(result, "spectra")           # a recording's result (module doc), not imported curves
     part = estimate_model_part(result.fit, data, cancel, always, getattr(result, "other_bands", ()),
-                               drop_degenerate=always or recorded, ensemble=recorded)
+                               drop_degenerate=always or recorded, ensemble=recorded, executor=executor)
     return with_estimated(result, part)
 
 

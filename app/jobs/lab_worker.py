@@ -1,175 +1,22 @@
 """The model lab's fits off the GUI thread: refits of one model, and diagnoses.
 
 A LabWorker is a JobRunner (app.jobs.book). What crosses to the GUI thread is
-frozen (LabFit, DiagnosisOutcome) and already holds everything the page
-draws: the parameter table, the dense model curves and the residual in words.
+frozen (LabFit, DiagnosisOutcome: app.jobs.lab_outcome) and already holds
+everything the page draws: the parameter table, the dense model curves and the
+residual in words.
 """
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
-import threading
-from dataclasses import dataclass
 
-from analysis.derived import parameter_table
 from analysis.diagnosis import residuals
-from analysis.diagnosis.acceptance import Flag
-from analysis.diagnosis.candidates import MAX_STEPS, Candidate, Diagnosis, Step, diagnose, explain
-from analysis.diagnosis.sites import SiteResult
-from analysis.diagnosis.words import drift_from_validity, verdict_headline, verdict_text
-from analysis.effects import Effect
-from analysis.fit.error import band_text
+from analysis.diagnosis.candidates import MAX_STEPS, Candidate, Step, diagnose
 from analysis.fit.least_squares import FitCancelled, FitData, FitResult, fit_model
 from analysis.model.composed import Model
-from analysis.parallel import fit_executor
 from analysis.pipeline import AnalysisResult
-from analysis.validity.fit import rejudged
+from app.jobs.background_pool import PoolCancelled, background_pool
 from app.jobs.book import Job, JobRunner
-from app.results.curves import ResultCurves, result_curves
-
-
-CANCEL_POLL_S = 0.1     # how often a diagnosis waiting on the process pool looks at its cancel flag
-
-
-@dataclass(frozen=True, slots=True)
-class LabFit:
-    """One fitted model, ready to show: its AnalysisResult, curves and residual description."""
-
-    result: AnalysisResult      # the lab's recording with this fit and its parameter table
-    curves: ResultCurves
-    residual: str               # analysis.diagnosis.residuals.describe(fit)
-
-    @property
-    def fit(self) -> FitResult:
-        return self.result.fit
-
-
-def lab_fit(base: AnalysisResult, fit: FitResult) -> LabFit:
-    """`fit` dressed for display; milliseconds, but run in the worker with the fit it follows."""
-    # The validity goes with the fit: the base's misfit finding is the base model's, not this one's. The lab
-    # fits every line (app.model_lab.session), whatever band the base's parameters came from.
-    result = dataclasses.replace(base, fit=fit, parameters=parameter_table(fit, base.sd_m2),
-                                 validity=rejudged(base.validity, fit), data=None, whole_band_fit=None)
-    return LabFit(result, result_curves(result), residuals.describe(fit))
-
-
-def first_version(result: AnalysisResult) -> tuple[LabFit, str]:
-    """The lab's first version and how it came about: the result's fit, or, when its parameters come from the
-    piston band, the same model over every line the lab works on (its curves and the residual in words take
-    milliseconds: no worker needed)."""
-    if result.whole_band_fit is None:
-        return LabFit(result, result_curves(result), residuals.describe(result.fit)), "as fitted on the Results page"
-    band = band_text(result.validity, "displacement").strip(" ()")         # "14.6-144 Hz"; the page adds ()
-    return (lab_fit(result, result.whole_band_fit),
-            f"over every line; the Results page's parameters come from the piston band, {band} on Hx")
-
-
-@dataclass(frozen=True, slots=True)
-class CandidateRow:
-    """One ranked candidate of a diagnosis: the move, its numbers and its explanation."""
-
-    action: str                     # "add" or "replace"
-    effect: Effect
-    replaces: Effect | None
-    delta_bic: float                # inf when the refit failed
-    explanation: str                # analysis.diagnosis.candidates.explain
-    fitted: LabFit | None           # None when the refit failed
-    error: str | None = None
-    flags: tuple[Flag, ...] = ()
-    accepted: bool = False          # the acceptance rule would take it (analysis.diagnosis.acceptance)
-    judgement: str = ""             # why (not): the assessment's reason code
-    partner: Effect | None = None   # a second effect taken with this one (a pair)
-
-    @property
-    def chi2_red(self) -> dict[str, float]:
-        return self.fitted.fit.chi2_red_by_channel() if self.fitted else {}
-
-    @property
-    def move(self) -> str:
-        if self.replaces is not None:
-            return f"replace {self.replaces.id} by {self.effect.id}"
-        return f"add {self.effect.id}" + (f" with {self.partner.id}" if self.partner is not None else "")
-
-
-@dataclass(frozen=True, slots=True)
-class DiagnosisOutcome:
-    ranked_from: FitResult                  # the model the candidates are one move away from
-    candidates: tuple[CandidateRow, ...]    # best first
-    path: tuple[LabFit, ...]                # greedy path: the models taken, in order (empty: ranking only)
-    residual: str                           # where the residual of ranked_from sits
-    verdict: str = ""                       # analysis.diagnosis.acceptance's four verdicts
-    verdict_text: str = ""                  # the verdict in plain words, with the site and what to do next
-    sites: tuple[SiteResult, ...] = ()      # where the misfit left belongs, best first
-    step_cap_reached: bool = False
-    verdict_headline: str = ""              # the verdict in one short sentence
-
-    @property
-    def chosen(self) -> CandidateRow | None:
-        """The candidate the acceptance rule takes (None: none would be taken)."""
-        return next((c for c in self.candidates if c.accepted), None)
-
-
-def _row(base: AnalysisResult, ranked_from: FitResult, c: Candidate) -> CandidateRow:
-    return CandidateRow(c.action, c.effect, c.replaces, c.delta_bic, explain(ranked_from, c),
-                        lab_fit(base, c.fit) if c.fit is not None else None, c.error, c.flags, c.accepted,
-                        c.assessment.reason if c.assessment else "", c.partner)
-
-
-def diagnosis_outcome(base: AnalysisResult, result: Diagnosis, follow: bool) -> DiagnosisOutcome:
-    """What the lab shows of a diagnosis: the last ranking, the path taken, the verdict and the sites."""
-    if follow:
-        last = result.steps[-1]
-        path = tuple(lab_fit(base, step.fit) for step in result.steps[1:])
-    else:
-        last, path = result.steps[0], ()
-    rows = tuple(_row(base, last.fit, c) for c in last.candidates)
-    drift = drift_from_validity(base.validity)
-    return DiagnosisOutcome(last.fit, rows, path, last.residual, result.verdict, verdict_text(result, drift),
-                            result.sites, result.step_cap_reached, verdict_headline(result))
-
-
-class DiagnosisCancelled(Exception):
-    """Deliberately not a FitError: rank_candidates records those as failed candidates and goes on."""
-
-
-class _PollingFuture:
-    """A pool future whose result() wakes up to look at the cancel flag.
-
-    rank_candidates waits on each refit with result() and no timeout, and an
-    Event cannot be sent to the worker processes: without this a cancelled
-    diagnosis would run every remaining refit to the end.
-    """
-
-    def __init__(self, future: concurrent.futures.Future, owner: "_CancellableExecutor"):
-        self._future = future
-        self._owner = owner
-
-    def result(self, timeout=None):
-        while True:
-            try:
-                return self._future.result(timeout=CANCEL_POLL_S)
-            except concurrent.futures.TimeoutError:
-                self._owner.check()
-
-    def done(self) -> bool:
-        """Whether the result is back (analysis.diagnosis.jobs.as_ready takes those first)."""
-        return self._future.done()
-
-
-class _CancellableExecutor:
-    def __init__(self, pool: concurrent.futures.Executor, cancel: threading.Event):
-        self._pool = pool
-        self._cancel = cancel
-
-    def check(self) -> None:
-        if self._cancel.is_set():
-            # Refits not yet started are dropped; the one or two running finish in well under a second.
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            raise DiagnosisCancelled("diagnosis cancelled")
-
-    def submit(self, fn, *args, **kwargs) -> _PollingFuture:
-        self.check()
-        return _PollingFuture(self._pool.submit(fn, *args, **kwargs), self)
+from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome, LabFit, diagnosis_outcome, lab_fit
 
 
 def _refit(job: Job, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> LabFit:
@@ -188,22 +35,26 @@ def _diagnose(job: Job, base: AnalysisResult, data: FitData, start: FitResult, f
     (it still counts as the path's first step, for the verdict).
     """
     begin = taken.fitted.fit if taken is not None else start
-    with fit_executor(background=True) as pool:        # the window keeps the cores it needs
-        executor = None if pool is None else _CancellableExecutor(pool, job.cancel_event)
+    with background_pool(job.cancel_event) as executor:       # the window keeps the cores (and the GIL) it needs
         result = diagnose(data, begin.model, executor=executor, cancel=job.cancel_event, start_fit=begin,
                           progress=job.say, max_steps=MAX_STEPS, follow=follow)
-    job.check()
-    if taken is not None:
-        t = taken
-        first = Step(fit=start, candidates=(), residual=residuals.describe(start),
-                     chosen=Candidate(action=t.action, effect=t.effect, replaces=t.replaces, fit=t.fitted.fit,
-                                      delta_bic=t.delta_bic, error=t.error, flags=t.flags))
-        result = dataclasses.replace(result, steps=(first,) + result.steps)
-    return diagnosis_outcome(base, result, follow)
+        job.check()
+        if taken is not None:
+            t = taken
+            first = Step(fit=start, candidates=(), residual=residuals.describe(start),
+                         chosen=Candidate(action=t.action, effect=t.effect, replaces=t.replaces, fit=t.fitted.fit,
+                                          delta_bic=t.delta_bic, error=t.error, flags=t.flags))
+            result = dataclasses.replace(result, steps=(first,) + result.steps)
+        if executor is None:
+            return diagnosis_outcome(base, result, follow)
+        # Built on a worker too: 0.1-0.2 s of CPU (a parameter table and curves per candidate) that in this
+        # thread held the GIL against the GUI thread's paint just before the table is shown; the round trip
+        # of its pickles costs the GUI process ~25 ms of CPU.
+        return executor.submit(diagnosis_outcome, base, result, follow).result()
 
 
 class LabWorker(JobRunner):
-    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, DiagnosisCancelled)
+    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, PoolCancelled)
 
     def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> Job:
         start = dict(start)

@@ -9,6 +9,7 @@ from analysis.fit.least_squares import FitCancelled
 from analysis.fit.model_uncertainty import model_uncertainty
 from analysis.pipeline import AnalysisResult, analyze_recording
 from analysis.recording.format import read_recording
+from app.jobs.background_pool import PoolCancelled, background_pool
 from app.jobs.book import Job, JobRunner
 from app.results.curves import ResultCurves, result_curves
 
@@ -23,7 +24,7 @@ class AnalysisOutcome:
 
 
 class AnalysisWorker(JobRunner):
-    cancel_errors = (*JobRunner.cancel_errors, FitCancelled)
+    cancel_errors = (*JobRunner.cancel_errors, FitCancelled, PoolCancelled)
 
     def start(self, path: str | Path, sd_m2: float | None = None) -> Job:
         path = Path(path)
@@ -42,10 +43,13 @@ class AnalysisWorker(JobRunner):
     def start_model_part(self, outcome: AnalysisOutcome) -> Job:
         """The model part of each parameter's uncertainty (analysis.fit.model_uncertainty), after the statistical
         result is shown: a few seconds of refits when the model misses the data, none when it does not. It
-        finishes with the outcome again, its parameters' std now the total (std_noise and std_model beside)."""
+        finishes with the outcome again, its parameters' std now the total (std_noise and std_model beside).
+        The refits run on worker processes below the window (app.jobs.background_pool): in this thread they held
+        the GIL against the GUI thread for seconds, while the user turns to the Model lab."""
         def work(job: Job) -> AnalysisOutcome:
             job.say(f"the model part of the uncertainties of {outcome.path.name}")
-            result = model_uncertainty(outcome.result, cancel=job.cancel_event)
+            with background_pool(job.cancel_event) as executor:
+                result = model_uncertainty(outcome.result, cancel=job.cancel_event, executor=executor)
             return AnalysisOutcome(job.id, outcome.path, result, outcome.curves, outcome.nominal_ohm)
         return self.run("model part", work, f"estimating the model part of {outcome.path.name}'s uncertainties")
 

@@ -24,7 +24,8 @@ from analysis.fit.words import fit_headline
 from analysis.pipeline import AnalysisResult
 from analysis.diagnosis.refit_words import refit_text
 from app.jobs.controls import JobControls
-from app.jobs.lab_worker import DiagnosisOutcome, LabFit, LabWorker, first_version
+from app.jobs.lab_outcome import DiagnosisOutcome, LabFit, first_version
+from app.jobs.lab_worker import LabWorker
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel

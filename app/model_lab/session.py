@@ -16,7 +16,7 @@ from app.model_lab.versions import LabVersion
 
 if TYPE_CHECKING:
     from analysis.pipeline import AnalysisResult
-    from app.jobs.lab_worker import DiagnosisOutcome, LabFit
+    from app.jobs.lab_outcome import DiagnosisOutcome, LabFit
 
 
 class LabSession:

@@ -8,7 +8,7 @@ from analysis.effects import get_effect
 from analysis.model.composed import Model
 
 if TYPE_CHECKING:       # a type only: the versions (and app.model_lab.session) import no Qt
-    from app.jobs.lab_worker import LabFit
+    from app.jobs.lab_outcome import LabFit
 
 
 @dataclass(frozen=True, slots=True)

@@ -58,6 +58,14 @@ def test_the_alternatives_exchange_the_blocked_impedance_and_the_creep_law():
     assert alternative_models(Model(parse_effects("none"))) == []
 
 
+def test_the_model_part_on_a_pool_is_the_one_without(pool):
+    """The GUI hands the refits to worker processes (app.jobs.background_pool): the same fits, the same numbers."""
+    statistical = analyze_recording(realistic_recording("woofer", 0))
+    alone, pooled = model_uncertainty(statistical), model_uncertainty(statistical, executor=pool)
+    assert alone.model_part.members and pooled.model_part.members == alone.model_part.members
+    assert pooled.parameters == alone.parameters
+
+
 def test_a_cancelled_model_part_stops():
     statistical = analyze_recording(realistic_recording("woofer", 0))
     cancel = threading.Event()

@@ -16,10 +16,12 @@ import pytest
 from PySide6.QtCore import Qt
 
 import analysis.diagnosis.candidates
+import app.jobs.background_pool
 import app.jobs.lab_worker
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit.least_squares import FitCancelled, FitError
+from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app.widgets import style
@@ -205,6 +207,31 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
     assert threading.current_thread() is threading.main_thread()
 
 
+@pytest.mark.skipif(worker_count() < 2, reason="one core: no pool, the diagnosis runs in the job's thread")
+def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, lab, monkeypatch):
+    """Nothing of it holds the GIL in the GUI process but the hand-over (app.jobs.background_pool)."""
+    handed = []
+    real = app.jobs.lab_worker.background_pool
+
+    class Counting:
+        def __init__(self, executor):
+            self.executor = executor
+
+        def submit(self, fn, *args):
+            handed.append(fn.__name__)
+            return self.executor.submit(fn, *args)
+
+    @contextlib.contextmanager
+    def counting_pool(cancel):
+        with real(cancel) as executor:
+            yield Counting(executor)
+    monkeypatch.setattr(app.jobs.lab_worker, "background_pool", counting_pool)
+    outcome = _diagnose(qtbot, lab)
+    assert handed[-1] == "diagnosis_outcome" and handed.count("diagnosis_outcome") == 1
+    assert handed.count("_refit") >= len(analysis.diagnosis.candidates.candidate_models(lab.current.fitted.fit.model))
+    assert outcome.candidates and all(c.fitted is not None or c.error for c in outcome.candidates)
+
+
 def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
     started = threading.Event()
 
@@ -249,7 +276,7 @@ def test_cancel_stops_a_diagnosis_waiting_on_the_pool(qtbot, lab, monkeypatch):
         with OneThreadPool(max_workers=1) as pool:
             yield pool
     monkeypatch.setattr(analysis.diagnosis.candidates, "_refit", slow_refit)
-    monkeypatch.setattr(app.jobs.lab_worker, "fit_executor", one_process_pool)
+    monkeypatch.setattr(app.jobs.background_pool, "fit_executor", one_process_pool)
     qtbot.mouseClick(lab.candidates.diagnose_button, Qt.LeftButton)
     qtbot.waitUntil(lambda: bool(calls), timeout=wait_ms(10))
     with qtbot.waitSignal(lab.job_cancelled, timeout=wait_ms(10)):

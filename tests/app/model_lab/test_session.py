@@ -10,7 +10,7 @@ from analysis.effects import parse_effects
 from analysis.fit.least_squares import fit_model
 from analysis.model.composed import Model
 from analysis.pipeline import AnalysisResult, analyze_recording
-from app.jobs.lab_worker import LabFit, lab_fit
+from app.jobs.lab_outcome import LabFit, lab_fit
 from app.model_lab.session import LabSession
 from app.results.curves import result_curves
 from tests.builders import TYPICAL_NOISE, recording
@@ -91,7 +91,7 @@ def band_fitted() -> AnalysisResult:
 
 
 def test_a_band_fitted_result_is_modelled_over_every_line_where_the_cone_mode_shows(band_fitted):
-    from app.jobs.lab_worker import first_version as lab_first_version
+    from app.jobs.lab_outcome import first_version as lab_first_version
     session = LabSession()
     session.restart(band_fitted)
     band_lines = len(band_fitted.data.displacement.freqs)
@@ -108,7 +108,7 @@ def test_a_band_fitted_result_is_modelled_over_every_line_where_the_cone_mode_sh
 
 
 def test_a_result_fitted_over_every_line_starts_the_lab_as_it_is(base):
-    from app.jobs.lab_worker import first_version as lab_first_version
+    from app.jobs.lab_outcome import first_version as lab_first_version
     assert base.whole_band_fit is None
     first, how = lab_first_version(base)
     assert first.result is base and how == "as fitted on the Results page"

@@ -1,8 +1,8 @@
-"""The Model lab's cancellable pool: its futures say when they are done, so the diagnosis takes those first."""
+"""A job's cancellable pool: its futures say when they are done, so the diagnosis takes those first."""
 import threading
 from concurrent.futures import Future
 
-from app.jobs.lab_worker import _CancellableExecutor
+from app.jobs.background_pool import CancellableExecutor
 
 
 class _Pool:
@@ -16,7 +16,7 @@ class _Pool:
 
 def test_a_cancellable_pools_future_is_done_when_its_result_is_back():
     pool = _Pool()
-    future = _CancellableExecutor(pool, threading.Event()).submit(print, "x")
+    future = CancellableExecutor(pool, threading.Event()).submit(print, "x")
     assert not future.done()
     pool.futures[0].set_result(42)
     assert future.done() and future.result() == 42

@@ -1,0 +1,44 @@
+"""The analysis worker's model part: its refits run on worker processes, not in the job's thread of the GUI process."""
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+
+import pytest
+
+import app.jobs.workers
+from analysis.fit.model_uncertainty import alternative_models
+from analysis.parallel import worker_count
+from analysis.pipeline import analyze_recording
+from app.jobs.workers import AnalysisOutcome, AnalysisWorker
+from tests.app.conftest import analysis_wait_ms
+from tests.pace import wait_ms
+from tests.realistic_drivers import realistic_recording
+
+
+@pytest.mark.skipif(worker_count() < 2, reason="one core: the refits run in the job's thread, no pool is started")
+def test_the_model_parts_refits_are_handed_to_the_pool(qtbot, monkeypatch):
+    handed = []
+    real = app.jobs.workers.background_pool
+
+    class Counting:
+        def __init__(self, executor):
+            self.executor = executor
+
+        def submit(self, fn, *args):
+            handed.append(fn.__name__)
+            return self.executor.submit(fn, *args)
+
+    @contextlib.contextmanager
+    def counting_pool(cancel):
+        with real(cancel) as executor:
+            yield Counting(executor)
+    monkeypatch.setattr(app.jobs.workers, "background_pool", counting_pool)
+    result = analyze_recording(realistic_recording("midrange", 0))
+    worker = AnalysisWorker()
+    with qtbot.waitSignal(worker.finished, timeout=analysis_wait_ms(4)) as done:
+        worker.start_model_part(AnalysisOutcome(0, Path("midrange"), result, None))
+    assert handed == ["fit_with"] * len(alternative_models(result.fit.model))
+    mms = done.args[1].result.parameters["Mms"]
+    assert mms.value == result.parameters["Mms"].value and mms.std_model > 0
+    assert worker.shutdown(wait_ms(10))
