@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Callable
 
 import numpy as np
 import pyqtgraph as pg
@@ -297,8 +298,10 @@ class LivePanels(QWidget):
         if fit or width > self.status.width() or height > self.status.height():
             self.status.setFixedSize(width, height)
 
-    def clear(self, text: str = "Waiting for the first period…", band_hz: tuple[float, float] | None = None) -> None:
-        """Empty panels; `band_hz`, when known, sets the frequency axis already."""
+    def clear(self, text: str = "Waiting for the first period…", band_hz: tuple[float, float] | None = None,
+              then: Callable[[], None] | None = None) -> None:
+        """Empty panels; `band_hz`, when known, sets the frequency axis already. `then` is called in the turn after
+        the last channel's (its paint is done by then), unless a newer clear or frame took over."""
         self._pending = None
         self.frame = None
         self._drawing += 1
@@ -307,12 +310,16 @@ class LivePanels(QWidget):
         self.legend.setVisible(True)
         for panel in self.panels.values():       # until the first period, say so where the lines will be
             panel.empty_text = text
-        self._clear_channel(self._drawing, list(self.panels.values()), band_hz)
+        self._clear_channel(self._drawing, list(self.panels.values()), band_hz, then)
 
-    def _clear_channel(self, drawing: int, panels: list, band_hz: tuple[float, float] | None) -> None:
+    def _clear_channel(self, drawing: int, panels: list, band_hz: tuple[float, float] | None,
+                       then: Callable[[], None] | None) -> None:
         """As _draw_channel: a channel per turn of the event loop (a measurement starts with this)."""
         if drawing != self._drawing:
             return
+        if not panels:
+            then()
+            return
         panels[0].clear(band_hz=band_hz)
-        if len(panels) > 1:
-            in_a_later_turn(self, lambda: self._clear_channel(drawing, panels[1:], band_hz))
+        if len(panels) > 1 or then is not None:
+            in_a_later_turn(self, lambda: self._clear_channel(drawing, panels[1:], band_hz, then))

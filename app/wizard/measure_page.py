@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import html
+import threading
 from pathlib import Path
 
 from PySide6.QtCore import QStandardPaths, Signal
@@ -174,8 +175,9 @@ class MeasurePage(WizardPage):
         """A measurement job of the session (start_job(request)), its frames on the live panels."""
         self.result.setText("")
         request = self.request()
-        self.panels.clear(band_hz=request.template.band_hz)
-        self.jobs.run(start_job(request), "Starting…", on_done,
+        panels_drawn = threading.Event()            # the job begins once the emptied panels are drawn
+        self.panels.clear(band_hz=request.template.band_hz, then=panels_drawn.set)
+        self.jobs.run(start_job(request, panels_drawn), "Starting…", on_done,
                       lambda message: self.result.setText(coloured("Failed: " + message, ERROR_COLOUR)),
                       lambda: self.result.setText(cancelled_text), frame=self.panels.set_frame)
         self.changed.emit()

@@ -105,3 +105,19 @@ def test_a_measurement_without_displacement_shows_that_channel_absent(qtbot, pan
         panels.set_frame(frames[-1])
     assert panels.panels["displacement"].light.light.status == "absent"
     assert len(panels.panels["displacement"].lines.getData()[0] or []) == 0
+
+
+def test_clear_calls_back_after_the_last_channel_is_emptied_and_not_when_a_newer_clear_took_over(qtbot, panels,
+                                                                                                 clean_frames):
+    """A measurement begins on this call back (app.wizard.measure_session): the three channels emptied first,
+    each in its own turn, and a superseded clear never calls."""
+    with qtbot.waitSignal(panels.repainted, timeout=wait_ms(10)):
+        panels.set_frame(clean_frames[-1])
+    called, superseded = [], []
+    panels.clear(band_hz=(10.0, 1000.0), then=lambda: superseded.append(1))
+    panels.clear(band_hz=(10.0, 1000.0),
+                 then=lambda: called.append([len(p.lines.getData()[0] or []) for p in panels.panels.values()]))
+    assert not called                                  # later turns, not the clear's own
+    qtbot.waitUntil(lambda: bool(called), timeout=wait_ms(10))
+    assert called == [[0, 0, 0]]                       # every channel empty by then
+    assert superseded == []             # its next turn was due before the newer chain's: it ran, and stopped

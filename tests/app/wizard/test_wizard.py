@@ -140,6 +140,31 @@ def test_the_measurement_runs_off_the_gui_thread(qtbot, wizard, monkeypatch):
     assert threads and threads[0] is not threading.main_thread()
 
 
+def test_the_measurement_begins_once_the_emptied_panels_are_drawn(qtbot, wizard, monkeypatch):
+    """The Start click's turns are the GUI's: the measurement's own start-up (devices, imports) held the GIL
+    against them, so its job waits for the panels' clear (app.wizard.measure_session.PANELS_DRAWN_WAIT_S)."""
+    import app.wizard.measure_session as session
+    import app.wizard.tasks as tasks
+    monkeypatch.setattr(session, "PANELS_DRAWN_WAIT_S", wait_ms(60) / 1000)    # never the bound that ends the wait
+    emptied, begun_after_emptied = [], []
+    panels = wizard.measure_page.panels
+    clear = panels.clear
+
+    def noting_clear(*args, then=None, **kwargs):
+        clear(*args, then=lambda: (emptied.append(True), then()), **kwargs)
+    monkeypatch.setattr(panels, "clear", noting_clear)
+    real = tasks.run_measurement
+
+    def spy(*args, **kwargs):
+        begun_after_emptied.append(bool(emptied))
+        return real(*args, **kwargs)
+    monkeypatch.setattr(tasks, "run_measurement", spy)
+    skip_to_measure(qtbot, wizard, realtime=False)
+    with qtbot.waitSignal(wizard.measurement_finished, timeout=job_wait_ms()):
+        wizard.measure_page.start_button.click()
+    assert begun_after_emptied == [True]
+
+
 def test_a_failing_device_is_a_message_not_a_crash(qtbot, wizard, monkeypatch):
     from instruments.audio.errors import AudioError
     import app.wizard.hardware as hardware
