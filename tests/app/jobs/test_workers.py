@@ -1,7 +1,6 @@
 """The analysis worker's model part: its refits run on worker processes, not in the job's thread of the GUI process."""
 from __future__ import annotations
 
-import contextlib
 from pathlib import Path
 
 import pytest
@@ -12,6 +11,7 @@ from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from app.jobs.workers import AnalysisOutcome, AnalysisWorker
 from tests.app.conftest import analysis_wait_ms
+from tests.app.jobs.pool_spy import noting_background_pool
 from tests.pace import wait_ms
 from tests.realistic_drivers import realistic_recording
 
@@ -19,21 +19,7 @@ from tests.realistic_drivers import realistic_recording
 @pytest.mark.skipif(worker_count() < 2, reason="one core: the refits run in the job's thread, no pool is started")
 def test_the_model_parts_refits_are_handed_to_the_pool(qtbot, monkeypatch):
     handed = []
-    real = app.jobs.workers.background_pool
-
-    class Counting:
-        def __init__(self, executor):
-            self.executor = executor
-
-        def submit(self, fn, *args):
-            handed.append(fn.__name__)
-            return self.executor.submit(fn, *args)
-
-    @contextlib.contextmanager
-    def counting_pool(cancel):
-        with real(cancel) as executor:
-            yield Counting(executor)
-    monkeypatch.setattr(app.jobs.workers, "background_pool", counting_pool)
+    monkeypatch.setattr(app.jobs.workers, "background_pool", noting_background_pool(app.jobs.workers.background_pool, handed))
     result = analyze_recording(realistic_recording("midrange", 0))
     worker = AnalysisWorker()
     with qtbot.waitSignal(worker.finished, timeout=analysis_wait_ms(4)) as done:

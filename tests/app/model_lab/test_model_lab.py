@@ -31,6 +31,7 @@ from app.model_lab.page import ModelLab
 from app.results.parameter_table import VALUE
 
 from tests.app.conftest import PAPER, analysis_wait_ms, open_and_wait
+from tests.app.jobs.pool_spy import noting_background_pool
 from tests.pace import wait_ms
 
 CLOSE_WAIT_MS = 10_000
@@ -211,21 +212,7 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
 def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, lab, monkeypatch):
     """Nothing of it holds the GIL in the GUI process but the hand-over (app.jobs.background_pool)."""
     handed = []
-    real = app.jobs.lab_worker.background_pool
-
-    class Counting:
-        def __init__(self, executor):
-            self.executor = executor
-
-        def submit(self, fn, *args):
-            handed.append(fn.__name__)
-            return self.executor.submit(fn, *args)
-
-    @contextlib.contextmanager
-    def counting_pool(cancel):
-        with real(cancel) as executor:
-            yield Counting(executor)
-    monkeypatch.setattr(app.jobs.lab_worker, "background_pool", counting_pool)
+    monkeypatch.setattr(app.jobs.lab_worker, "background_pool", noting_background_pool(app.jobs.lab_worker.background_pool, handed))
     outcome = _diagnose(qtbot, lab)
     assert handed[-1] == "diagnosis_outcome" and handed.count("diagnosis_outcome") == 1
     assert handed.count("_refit") >= len(analysis.diagnosis.candidates.candidate_models(lab.current.fitted.fit.model))
