@@ -1,4 +1,5 @@
-"""MINPACK's Levenberg-Marquardt (scipy.optimize.leastsq) with bounds, as lmfit's "leastsq" method runs it.
+"""MINPACK's Levenberg-Marquardt (scipy.optimize.leastsq's, analysis.fit.minpack) with bounds, as lmfit's
+"leastsq" method runs it.
 
 MINPACK knows no bounds. Each bounded parameter is fitted through an internal variable that can take any
 value (MINUIT's transform, as lmfit's Parameter.setup_bounds does it):
@@ -22,12 +23,14 @@ from typing import Callable, Collection, Mapping
 
 import numpy as np
 
+from analysis.fit.minpack import leastsq
+
 # An internal start value this small is taken as 0 (lmfit's `tiny`).
 TINY = 1.0e-15
 
 # What MINPACK is asked, as lmfit asks it: no gradient test, a small step for the forward differences,
 # MINPACK's own step bound and scaling. Its evaluation limit is twice the fit's own, which ends it first.
-LMDIF_OPTIONS = dict(Dfun=None, full_output=1, col_deriv=0, gtol=0.0, epsfcn=1.0e-10, factor=100, diag=None)
+LMDIF_OPTIONS = dict(gtol=0.0, epsfcn=1.0e-10, factor=100)
 # The count a fit reports is lmfit's: it starts at -2, loses one when MINPACK returns and gains the final
 # evaluation at the best point, so it is the evaluations made less three (scipy checks the residual's
 # shape with one before MINPACK starts).
@@ -160,13 +163,11 @@ def bounded_leastsq(residual: Residual, start: Start, *, xtol: float, ftol: floa
     At most `max_nfev` evaluations; `iter_cb` sees each one and may end the fit. An ended fit returns the
     values it was last evaluated at, without covariance, success False.
     """
-    from scipy.optimize import leastsq      # half a second to import: not before a fit needs it
-
     evaluate = _Evaluations(residual, start, max_nfev, iter_cb)
     x0 = [to_internal(start.values[n], start.bounds[n]) for n in start.varying]
     with np.errstate(all="ignore"):
         try:
-            best, cov, _, _, ier = leastsq(evaluate, x0, xtol=xtol, ftol=ftol, maxfev=2 * max_nfev, **LMDIF_OPTIONS)
+            best, cov, ier = leastsq(evaluate, x0, xtol=xtol, ftol=ftol, maxfev=2 * max_nfev, **LMDIF_OPTIONS)
         except _Cancelled:
             best, cov, ier = evaluate.last_internal, None, -1
         aborted = ier == -1
