@@ -16,6 +16,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -26,6 +27,7 @@ from instruments.measurement.recovery import find_unfinished, run_journaled
 from instruments.rig.workstation import rig_audio
 from tests.builders import PAPER, REPO_ROOT
 from tests.pace import paced
+from tests.rig_xruns import ATTEMPTS, UNINJECTED_XRUN
 
 pytestmark = [pytest.mark.rig, pytest.mark.timeout(120)]
 DEFAULT_LASER = {"clock_ppm": 37.0, "start_latency_s": 0.02}
@@ -80,14 +82,17 @@ def test_after_an_xrun_and_after_a_closed_laser_pty_the_next_measurement_complet
     assert find_unfinished(tmp_path) == []
 
 
-def test_linpar_measure_with_the_jack_server_killed_says_so_in_one_line_and_keeps_the_periods(tmp_path,
-                                                                                             virtual_rig):
+def _measure_and_kill_jackd(tmp_path, attempt: int) -> tuple[subprocess.Popen, list[str], bool, Path]:
+    """`linpar measure` on a rig of its own whose JACK server is killed once 2 periods are averaged: the command,
+    what it said, whether the server was killed, and its output folder."""
     from instruments.rig.manager import find_rig, start_rig, stop_rig
-    name, runtime = f"linpar-jackd-{os.getpid()}", tmp_path / "rig"
+    name, runtime = f"linpar-jackd-{os.getpid()}-{attempt}", tmp_path / f"rig{attempt}"
+    out_folder = tmp_path / f"out{attempt}"
     handle = start_rig(name, runtime_dir=runtime, seed=4)
+    killed = False
     try:
         proc = subprocess.Popen(
-            [sys.executable, "-m", "app.cli", "measure", "--out", str(tmp_path / "out"), "--name", "m",
+            [sys.executable, "-m", "app.cli", "measure", "--out", str(out_folder), "--name", "m",
              "--rig-name", name, "--runtime-dir", str(runtime), "--period", "8192", "--periods", "60"],
             cwd=REPO_ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         lines = []
@@ -95,17 +100,29 @@ def test_linpar_measure_with_the_jack_server_killed_says_so_in_one_line_and_keep
             lines.append(line)
             if "averaging 2/" in line:
                 os.kill(handle.state.jackd_pid, signal.SIGKILL)
+                killed = True
                 break
         out, err = proc.communicate(timeout=paced(60))
         lines += err.splitlines(keepends=True)
     finally:
         if find_rig(name, runtime) is not None:
             stop_rig(name, runtime)
+    return proc, lines, killed, out_folder
+
+
+def test_linpar_measure_with_the_jack_server_killed_says_so_in_one_line_and_keeps_the_periods(tmp_path,
+                                                                                             virtual_rig):
+    # An xrun nobody injected can end the measurement before the server is killed (tests/rig_xruns.py): then
+    # it is measured again, at most ATTEMPTS times.
+    for attempt in range(ATTEMPTS):
+        proc, lines, killed, out_folder = _measure_and_kill_jackd(tmp_path, attempt)
+        if killed or UNINJECTED_XRUN not in "".join(lines):
+            break
     assert proc.returncode == 2, "".join(lines)
     errors = [line for line in lines if line.startswith("linpar: error: ")]
     assert len(errors) == 1 and "Traceback" not in "".join(lines)
     # The rig's process dies with its server and takes the laser's pty along: either may be noticed first.
     assert "sound card" in errors[0] or "laser link lost" in errors[0]
-    assert "marked partial" in errors[0] and str(tmp_path / "out" / "m.wav") in errors[0]
-    rec = read_recording(tmp_path / "out" / "m.wav")
-    assert rec.n_periods >= 2 and json.loads((tmp_path / "out" / "m.json").read_text())["measurement"]["partial"]
+    assert "marked partial" in errors[0] and str(out_folder / "m.wav") in errors[0]
+    rec = read_recording(out_folder / "m.wav")
+    assert rec.n_periods >= 2 and json.loads((out_folder / "m.json").read_text())["measurement"]["partial"]

@@ -3,11 +3,34 @@ from __future__ import annotations
 
 import pytest
 
+from analysis.recording.format import read_recording
 from app.wizard import MeasureWizard
-
-from tests.app.wizard.test_wizard_helpers import fill_driver, job_wait_ms, parameter_errors, plain, run_job
+from tests.app.wizard.test_wizard_helpers import fill_driver, parameter_errors, plain, run_job
+from tests.rig_xruns import ATTEMPTS, UNINJECTED_XRUN
 
 pytestmark = pytest.mark.rig
+
+
+def _ended_by_an_xrun(page) -> bool:
+    """Whether the measurement just made ended on an xrun: its recording says so, or it kept too few periods
+    for one and the page's failure line names the xrun."""
+    outcome = page.state.outcome
+    if outcome is None:
+        return UNINJECTED_XRUN in plain(page.result)
+    return read_recording(outcome.path).extra["measurement"]["ended_by"] == "xrun"
+
+
+def _measure_until_no_xrun(qtbot, wizard):
+    """Start the measurement, again after an xrun nobody injected (at most ATTEMPTS times; see tests/rig_xruns.py:
+    on a loaded 2-core machine the rig's JACK server reports one now and then, and with the serial laser it ends
+    the measurement, which tests/instruments/measurement/test_measure_rig.py tests on its own)."""
+    page = wizard.measure_page
+    for _ in range(ATTEMPTS):
+        run_job(qtbot, page.start_button, page.jobs)
+        if not _ended_by_an_xrun(page):
+            break
+    assert page.state.outcome is not None, plain(page.result)
+    return page.state.outcome
 
 
 def test_a_whole_run_on_the_virtual_rig(qtbot, settings, tmp_path, virtual_rig):
@@ -33,9 +56,10 @@ def test_a_whole_run_on_the_virtual_rig(qtbot, settings, tmp_path, virtual_rig):
         assert level.decision.level is not None, level.decision.reason
         assert level.panels.frames_received >= 2
         wizard.next_button.click()
-        with qtbot.waitSignal(wizard.measurement_finished, timeout=job_wait_ms()) as finished:
-            wizard.measure_page.start_button.click()
-        outcome = finished.args[0]
+        finished = []
+        wizard.measurement_finished.connect(finished.append)
+        outcome = _measure_until_no_xrun(qtbot, wizard)
+        assert finished[-1] is outcome                  # the wizard says so (the main window goes on from it)
         assert outcome.path.exists()
         assert wizard.measure_page.panels.frames_received >= 2
         wizard.next_button.click()
