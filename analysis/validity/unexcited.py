@@ -10,7 +10,8 @@ distortion power over the noise power.
 R_k is the unexcited line itself for the voltage. For the current and the
 displacement it is what the voltage does not explain: R_k = Y_k - H(f_k) U_k,
 with H = Y/U interpolated from the excited lines (cubic spline in log f,
-~1e-3 accurate on the project's grid). So an amplifier that clips shows in the
+~1e-3 accurate on the project's grid; analysis.validity.knot_spline keeps it
+as a linear map per set of lines). So an amplifier that clips shows in the
 voltage only, and a distorted current means the driver itself is nonlinear.
 The voltage part is removed only on lines where the voltage carries more than
 noise, |U_k|^2 > 10 <var_U>_k (the voltage's noise pooled over 33 lines, so
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.validity.knot_spline import spline_at
 from analysis.validity.line_spectra import LineSpectra
 from analysis.validity.pooling import pooled_mean
 
@@ -68,8 +70,7 @@ def interpolated_transfer(line_freqs: np.ndarray, h: np.ndarray, freqs: np.ndarr
     """H at `freqs` from its values at the excited lines: cubic spline of Re and Im in log f."""
     if line_freqs.size < 4:
         return np.interp(freqs, line_freqs, h.real) + 1j * np.interp(freqs, line_freqs, h.imag)
-    from scipy.interpolate import CubicSpline      # 0.1 s to import: only when the voltage carries off its lines
-    return CubicSpline(np.log(line_freqs), h, extrapolate=True)(np.log(freqs))
+    return spline_at(np.log(line_freqs), h, np.log(freqs))
 
 
 def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarray,
