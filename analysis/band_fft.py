@@ -75,6 +75,13 @@ class BandFFT:
             joined += even_odd[0, self.lo:self.hi]
         return self.band
 
+    def row_sums(self) -> np.ndarray:
+        """Each row's sum of samples, from the last transform's DC bins."""
+        whole = self._whole_spectra[:, 0].real
+        if not self._split:
+            return whole.copy()
+        return np.append(whole, self._half_spectra[0, 0].real + self._half_spectra[1, 0].real)
+
 
 @functools.cache
 def _keep_scratch_in_heap() -> bool:

@@ -108,6 +108,7 @@ class LiveAccumulator:
         self._var = np.empty((len(self.signals), span.size))
         self._fft = BandFFT(len(self.signals), self.period_samples, self._lo, self._hi)
         self._x_sum = np.zeros(self.period_samples)      # the displacement's periods summed, for its peak
+        self._x_total = 0.0                               # and the sum of that sum's samples
         self._n = 0
 
     @property
@@ -118,6 +119,7 @@ class LiveAccumulator:
         self._mean[:] = 0
         self._m2[:] = 0
         self._x_sum[:] = 0
+        self._x_total = 0.0
         self._n = 0
 
     def channel_spectra(self) -> dict[str, ChannelSpectrum]:
@@ -133,6 +135,8 @@ class LiveAccumulator:
         if self._x_row is not None:
             self._x_sum += rows[self._x_row]
         delta = self._fft.transform(rows)
+        if self._x_row is not None:
+            self._x_total += float(self._fft.row_sums()[self._x_row])
         delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
         self._n = n
         # In place, no temporaries of the band's size: X - mean_new = d (1 - 1/n), so M2 += |d|^2 (n-1)/n.
@@ -197,8 +201,11 @@ class LiveAccumulator:
         statuses = [ch.status for ch in channels.values()]
         overall = UNKNOWN if UNKNOWN in statuses else str(worst(f.severity for ch in channels.values()
                                                                  for f in ch.findings))
-        # The peak of the coherent mean period: of the sum, divided by the count (one pass a period, not three).
-        peak = peak_of_period(self._x_sum) / self._n if self._x_row is not None else None
+        # The peak of the coherent mean period: of the sum, divided by the count (one pass a period, not three),
+        # about the sum's mean from the FFT's DC bins.
+        peak = None
+        if self._x_row is not None:
+            peak = peak_of_period(self._x_sum, self._x_total / self.period_samples) / self._n
         other_freqs = self._other_buckets.freqs if self._other_buckets is not None else _frozen(np.zeros(0))
         return LiveFrame(self._n, self._line_freqs, other_freqs, self._noise_buckets.freqs,
                          MappingProxyType(channels), overall, peak)

@@ -61,3 +61,42 @@ def _window_counts(n: int, window: int) -> np.ndarray:
     counts = np.minimum(index + half, n - 1) - np.maximum(index - half, 0) + 1
     counts.flags.writeable = False
     return counts
+
+
+def above_pooled_mean(values: np.ndarray, window: int, test: np.ndarray,
+                      factor: float) -> tuple[np.ndarray, np.ndarray]:
+    """Where test > factor * pooled_mean(values, window), for one row of non-negative values (variances): the
+    indices and the pooled means there.
+
+    Only candidates get their window summed: each centred window of 2h + 1 holds a whole aligned block of h
+    values (block (k - 1) // h for k >= 1, block 0 for k = 0), so that block's sum over the window's count
+    bounds the pooled mean from below, and a value the bound clears cannot clear the mean. Noise puts ~1 %
+    of 13,532 lines above 10 x the bound against ~0.01 % above 10 x the mean; a live frame asks this of the
+    voltage's unexcited lines every period (the whole pooled mean: 0.1 ms).
+    """
+    window = max(1, int(window)) | 1
+    n = values.shape[-1]
+    if window == 1 or n < 2:
+        pooled = pooled_mean(values, window)
+        index = np.flatnonzero(test > factor * pooled)
+        return index, pooled[index]
+    half = window // 2
+    block_of, scale = _block_bounds(n, window, float(factor))
+    bound = np.add.reduceat(values, np.arange(0, n, half))[block_of]
+    bound *= scale                  # factor / count, a hair under it: rounding never drops a true candidate
+    candidates = np.flatnonzero(test > bound)
+    padded = np.concatenate((np.zeros(half), values, np.zeros(half)))
+    pooled = padded[candidates[:, None] + np.arange(window)].sum(axis=1) / _window_counts(n, window)[candidates]
+    above = test[candidates] > factor * pooled
+    return candidates[above], pooled[above]
+
+
+@functools.lru_cache(maxsize=32)
+def _block_bounds(n: int, window: int, factor: float) -> tuple[np.ndarray, np.ndarray]:
+    """For each of n values: the aligned block of window // 2 that its window surely holds, and
+    factor / (its window's count), lowered by 1e-12 relative."""
+    half = window // 2
+    block_of = np.maximum((np.arange(n) - 1) // half, 0)
+    scale = factor * (1.0 - 1e-12) / _window_counts(n, window)
+    block_of.flags.writeable = scale.flags.writeable = False
+    return block_of, scale

@@ -30,7 +30,7 @@ import numpy as np
 
 from analysis.validity.knot_spline import spline_at
 from analysis.validity.line_spectra import LineSpectra
-from analysis.validity.pooling import pooled_mean
+from analysis.validity.pooling import above_pooled_mean
 
 # A voltage line counts as carrying something (amplifier distortion) above this |U|^2 / <var_U>.
 _VOLTAGE_CARRIES = 10.0
@@ -86,8 +86,11 @@ def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.n
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(v > 0, r / v, np.where(r > 0, np.inf, 1.0))   # noise-free: 1 when empty, else inf
     worst = np.argmax(ratio, axis=-1)
-    excess = np.subtract(residual, var)
-    excess = np.maximum(excess, 0.0, out=excess).sum(axis=-1)
+    # sum max(|R|^2 - V, 0) as sum max(|R|^2, V) - sum V: no array of the differences (noise alone puts the
+    # excess at ~e^-1 of sum V, so no cancellation to speak of; with |R|^2 <= V everywhere both sums are the
+    # same terms in the same order, and the excess exactly 0, as before).
+    excess = np.maximum(residual, var).sum(axis=-1) - var.sum(axis=-1)
+    np.maximum(excess, 0.0, out=excess)
     out = {}
     for i, name in enumerate(judged):
         band = int(worst[i])
@@ -119,17 +122,20 @@ def _residuals(spectra: LineSpectra, judged: list[str], rows: list[int], line_fr
 
 def _voltage_parts(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarray,
                    other_freqs: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
-    """For the current and the displacement among `judged`, where the voltage carries: the lines, |R_k|^2 there
-    and what the voltage's noise adds to V_k there (|H_k|^2 <var_U>_k). Empty where nothing carries."""
-    voltage = spectra.row("voltage")
-    u_var = pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL)
-    carries = spectra.other_power[voltage] > _VOLTAGE_CARRIES * u_var
+    """For the current and the displacement among `judged`, where the voltage carries: the lines (indices),
+    |R_k|^2 there and what the voltage's noise adds to V_k there (|H_k|^2 <var_U>_k). Empty where nothing
+    carries."""
     names = [name for name in judged if name != "voltage"]
-    if not names or not carries.any():
+    if not names:
+        return []
+    voltage = spectra.row("voltage")
+    carries, u_var_carries = above_pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL,
+                                               spectra.other_power[voltage], _VOLTAGE_CARRIES)
+    if not carries.size:
         return []
     u_lines = spectra.lines[voltage]
     h_all = _transfers(spectra, names, u_lines, line_freqs, other_freqs[carries])
-    u_carries, u_var_carries = spectra.other[voltage][carries], u_var[carries]
+    u_carries = spectra.other[voltage][carries]
     parts = []
     for name in names:
         row = spectra.row(name)
