@@ -30,7 +30,7 @@ import numpy as np
 
 from analysis.validity.knot_spline import spline_at
 from analysis.validity.line_spectra import LineSpectra
-from analysis.validity.pooling import above_pooled_mean
+from analysis.validity.pooling import pooled_mean
 
 # A voltage line counts as carrying something (amplifier distortion) above this |U|^2 / <var_U>.
 _VOLTAGE_CARRIES = 10.0
@@ -129,10 +129,11 @@ def _voltage_parts(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarr
     if not names:
         return []
     voltage = spectra.row("voltage")
-    carries, u_var_carries = above_pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL,
-                                               spectra.other_power[voltage], _VOLTAGE_CARRIES)
+    u_var = pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL)
+    carries = np.flatnonzero(spectra.other_power[voltage] > _VOLTAGE_CARRIES * u_var)
     if not carries.size:
         return []
+    u_var_carries = u_var[carries]
     u_lines = spectra.lines[voltage]
     h_all = _transfers(spectra, names, u_lines, line_freqs, other_freqs[carries])
     u_carries = spectra.other[voltage][carries]

@@ -3,7 +3,7 @@ on a 2-D array, and a huge or infinite value spoiling only its own windows."""
 import numpy as np
 import pytest
 
-from analysis.validity.pooling import above_pooled_mean, pooled_mean
+from analysis.validity.pooling import pooled_mean
 
 
 def test_the_pooled_mean_gives_the_same_for_each_size_its_kept_windows_serve():
@@ -41,27 +41,3 @@ def test_the_pooled_mean_of_a_2d_array_is_each_row_s_bit_for_bit(n, window):
     together = pooled_mean(rows, window)
     for row in range(3):
         np.testing.assert_array_equal(together[row], pooled_mean(rows[row].copy(), window))
-
-
-@pytest.mark.parametrize("window", [1, 3, 5, 33])
-def test_the_values_above_the_pooled_mean_are_those_the_whole_pooled_mean_finds(window):
-    rng = np.random.default_rng(window)
-    for n in (1, 2, 40, 13532):
-        var = rng.exponential(1.0, n) * 10.0 ** rng.uniform(-3, 3, n)       # variances over six decades
-        power = var * rng.exponential(1.0, n)                              # noise: |X|^2 scatters about var
-        power[rng.choice(n, max(1, n // 500), replace=False)] *= 1e3        # and some lines carry something
-        var[rng.choice(n, max(1, n // 2000), replace=False)] = 0.0
-        pooled = pooled_mean(var, window)
-        expected = np.flatnonzero(power > 10.0 * pooled)
-        index, pooled_there = above_pooled_mean(var, window, power, 10.0)
-        np.testing.assert_array_equal(index, expected)
-        np.testing.assert_allclose(pooled_there, pooled[expected], rtol=1e-12)
-
-
-def test_a_nan_or_infinite_variance_lets_no_line_of_its_windows_count_as_above():
-    var = np.full(200, 1.0)
-    var[50], var[150] = np.nan, np.inf
-    power = np.full(200, 100.0)
-    index, _ = above_pooled_mean(var, 33, power, 10.0)
-    np.testing.assert_array_equal(index, np.flatnonzero(power > 10.0 * pooled_mean(var, 33)))
-    assert not np.any((index >= 50 - 16) & (index <= 50 + 16)) and not np.any((index >= 150 - 16) & (index <= 150 + 16))
