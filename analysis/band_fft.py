@@ -39,11 +39,12 @@ _HEAP_KEEPS_FREE = 32 << 20
 
 
 class BandFFT:
-    """Bins lo .. hi-1 of the FFT of `rows` rows of `samples` real samples, in a kept (rows, hi - lo) array."""
+    """Bins lo .. hi-1 of the FFT of `rows` rows of `samples` real samples, times `scale`, in a kept
+    (rows, hi - lo) array (the scale applied as the band is copied out, not in a pass of its own)."""
 
-    def __init__(self, rows: int, samples: int, lo: int, hi: int):
+    def __init__(self, rows: int, samples: int, lo: int, hi: int, scale: float = 1.0):
         _keep_scratch_in_heap()
-        self.lo, self.hi = lo, hi
+        self.lo, self.hi, self.scale = lo, hi, float(scale)
         self._split = rows % 2 == 1 and samples % 2 == 0 and hi - 1 <= samples // 4
         whole = rows - 1 if self._split else rows
         self._whole = np.empty((whole, samples))       # the whole rows, unless they come as one array
@@ -51,11 +52,11 @@ class BandFFT:
         if self._split:
             self._halves = np.empty((2, samples // 2))
             self._half_spectra = np.empty((2, samples // 4 + 1), dtype=np.complex128)
-            self._twiddle = np.exp(-2j * np.pi * np.arange(lo, hi) / samples)
+            self._twiddle = np.exp(-2j * np.pi * np.arange(lo, hi) / samples) * self.scale
         self.band = np.empty((rows, hi - lo), dtype=np.complex128)
 
     def transform(self, rows: Sequence[np.ndarray] | np.ndarray) -> np.ndarray:
-        """The band of each row's FFT (unscaled), written into `band` and returned; the rows are not changed.
+        """The band of each row's FFT times `scale`, written into `band` and returned; the rows are not changed.
         Rows of one C-contiguous float64 array are read where they are; separate rows are copied together."""
         whole = self._whole.shape[0]
         if whole:
@@ -66,13 +67,13 @@ class BandFFT:
                     self._whole[index] = rows[index]
                 source = self._whole
             spectra = np.fft.rfft(source, axis=-1, out=self._whole_spectra)
-            self.band[:whole] = spectra[:, self.lo:self.hi]
+            np.multiply(spectra[:, self.lo:self.hi], self.scale, out=self.band[:whole])
         if self._split:
             last = rows[whole]
             self._halves[0], self._halves[1] = last[0::2], last[1::2]
             even_odd = np.fft.rfft(self._halves, axis=-1, out=self._half_spectra)
             joined = np.multiply(even_odd[1, self.lo:self.hi], self._twiddle, out=self.band[whole])
-            joined += even_odd[0, self.lo:self.hi]
+            joined += self.scale * even_odd[0, self.lo:self.hi]
         return self.band
 
     def row_sums(self) -> np.ndarray:

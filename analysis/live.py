@@ -106,7 +106,8 @@ class LiveAccumulator:
         # Kept for Welford's update and the variance of the mean: no band-sized temporaries per period.
         self._step = np.empty((2, len(self.signals), span.size))
         self._var = np.empty((len(self.signals), span.size))
-        self._fft = BandFFT(len(self.signals), self.period_samples, self._lo, self._hi)
+        # Peak amplitudes (2/N; the band holds no DC or Nyquist bin), scaled as the band is copied out.
+        self._fft = BandFFT(len(self.signals), self.period_samples, self._lo, self._hi, 2.0 / self.period_samples)
         self._x_sum = np.zeros(self.period_samples)      # the displacement's periods summed, for its peak
         self._x_total = 0.0                               # and the sum of that sum's samples
         self._n = 0
@@ -134,10 +135,9 @@ class LiveAccumulator:
         n = self._n + 1
         if self._x_row is not None:
             self._x_sum += rows[self._x_row]
-        delta = self._fft.transform(rows)
+        delta = self._fft.transform(rows)               # X, peak amplitudes
         if self._x_row is not None:
             self._x_total += float(self._fft.row_sums()[self._x_row])
-        delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
         self._n = n
         # In place, no temporaries of the band's size: X - mean_new = d (1 - 1/n), so M2 += |d|^2 (n-1)/n.
         delta -= self._mean

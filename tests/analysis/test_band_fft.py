@@ -19,11 +19,12 @@ def test_the_band_is_the_whole_fft_s_and_the_rows_are_left_as_they_were(rows, sa
     data = rng.standard_normal((rows, samples)) * [[1.0], [1e-3], [5e-4]][:rows]
     data += np.cos(2 * np.pi * 13 * t / samples)[None, :] * np.arange(1, rows + 1)[:, None] + 0.3   # a line, an offset
     before = data.copy()
-    fft = BandFFT(rows, samples, lo, hi)
-    for _ in range(2):                                  # the kept buffers are reused
-        got = fft.transform(list(data))
-    expected = np.fft.rfft(before, axis=-1)[:, lo:hi]
+    fft = BandFFT(rows, samples, lo, hi, scale=2.0 / samples)
+    for source in (list(data), data):                   # separate rows, one array; the kept buffers reused
+        got = fft.transform(source)
+    expected = np.fft.rfft(before, axis=-1)[:, lo:hi] * (2.0 / samples)
     for row in range(rows):
         scale = np.max(np.abs(expected[row]))
         np.testing.assert_allclose(got[row], expected[row], rtol=0, atol=1e-13 * scale)
     np.testing.assert_array_equal(data, before)
+    np.testing.assert_allclose(fft.row_sums(), before.sum(axis=-1), rtol=1e-12)
