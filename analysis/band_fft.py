@@ -27,8 +27,8 @@ once. Elsewhere than glibc nothing is asked.
 from __future__ import annotations
 
 import ctypes
-import ctypes.util
 import functools
+import sys
 from typing import Sequence
 
 import numpy as np
@@ -88,10 +88,11 @@ class BandFFT:
 def _keep_scratch_in_heap() -> bool:
     """Blocks of up to 8 MB from the heap, 32 MB kept free at its top (see the module doc); True if glibc
     took it."""
+    if not sys.platform.startswith("linux"):
+        return False
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):      # not glibc (macOS, Windows, musl without mallopt): nothing to ask
+        mallopt = ctypes.CDLL(None).mallopt     # the process's own symbols: libc's, without a library search
+    except (OSError, AttributeError):           # a C library without mallopt: nothing to ask
         return False
     mallopt.argtypes, mallopt.restype = (ctypes.c_int, ctypes.c_int), ctypes.c_int
     return bool(mallopt(_M_MMAP_THRESHOLD, _HEAP_BLOCKS_UP_TO)) and bool(mallopt(_M_TRIM_THRESHOLD, _HEAP_KEEPS_FREE))
