@@ -18,12 +18,14 @@ import numpy as np
 from analysis.recording.format import Recording
 
 
-def peak_of_period(mean_period: np.ndarray) -> float:
-    """Largest |x - mean(x)| of one (averaged) period, m."""
+def peak_of_period(mean_period: np.ndarray, centre: float | None = None) -> float:
+    """Largest |x - mean(x)| of one (averaged) period, m. `centre`: mean(x), when already known (a live frame
+    has it from the FFT's DC bin: one pass over the period fewer)."""
     x = np.asarray(mean_period, dtype=np.float64)
     if x.size == 0:
         return 0.0
-    centre = x.mean()
+    if centre is None:
+        centre = x.mean()
     return float(max(x.max() - centre, centre - x.min()))
 
 

@@ -32,8 +32,8 @@ from types import MappingProxyType
 from typing import Mapping, Sequence
 
 import numpy as np
-import scipy.fft
 
+from analysis.band_fft import BandFFT
 from analysis.excursion import peak_of_period
 from analysis.log_buckets import LogBuckets
 from analysis.recording.format import UNITS
@@ -106,9 +106,10 @@ class LiveAccumulator:
         # Kept for Welford's update and the variance of the mean: no band-sized temporaries per period.
         self._step = np.empty((2, len(self.signals), span.size))
         self._var = np.empty((len(self.signals), span.size))
-        self._x_mean = np.zeros(self.period_samples)
-        self._data = np.empty((len(self.signals), self.period_samples))
-        self._x_step = np.empty(self.period_samples)
+        # Peak amplitudes (2/N; the band holds no DC or Nyquist bin), scaled as the band is copied out.
+        self._fft = BandFFT(len(self.signals), self.period_samples, self._lo, self._hi, 2.0 / self.period_samples)
+        self._x_sum = np.zeros(self.period_samples)      # the displacement's periods summed, for its peak
+        self._x_total = 0.0                               # and the sum of that sum's samples
         self._n = 0
 
     @property
@@ -118,7 +119,8 @@ class LiveAccumulator:
     def reset(self) -> None:
         self._mean[:] = 0
         self._m2[:] = 0
-        self._x_mean[:] = 0
+        self._x_sum[:] = 0
+        self._x_total = 0.0
         self._n = 0
 
     def channel_spectra(self) -> dict[str, ChannelSpectrum]:
@@ -129,16 +131,13 @@ class LiveAccumulator:
 
     def add_period(self, period: Mapping[str, np.ndarray] | np.ndarray) -> LiveFrame:
         """One period of every signal (a mapping by name, or rows in `signals` order) -> the new frame."""
-        data = self._stacked(period)
+        rows = self._rows(period)
         n = self._n + 1
-        if self._x_row is not None:                    # before the FFT, which may overwrite the samples
-            x = np.subtract(data[self._x_row], self._x_mean, out=self._x_step)
-            x *= 1.0 / n
-            self._x_mean += x
-        # scipy's FFT works in our own buffer (overwrite_x; data is ours, see _stacked): 10-15 % less CPU than
-        # numpy's rfft into a kept buffer, copy included, and the same values bit for bit.
-        delta = scipy.fft.rfft(data, axis=-1, overwrite_x=True, workers=1)[:, self._lo:self._hi]
-        delta *= 2.0 / self.period_samples             # peak amplitudes; the band holds no DC or Nyquist bin
+        if self._x_row is not None:
+            self._x_sum += rows[self._x_row]
+        delta = self._fft.transform(rows)               # X, peak amplitudes
+        if self._x_row is not None:
+            self._x_total += float(self._fft.row_sums()[self._x_row])
         self._n = n
         # In place, no temporaries of the band's size: X - mean_new = d (1 - 1/n), so M2 += |d|^2 (n-1)/n.
         delta -= self._mean
@@ -152,9 +151,9 @@ class LiveAccumulator:
 
     # --- internals ----------------------------------------------------------------------------
 
-    def _stacked(self, period) -> np.ndarray:
-        """The period's rows copied into the accumulator's own buffer (add_period works in it; a fresh 1.5 MB
-        array per period would cost its pages' faults each time)."""
+    def _rows(self, period) -> list[np.ndarray] | np.ndarray:
+        """The period's rows in `signals` order, as float64, checked (not copied: BandFFT copies them into
+        its kept buffers, where a fresh 1.5 MB array per period would cost its pages' faults each time)."""
         if isinstance(period, Mapping):
             missing = [s for s in self.signals if s not in period]
             if missing:
@@ -164,12 +163,10 @@ class LiveAccumulator:
         else:
             rows = np.asarray(period, dtype=np.float64)
             shape = rows.shape
-        if shape != self._data.shape:
+        if shape != (len(self.signals), self.period_samples):
             raise ValueError(f"expected {len(self.signals)} signals of {self.period_samples} samples, "
                              f"got shape {shape}")
-        for index, row in enumerate(rows):          # row by row: a list would first be stacked into a new array
-            self._data[index] = row
-        return self._data
+        return rows
 
     def _var_mean(self) -> np.ndarray:
         """The variance of the mean, in the kept buffer (the next period overwrites it)."""
@@ -204,7 +201,11 @@ class LiveAccumulator:
         statuses = [ch.status for ch in channels.values()]
         overall = UNKNOWN if UNKNOWN in statuses else str(worst(f.severity for ch in channels.values()
                                                                  for f in ch.findings))
-        peak = peak_of_period(self._x_mean) if self._x_row is not None else None
+        # The peak of the coherent mean period: of the sum, divided by the count (one pass a period, not three),
+        # about the sum's mean from the FFT's DC bins.
+        peak = None
+        if self._x_row is not None:
+            peak = peak_of_period(self._x_sum, self._x_total / self.period_samples) / self._n
         other_freqs = self._other_buckets.freqs if self._other_buckets is not None else _frozen(np.zeros(0))
         return LiveFrame(self._n, self._line_freqs, other_freqs, self._noise_buckets.freqs,
                          MappingProxyType(channels), overall, peak)

@@ -82,7 +82,8 @@ def quantile(values: np.ndarray, q: float) -> float:
 
 def line_snr_db(lines: np.ndarray, var: np.ndarray, pool: int) -> np.ndarray:
     """SNR of each excited line in dB against the pooled noise; a silent, noise-free line is -inf."""
-    power = np.abs(lines) ** 2
+    power = np.square(lines.real)
+    power += np.square(lines.imag)
     noise = pooled_mean(var, pool)
     with np.errstate(divide="ignore", invalid="ignore"):
         snr = 10.0 * np.log10(power / noise)

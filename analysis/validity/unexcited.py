@@ -10,7 +10,8 @@ distortion power over the noise power.
 R_k is the unexcited line itself for the voltage. For the current and the
 displacement it is what the voltage does not explain: R_k = Y_k - H(f_k) U_k,
 with H = Y/U interpolated from the excited lines (cubic spline in log f,
-~1e-3 accurate on the project's grid). So an amplifier that clips shows in the
+~1e-3 accurate on the project's grid; analysis.validity.knot_spline keeps it
+as a linear map per set of lines). So an amplifier that clips shows in the
 voltage only, and a distorted current means the driver itself is nonlinear.
 The voltage part is removed only on lines where the voltage carries more than
 noise, |U_k|^2 > 10 <var_U>_k (the voltage's noise pooled over 33 lines, so
@@ -27,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from analysis.validity.knot_spline import spline_at
 from analysis.validity.line_spectra import LineSpectra
 from analysis.validity.pooling import pooled_mean
 
@@ -68,8 +70,7 @@ def interpolated_transfer(line_freqs: np.ndarray, h: np.ndarray, freqs: np.ndarr
     """H at `freqs` from its values at the excited lines: cubic spline of Re and Im in log f."""
     if line_freqs.size < 4:
         return np.interp(freqs, line_freqs, h.real) + 1j * np.interp(freqs, line_freqs, h.imag)
-    from scipy.interpolate import CubicSpline      # 0.1 s to import: only when the voltage carries off its lines
-    return CubicSpline(np.log(line_freqs), h, extrapolate=True)(np.log(freqs))
+    return spline_at(np.log(line_freqs), h, np.log(freqs))
 
 
 def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarray,
@@ -85,8 +86,11 @@ def unexcited_measures(spectra: LineSpectra, judged: list[str], line_freqs: np.n
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(v > 0, r / v, np.where(r > 0, np.inf, 1.0))   # noise-free: 1 when empty, else inf
     worst = np.argmax(ratio, axis=-1)
-    excess = np.subtract(residual, var)
-    excess = np.maximum(excess, 0.0, out=excess).sum(axis=-1)
+    # sum max(|R|^2 - V, 0) as sum max(|R|^2, V) - sum V: no array of the differences (noise alone puts the
+    # excess at ~e^-1 of sum V, so no cancellation to speak of; with |R|^2 <= V everywhere both sums are the
+    # same terms in the same order, and the excess exactly 0, as before).
+    excess = np.maximum(residual, var).sum(axis=-1) - var.sum(axis=-1)
+    np.maximum(excess, 0.0, out=excess)
     out = {}
     for i, name in enumerate(judged):
         band = int(worst[i])
@@ -118,17 +122,21 @@ def _residuals(spectra: LineSpectra, judged: list[str], rows: list[int], line_fr
 
 def _voltage_parts(spectra: LineSpectra, judged: list[str], line_freqs: np.ndarray,
                    other_freqs: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray, np.ndarray]]:
-    """For the current and the displacement among `judged`, where the voltage carries: the lines, |R_k|^2 there
-    and what the voltage's noise adds to V_k there (|H_k|^2 <var_U>_k). Empty where nothing carries."""
+    """For the current and the displacement among `judged`, where the voltage carries: the lines (indices),
+    |R_k|^2 there and what the voltage's noise adds to V_k there (|H_k|^2 <var_U>_k). Empty where nothing
+    carries."""
+    names = [name for name in judged if name != "voltage"]
+    if not names:
+        return []
     voltage = spectra.row("voltage")
     u_var = pooled_mean(spectra.other_var[voltage], _VOLTAGE_POOL)
-    carries = spectra.other_power[voltage] > _VOLTAGE_CARRIES * u_var
-    names = [name for name in judged if name != "voltage"]
-    if not names or not carries.any():
+    carries = np.flatnonzero(spectra.other_power[voltage] > _VOLTAGE_CARRIES * u_var)
+    if not carries.size:
         return []
+    u_var_carries = u_var[carries]
     u_lines = spectra.lines[voltage]
     h_all = _transfers(spectra, names, u_lines, line_freqs, other_freqs[carries])
-    u_carries, u_var_carries = spectra.other[voltage][carries], u_var[carries]
+    u_carries = spectra.other[voltage][carries]
     parts = []
     for name in names:
         row = spectra.row(name)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from analysis.live import DB_FLOOR, UNKNOWN, LiveAccumulator
+from analysis.live import DB_FLOOR, DISPLAY_BUCKETS, UNKNOWN, LiveAccumulator
 from analysis.spectra import estimate_spectra
 from analysis.synthesis import ChannelNoise
 from tests.builders import multitone, recording
@@ -132,3 +132,56 @@ def test_every_frame_judges_as_the_whole_recording_s_checks_on_the_same_spectra(
             assert dict(live.measures) == measures, (p, name)
             seen |= {(name, f.code) for f in live.findings}
     assert (channel, code) in seen              # the fault is judged, not only two empty lists compared
+
+
+@pytest.mark.parametrize("fault", ["clean", "amplifier_clipping", "low_snr", "laser_bandwidth_low"])
+def test_every_frame_says_what_the_float64_batch_path_says_on_the_same_periods(fault):
+    # The live path takes its shortcuts (the third row's FFT from its even and odd samples, Welford's
+    # running update, the excursion's centre from the DC bins); the batch path averages each period's whole
+    # FFT. Same lights, same findings word for word; numbers within 1e-6 relative, drawn dB within 1e-6 dB.
+    from analysis.excursion import peak_excursion
+    from analysis.log_buckets import LogBuckets
+    from analysis.recording.format import UNITS
+    from analysis.spectra import ChannelSpectrum, period_spectra
+    from analysis.thresholds import DEFAULT_THRESHOLDS
+    from analysis.validity.findings import worst
+    from analysis.validity.spectral import spectral_checks
+    from instruments.simulation import faults
+    rec = getattr(faults, fault)()
+    excited = np.asarray(rec.excited_bins)
+    lo, hi = int(excited[0]), int(excited[-1]) + 1
+    band_excited = excited - lo
+    band_unexcited = np.setdiff1d(np.arange(hi - lo), band_excited)
+    acc = LiveAccumulator(rec.sample_rate, rec.period_samples, excited)
+    spectra = {s: period_spectra(rec.periods(s))[:, lo:hi] for s in SIGNALS}
+    bin_width = rec.sample_rate / rec.period_samples
+    noise_buckets = LogBuckets(np.arange(lo, hi) * bin_width, DISPLAY_BUCKETS)
+    judged = set()
+    for p in range(rec.n_periods):
+        frame = acc.add_period(_periods(rec, p))
+        assert frame.peak_displacement_m == pytest.approx(peak_excursion(rec.periods("displacement")[:p + 1]),
+                                                          rel=1e-9)
+        if p == 0:
+            continue
+        reference = {}
+        for s in SIGNALS:
+            mean = spectra[s][:p + 1].mean(axis=0)
+            dev = spectra[s][:p + 1] - mean
+            var_mean = (dev.real**2 + dev.imag**2).sum(axis=0) / (p * (p + 1))
+            reference[s] = ChannelSpectrum(s, UNITS[s], mean, var_mean)
+        checks = spectral_checks(reference, band_excited, band_unexcited, bin_width, DEFAULT_THRESHOLDS,
+                                 first_bin=lo)
+        assert frame.status == str(worst(f.severity for findings, _ in checks.values() for f in findings))
+        for name, live in frame.channels.items():
+            findings, measures = checks[name]
+            assert [(f.code, f.severity, f.message, f.remedy) for f in live.findings] == \
+                [(f.code, f.severity, f.message, f.remedy) for f in findings], (p, name)
+            np.testing.assert_allclose([f.value for f in live.findings], [f.value for f in findings], rtol=1e-6)
+            assert live.measures.keys() == measures.keys()
+            np.testing.assert_allclose(list(live.measures.values()), list(measures.values()),
+                                       rtol=1e-6, atol=1e-6)
+            ref = reference[name]
+            np.testing.assert_allclose(live.line_db, 10 * np.log10(np.abs(ref.mean[band_excited]) ** 2), atol=1e-6)
+            np.testing.assert_allclose(live.noise_db, noise_buckets.power_mean_db(ref.var_mean), atol=1e-6)
+            judged |= {(name, f.code) for f in live.findings}
+    assert judged or fault == "clean"           # a fault is judged, not only empty lists compared
