@@ -27,7 +27,8 @@ from PySide6.QtWidgets import QAbstractScrollArea, QGraphicsItem, QGraphicsTextI
 DRAWING_ITEMS = (pg.AxisItem, pg.PlotCurveItem, pg.ScatterPlotItem, pg.ErrorBarItem, pg.InfiniteLine,
                  QGraphicsTextItem)
 # Room for the pixmaps, in KiB (Qt's default is 10 MiB, shared with the style's own pixmaps). Each item keeps at
-# most its part of the view: the Results page's plots on a 1920 x 1080 screen keep ~35 MiB, the Model lab's ~10.
+# most its part of the view: in a 1920 x 1080 window one of the Results page's transfer plots keeps ~26 MiB, the
+# Model lab's plots ~8 MiB. Beyond the room, the pixmaps used longest ago are dropped and drawn again when needed.
 PIXMAP_ROOM_KIB = 128 * 1024
 
 
