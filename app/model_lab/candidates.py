@@ -14,10 +14,12 @@ from analysis.diagnosis import acceptance
 from analysis.diagnosis.words import VERDICT_TITLES
 from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome
 from app.model_lab.catalogue import category_title
+from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
 # The reduced chi^2 per channel is in the Fit cell's tooltip: the columns must fit a 1280 px screen.
 COLUMNS = ("#", "Action", "Effect", "Category", "Fit", "Acceptable")
 RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, JUDGED = range(len(COLUMNS))
+SIZED_COLUMNS = (RANK, ACTION, CATEGORY, DELTA_BIC, JUDGED)      # as wide as their contents
 # The word scale of a BIC change (Kass and Raftery's grades of evidence), the best grade first.
 FIT_WORDS = ((-10.0, "fits far better"), (-6.0, "fits better"), (-2.0, "slightly better"), (2.0, "no better"))
 WORSE = "fits worse"
@@ -114,11 +116,10 @@ class CandidatesPanel(QWidget):
         self.table.setAlternatingRowColors(True)
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 6)
-        header = self.table.horizontalHeader()
-        for column in range(len(COLUMNS)):
-            header.setSectionResizeMode(column, QHeaderView.ResizeToContents)
         # The effect's title takes what is left, elided (whole in its tooltip); the category is read whole.
-        header.setSectionResizeMode(EFFECT, QHeaderView.Stretch)
+        self.table.horizontalHeader().setSectionResizeMode(EFFECT, QHeaderView.Stretch)
+        sized_when_filled(self.table, SIZED_COLUMNS)       # measured when filled, not at each show of the lab
+        fit_to_contents(self.table, SIZED_COLUMNS)
         self.table.setTextElideMode(Qt.ElideRight)
         self.table.setWordWrap(False)
         self.table.itemSelectionChanged.connect(self.on_selection_changed)
@@ -141,8 +142,9 @@ class CandidatesPanel(QWidget):
         self.table.clearSelection()
         self.rows = outcome.candidates if outcome is not None else ()
         chosen = outcome.chosen if outcome is not None else None
-        # Emptied first: an item put in place of another makes the ResizeToContents columns measure every row
-        # again (135 ms of the GUI thread for a second diagnosis's 24 rows; into empty rows 5 ms).
+        # Emptied first, then filled: every row is new. The columns are measured once, when filled (a column
+        # sized to its contents by Qt measured every row again at each item put in: 135 ms of the GUI thread for
+        # a second diagnosis's 24 rows).
         self.table.setRowCount(0)
         self.table.setRowCount(len(self.rows))
         gains = [-row.delta_bic for row in self.rows if math.isfinite(row.delta_bic)]
@@ -176,6 +178,7 @@ class CandidatesPanel(QWidget):
                     font.setBold(True)     # the acceptance rule would take it
                     item.setFont(font)
                 self.table.setItem(r, column, item)
+        fit_to_contents(self.table, SIZED_COLUMNS)
         if outcome is None:
             self._heading = "<b>Diagnosis</b>"
             self.title.setText(self._heading)

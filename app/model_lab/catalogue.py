@@ -12,11 +12,12 @@ import html
 
 from PySide6.QtCore import QEvent, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
+from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QLabel, QPushButton, QSizePolicy,
                                QSplitter, QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.effects import Effect, categories, registry
 from app.widgets import style
+from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
 EFFECT_ROLE = Qt.UserRole
 CATEGORY_TITLES = {       # the ids are for code; these are for the reader
@@ -95,7 +96,7 @@ class EffectCatalogue(QWidget):
         self.tree.setColumnCount(2)
         self.tree.setSelectionMode(QAbstractItemView.SingleSelection)
         self.tree.setMouseTracking(True)           # itemEntered: explain the effect under the pointer
-        self.tree.header().setSectionResizeMode(0, QHeaderView.ResizeToContents)
+        sized_when_filled(self.tree, (0,))      # the ids measured when the list changes, not at each show
         # Categories are headings, always open: no expand arrows, and little indentation, so the
         # narrow column keeps its room for the titles.
         self.tree.setRootIsDecorated(False)
@@ -114,6 +115,7 @@ class EffectCatalogue(QWidget):
         self._problems: list[str] = []
         self.refresh_user_effects()
         self.tree.expandAll()
+        fit_to_contents(self.tree, (0,))
         self.tree.itemChanged.connect(self.on_item_changed)
         self.tree.itemEntered.connect(self.on_item_entered)
         self.tree.currentItemChanged.connect(self.on_current_changed)
@@ -200,6 +202,7 @@ class EffectCatalogue(QWidget):
         finally:
             self._updating = False
         self.set_displacement_available(self._displacement)
+        fit_to_contents(self.tree, (0,))
 
     # -- state -------------------------------------------------------------
     def checked(self) -> tuple[str, ...]:

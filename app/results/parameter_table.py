@@ -25,9 +25,11 @@ from analysis.derived import NO_SD, ParameterValue
 from analysis.parameter_names import DISPLAY_NAMES, THIELE_SMALL, display_name  # noqa: F401 (shared)
 from analysis.report.numbers import pretty_unit, short_number
 from app.widgets import style
+from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
 NAME, VALUE, STD, UNIT = range(4)
+SIZED_COLUMNS = (NAME, STD, UNIT)       # as wide as their contents; the value takes the rest
 
 INTERNAL_TITLE = "Model's internal quantities"
 DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
@@ -262,11 +264,9 @@ class ParameterTable(QTableView):
         self.setTextElideMode(Qt.ElideRight)
         self.verticalHeader().setVisible(False)
         self.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 8)
-        header = self.horizontalHeader()
-        header.setSectionResizeMode(NAME, QHeaderView.ResizeToContents)
-        header.setSectionResizeMode(VALUE, QHeaderView.Stretch)
-        header.setSectionResizeMode(STD, QHeaderView.ResizeToContents)
-        header.setSectionResizeMode(UNIT, QHeaderView.ResizeToContents)
+        self.horizontalHeader().setSectionResizeMode(VALUE, QHeaderView.Stretch)
+        sized_when_filled(self, SIZED_COLUMNS)       # measured at each fill, not at each show of the page
+        fit_to_contents(self, SIZED_COLUMNS)         # empty: as wide as their titles
         self.internal_folded = False
         self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
         self.parameter_model.modelReset.connect(self._apply_spans)
@@ -295,6 +295,7 @@ class ParameterTable(QTableView):
             self.setRowHidden(row, below_section and self.internal_folded)
             if model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
+        fit_to_contents(self, SIZED_COLUMNS)        # the rows shown changed: the widths they need, once
 
     def _on_clicked(self, index: QModelIndex) -> None:
         if index.isValid() and self.parameter_model.is_section(index.row()):

@@ -14,6 +14,7 @@ import threading
 import numpy as np
 import pytest
 from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QHeaderView
 
 import analysis.diagnosis.candidates
 import app.jobs.background_pool
@@ -25,7 +26,7 @@ from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app.widgets import style
-from app.model_lab.candidates import ACTION, CATEGORY, DELTA_BIC, EFFECT, JUDGED
+from app.model_lab.candidates import ACTION, CATEGORY, COLUMNS, DELTA_BIC, EFFECT, JUDGED, SIZED_COLUMNS
 from app.model_lab.catalogue import EFFECT_ROLE
 from app.model_lab.page import ModelLab
 from app.results.parameter_table import VALUE
@@ -109,6 +110,9 @@ def test_the_catalogue_groups_every_effect_by_category_and_explains_it(qtbot, la
     assert sorted(sum(listed.values(), [])) == sorted(CATALOGUE)
     assert sorted(map(sorted, listed.values())) == sorted(sorted(e.id for e in es) for es in grouped.values())
     assert lab.catalogue.checked() == ("lr2",)          # the model the lab started from
+    # The ids' column sized when the list was filled, as wide as the longest id with its checkbox.
+    assert tree.header().sectionResizeMode(0) == QHeaderView.Interactive
+    assert tree.columnWidth(0) >= tree.sizeHintForColumn(0) > 0
     fit = lab.versions[-1].fitted.fit          # the model's numbers: the fit's own report (FitResult.report)
     assert lab.model_label.toolTip() == f"<pre>{html.escape(fit.report())}</pre>" and "[[Correlations]]" in fit.report()
 
@@ -129,6 +133,9 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
 
     table = lab.candidates.table
     assert table.rowCount() == len(outcome.candidates) > 5
+    for column in SIZED_COLUMNS:        # sized when filled, to the widest of its cells
+        assert table.horizontalHeader().sectionResizeMode(column) == QHeaderView.Interactive
+        assert table.columnWidth(column) >= table.sizeHintForColumn(column) > 0, COLUMNS[column]
     top = outcome.candidates[0]
     assert top.effect.category == "creep"
     assert table.item(0, CATEGORY).text() == "Suspension creep"

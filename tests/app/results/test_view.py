@@ -4,8 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QHeaderView
 
-from app.results.parameter_table import NAME, STD, UNIT, VALUE
+from analysis.derived import ParameterValue
+from app.results.parameter_table import COLUMNS, NAME, SIZED_COLUMNS, STD, UNIT, VALUE
 
 from tests.app.conftest import PAPER, open_and_wait
 from tests.pace import wait_ms
@@ -185,6 +187,22 @@ def test_values_show_at_most_four_digits_unless_all_digits_is_on(shown):
     full = _cell(table, "RE", VALUE)
     assert digits(full) > digits(short) and float(full) == pytest.approx(float(short), rel=1e-3)
     assert "±" in _cell(table, "RE", VALUE, Qt.ToolTipRole)       # every value explains itself
+
+
+def test_parameter_columns_are_sized_to_their_contents_at_each_fill(shown):
+    table = shown.parameter_table
+
+    def fitted() -> bool:
+        return all(table.columnWidth(column) >= table.sizeHintForColumn(column) > 0 for column in SIZED_COLUMNS)
+    assert all(table.horizontalHeader().sectionResizeMode(c) == QHeaderView.Interactive for c in SIZED_COLUMNS)
+    assert fitted(), [table.columnWidth(c) for c in range(len(COLUMNS))]
+    table.all_digits_box.setChecked(True)
+    assert fitted()
+    narrow = table.columnWidth(UNIT)
+    wide_unit = ParameterValue(name="RE", value=6.0, std=0.1, unit="ohm", display_unit="ohm (a unit far wider)",
+                               display_scale=1.0, fitted=True)
+    table.set_parameters({"RE": wide_unit})      # a new table: measured again
+    assert fitted() and table.columnWidth(UNIT) > narrow
 
 
 def test_residuals_beyond_the_strip_are_pinned_at_its_edge_and_counted(shown):
