@@ -71,6 +71,27 @@ def _impedance_curves() -> ChannelCurves:
     return ChannelCurves("impedance", freqs, z(freqs), np.full(freqs.size, 0.05), real + 1j * imag, 1.1, dense, z(dense))
 
 
+def _impedance_plot() -> TransferPlot:
+    plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
+    plot.set_curves(_impedance_curves(), "impedance")
+    return plot
+
+
+def _shown_on_a_tab(qtbot, plot, size: tuple[int, int] | None = None) -> QTabWidget:
+    """`plot` on the second tab of a tab widget of `size`, shown with that tab current (the first is another
+    page)."""
+    tabs = QTabWidget()
+    qtbot.addWidget(tabs)
+    tabs.addTab(QLabel("another page"), "other")
+    tabs.addTab(plot, "plot")
+    if size is not None:
+        tabs.resize(*size)
+    tabs.show()
+    tabs.setCurrentIndex(1)
+    QApplication.processEvents()
+    return tabs
+
+
 def _pixels(widget) -> np.ndarray:
     image = widget.grab().toImage().convertToFormat(QImage.Format_RGB32)
     rows = np.frombuffer(image.constBits(), np.uint8).reshape(image.height(), image.bytesPerLine())
@@ -79,16 +100,8 @@ def _pixels(widget) -> np.ndarray:
 
 def test_a_shown_plot_is_drawn_from_its_items_pixmaps_and_looks_as_drawn_directly(qtbot):
     style.configure_pyqtgraph()
-    plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
-    plot.set_curves(_impedance_curves(), "impedance")
-    tabs = QTabWidget()
-    qtbot.addWidget(tabs)
-    tabs.addTab(QLabel("another page"), "other")
-    tabs.addTab(plot, "plot")
-    tabs.resize(900, 650)
-    tabs.show()
-    tabs.setCurrentIndex(1)
-    QApplication.processEvents()
+    plot = _impedance_plot()
+    tabs = _shown_on_a_tab(qtbot, plot, (900, 650))
 
     items = plot.scene().items()
     drawing = [item for item in items if isinstance(item, DRAWING_ITEMS)]
@@ -113,15 +126,8 @@ def test_a_shown_plot_is_drawn_from_its_items_pixmaps_and_looks_as_drawn_directl
 
 
 def test_an_item_added_after_the_first_show_keeps_what_it_drew_from_the_next_show(qtbot):
-    plot = TransferPlot("|Z| (Ω)", 1.0, log_y=False)
-    plot.set_curves(_impedance_curves(), "impedance")
-    tabs = QTabWidget()
-    qtbot.addWidget(tabs)
-    tabs.addTab(QLabel("another page"), "other")
-    tabs.addTab(plot, "plot")
-    tabs.show()
-    tabs.setCurrentIndex(1)
-    QApplication.processEvents()
+    plot = _impedance_plot()
+    tabs = _shown_on_a_tab(qtbot, plot)
     plot.set_reference(np.geomspace(5, 2e4, 50), np.full(50, 7.0), "the other tool's fit")
     added = plot.magnitude_reference.curve
     assert added.cacheMode() == QGraphicsItem.NoCache
