@@ -214,6 +214,8 @@ class RigProcess:
             "connections": rig.connections() if rig.alive else {}, "faults": engine.faults.describe(),
             "callback_errors": rig.callback_errors, "last_error": rig.last_error,
             "peak_terminal_volts": engine.peak_terminal_volts, "sink_errors": engine.sink_errors,
+            # When the laser's time base started again (the schedule moved): what a misplaced stream points to.
+            "laser_time_base": None if self.laser is None else self.laser.feed.time_base(),
         }
 
     def shutdown(self) -> None:

@@ -17,6 +17,7 @@ from analysis.large_signal.stepping import StepMeasures, next_level, step_measur
 from analysis.large_signal.stepping import StepLimits
 from analysis.recording.format import make_recording
 from instruments.simulation import faults
+from tests.rig_xruns import BUSY_MACHINE
 
 TWO_PERIODS = replace(faults.DEFAULT_BENCH, n_periods=2)       # what the large-signal plan averages
 
@@ -67,6 +68,7 @@ def test_a_period_read_after_the_drive_stopped_is_not_trusted_and_stops_the_plan
     assert measured.displacement_change == pytest.approx(change) and not measured.displacement_repeats
     code, words = stop_reason(measured, StepLimits(), measured.re_per_period[0])
     assert code == "fault" and "displacement" in words and "0.3 V" in words
+    assert BUSY_MACHINE in words          # the rig's tests measure again on these words (tests/rig_xruns.py)
 
 
 def test_one_period_from_a_stretch_a_few_ms_off_is_not_trusted():

@@ -21,12 +21,12 @@ LINK = "latency=0.008,jitter=0.002"       # a USB serial adapter's packets, far 
 
 @pytest.fixture(scope="module")
 def plan_on_the_rig(virtual_rig, tmp_path_factory):
-    """One plan on the rig's nonlinear model (30 s; again after an xrun nobody injected): its exit code, JSON
-    document, stderr and output folder."""
+    """One plan on the rig's nonlinear model (30 s; again when the host did not keep up, tests/rig_xruns.py): its
+    exit code, JSON document, stderr (with the rig's status when the plan failed) and output folder."""
     if shutil.which("jackd") is None:
         pytest.skip("jackd is not installed")
     from instruments.audio import portaudio
-    from instruments.rig.manager import start_rig, stop_rig
+    from instruments.rig.manager import rig_status, start_rig, stop_rig
     tmp_path = tmp_path_factory.mktemp("large-signal-rig")
     name, runtime = f"linpar-ls-{os.getpid()}", tmp_path / "rigs"
     start_rig(name, driver="demo-large-signal", faults=[LINK], runtime_dir=runtime, seed=3, model="nonlinear")
@@ -35,6 +35,8 @@ def plan_on_the_rig(virtual_rig, tmp_path_factory):
             lambda out_folder: ["measure", "--plan", "large-signal", "--out", str(out_folder), "--name", "ls",
                                 "--rig-name", name, "--runtime-dir", str(runtime), "--max-excursion", "1.5",
                                 "--step", "2", "--json"], tmp_path)
+        if code != 0:
+            err += f"the rig's status: {json.dumps(rig_status(name, runtime))}\n"
     finally:
         portaudio.release()
         stop_rig(name, runtime)
