@@ -242,3 +242,5 @@ def _said_step(step) -> None:
     peak = "no displacement" if m.peak_m is None else f"peak {m.peak_m * 1e3:.2f} mm"
     say(f"step {step.index} at {step.level_v:.3g} V: {peak}, current distortion {m.current_distortion_db:.1f} dB, "
         f"RE {m.re_ohm:.3f} ohm -> {step.recording_path}")
+    if step.message:
+        say(f"step {step.index} at {step.level_v:.3g} V: {step.message}")

@@ -17,6 +17,11 @@ what stopped it. NAME.large-signal.json, rewritten atomically after every
 step, lists the plan, the steps (level, peak, distortion, RE per period)
 and why it stopped: the input of `linpar large-signal`, and what is left
 after a crash.
+
+A step whose displacement did not repeat from period to period (its laser
+stream was placed wrong in time: the host's moment, not the driver's) is
+measured once more at the same level before the plan stops on it; the first
+recording stays on disk, marked unusable, with the reason in its message.
 """
 from __future__ import annotations
 
@@ -118,6 +123,7 @@ def run_large_signal(plan: LargeSignalPlan, audio, laser=None, out_dir: Path | s
     re_reference = float("nan")
     level = float(plan.start_level_v)
     stopped, message = "steps", f"the plan's {plan.max_steps} steps were all measured"
+    measured_again = False          # this level was measured again after a misplaced laser stream
     for index in range(1, plan.max_steps + 1):
         step_plan = dataclasses.replace(plan.base, level_v_rms=level)
         step_name = f"{name}-s{index:02d}-{level:.3g}V"
@@ -140,15 +146,23 @@ def run_large_signal(plan: LargeSignalPlan, audio, laser=None, out_dir: Path | s
         measures, re_lines = step_measures(outcome.recording, level, re_lines)
         if index == 1:
             re_reference = measures.re_per_period[0] if measures.re_per_period else float("nan")
-        step = PlanStep(index, level, outcome.recording_path, measures)
+        reached = stop_reason(measures, plan.limits, re_reference)
+        again = reached is not None and reached[0] == "fault" and not measured_again
+        step = PlanStep(index, level, outcome.recording_path, measures,
+                        message=f"measured again at the same level, because {reached[1]}" if again else "")
         steps.append(step)
         _write_summary(summary, plan, steps, None, "", re_reference)
         if on_step is not None:
             on_step(step)
-        reached = stop_reason(measures, plan.limits, re_reference)
+        if again:
+            measured_again = True
+            continue
         if reached is not None:
             stopped, message = reached
+            if measured_again and stopped == "fault":
+                message += " (it did not repeat when measured again either)"
             break
+        measured_again = False
         nxt, why = next_level(measures, plan.limits, plan.step)
         if nxt is None:
             stopped = why if why in ("excursion", "voltage", "distortion") else "voltage"

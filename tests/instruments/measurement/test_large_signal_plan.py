@@ -109,33 +109,57 @@ def test_the_plan_steps_up_to_the_excursion_limit_and_keeps_every_step(tmp_path)
     assert all(len(s["measures"]["re_ohm_per_period"]) == 2 for s in summary["steps"])
 
 
-def test_a_step_whose_audio_was_timed_late_is_not_trusted_and_the_plan_stops_below_the_limit(tmp_path, monkeypatch):
-    """A starved host notes the audio's blocks late (here: every block of the 4 V step by 0.3 s, injected in the
-    time stamps, so the same whatever the load): the laser's stream is placed 0.3 s off, one period of the
-    coherent mean is the cone after the drive stopped, and the peak comes out about half the truth. The plan
-    used to step from that to 8 V and 3.1 mm, past the 2 mm limit; the displacement not repeating while the
-    voltage did says the peak cannot be trusted, and the plan stops there."""
+def _plan_with_late_audio(tmp_path, monkeypatch, late_measurements: int):
+    """The plan from 2 V on the in-process rig, the audio's blocks of the first ``late_measurements``
+    measurements at 4 V noted 0.3 s late (injected in the time stamps, so the same whatever the load)."""
     lateness = {"s": 0.0}
     monkeypatch.setattr(timed_audio, "time", SimpleNamespace(monotonic=lambda: time.monotonic() + lateness["s"]))
+    at_4_v = [0]
 
     def measure(step_plan, *args, **kwargs):
-        lateness["s"] = 0.3 if step_plan.level_v_rms == 4.0 else 0.0
+        at_4_v[0] += step_plan.level_v_rms == 4.0
+        lateness["s"] = 0.3 if step_plan.level_v_rms == 4.0 and at_4_v[0] <= late_measurements else 0.0
         return run_measurement(step_plan, *args, **kwargs)
 
     rig = InProcessRig(known_driver(8192), "simulated", calibration=LARGE_SIGNAL_CHAIN)
     limits = StepLimits(max_excursion_m=2.0e-3, max_voltage_v=20.0)
     try:
-        outcome = run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits), rig.audio,
-                                   rig.laser, tmp_path, name="ls", measure=measure)
+        return run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits), rig.audio,
+                                rig.laser, tmp_path, name="ls", measure=measure)
     finally:
         rig.close()
-    assert [s.level_v for s in outcome.steps] == [2.0, 4.0], outcome.message
+
+
+def test_a_step_whose_audio_was_timed_late_twice_is_not_trusted_and_the_plan_stops_below_the_limit(
+        tmp_path, monkeypatch):
+    """A starved host notes the audio's blocks late: the laser's stream is placed 0.3 s off, one period of the
+    coherent mean is the cone after the drive stopped, and the peak comes out about half the truth. The plan
+    used to step from that to 8 V and 3.1 mm, past the 2 mm limit; the displacement not repeating while the
+    voltage did says the peak cannot be trusted. The step is measured again; late again, the plan stops."""
+    outcome = _plan_with_late_audio(tmp_path, monkeypatch, late_measurements=2)
+    assert [s.level_v for s in outcome.steps] == [2.0, 4.0, 4.0], outcome.message
     assert outcome.stopped_by == "fault" and "displacement" in outcome.message
-    late = outcome.steps[-1]
-    assert late.measures.displacement_change > 0.2 and not late.usable
-    assert late.recording_path.is_file() and late.recording_path not in outcome.recordings
-    assert all(s.measures.displacement_change < 0.01 for s in outcome.steps[:-1])
-    assert json.loads(outcome.summary_path.read_text())["steps"][-1]["usable"] is False
+    assert "did not repeat when measured again either" in outcome.message
+    first, again = outcome.steps[1:]
+    assert first.message.startswith("measured again at the same level, because the displacement at 4 V")
+    for late in (first, again):
+        assert late.measures.displacement_change > 0.2 and not late.usable
+        assert late.recording_path.is_file() and late.recording_path not in outcome.recordings
+    assert outcome.steps[0].measures.displacement_change < 0.01
+    assert [s["usable"] for s in json.loads(outcome.summary_path.read_text())["steps"]] == [True, False, False]
+
+
+def test_a_step_timed_late_once_is_measured_again_and_the_plan_goes_on_to_its_limit(tmp_path, monkeypatch):
+    """The host's moment passes: the step measured again repeats, and the plan steps on from it."""
+    outcome = _plan_with_late_audio(tmp_path, monkeypatch, late_measurements=1)
+    levels = [s.level_v for s in outcome.steps]
+    assert levels[:3] == [2.0, 4.0, 4.0] and len(levels) >= 4, outcome.message
+    assert outcome.stopped_by == "excursion", outcome.message
+    late = outcome.steps[1]
+    assert not late.usable and late.measures.displacement_change > 0.2 and "measured again" in late.message
+    assert late.recording_path not in outcome.recordings
+    assert all(s.usable and not s.message for s in outcome.steps[2:])
+    assert 0.98 * 2.0e-3 <= outcome.steps[-1].measures.peak_m <= 2.3e-3      # not stepped past the limit
 
 
 def test_the_plan_stops_at_the_voltage_limit(tmp_path):
