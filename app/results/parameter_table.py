@@ -29,7 +29,9 @@ from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
 NAME, VALUE, STD, UNIT = range(4)
-SIZED_COLUMNS = (NAME, STD, UNIT)       # as wide as their contents; the value takes the rest
+# As wide as their contents; the name takes the rest (a long name elides, its cell's tooltip has it whole).
+# A value needs every digit it shows: elided, "0.4906" read "0.4…" in a narrow window.
+SIZED_COLUMNS = (VALUE, STD, UNIT)
 
 INTERNAL_TITLE = "Model's internal quantities"
 DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
@@ -264,7 +266,7 @@ class ParameterTable(QTableView):
         self.setTextElideMode(Qt.ElideRight)
         self.verticalHeader().setVisible(False)
         self.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 8)
-        self.horizontalHeader().setSectionResizeMode(VALUE, QHeaderView.Stretch)
+        self.horizontalHeader().setSectionResizeMode(NAME, QHeaderView.Stretch)
         sized_when_filled(self, SIZED_COLUMNS)       # measured at each fill, not at each show of the page
         fit_to_contents(self, SIZED_COLUMNS)         # empty: as wide as their titles
         self.internal_folded = False
@@ -296,6 +298,17 @@ class ParameterTable(QTableView):
             if model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
         fit_to_contents(self, SIZED_COLUMNS)        # the rows shown changed: the widths they need, once
+
+    def sizeHintForColumn(self, column: int) -> int:
+        """The widest cell of the column that has it alone: a section title and the reason of a missing value
+        span columns and elide (their tooltips hold them whole), so they do not widen the one they start in."""
+        model = self.parameter_model
+        widest = 0
+        for row in range(model.rowCount()):
+            if self.isRowHidden(row) or self.columnSpan(row, column) > 1 or self.rowSpan(row, column) > 1:
+                continue
+            widest = max(widest, self.sizeHintForIndex(model.index(row, column)).width())
+        return widest + (1 if self.showGrid() else 0)       # as QTableView's own: the grid line
 
     def _on_clicked(self, index: QModelIndex) -> None:
         if index.isValid() and self.parameter_model.is_section(index.row()):

@@ -291,3 +291,39 @@ def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, rec
         qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
     assert done == [True]
     assert [str(e[1]) for e in exceptions] == ["a plot failed"]
+
+
+def test_a_narrow_table_shows_every_value_whole_and_elides_the_names(qtbot):
+    """At 1280x720 the Model lab's table is ~350 px wide: the values used to give way ("0.46…" for Qts) to a
+    name column as wide as its longest name. Now the names give way; a spanned cell (the section title, the
+    reason of a missing value) widens no column."""
+    from app.results.parameter_table import ParameterTable
+    table = ParameterTable()
+    qtbot.addWidget(table)
+    parameters = {
+        "Qts": ParameterValue(name="Qts", value=0.463812, std=1.3e-6, unit="1", display_unit="1", display_scale=1.0),
+        "Cms": ParameterValue(name="Cms", value=4.2963e-4, std=1.9e-9, unit="m/N", display_unit="mm/N",
+                              display_scale=1e3),
+        "Vas": ParameterValue(name="Vas", value=None, std=None, unit="m^3", display_unit="l", display_scale=1e3,
+                              reason="no Sd: enter the diaphragm's area to derive Vas, the sensitivity and η0"),
+        "L2": ParameterValue(name="L2", value=1.23e-4, std=2e-7, unit="H", display_unit="mH", display_scale=1e3,
+                             fitted=True),
+        "SPL_1W_1m": ParameterValue(name="SPL_1W_1m", value=90.03, std=1.6e-5, unit="dB", display_unit="dB SPL",
+                                    display_scale=1.0),
+    }
+    table.set_parameters(parameters)
+    table.resize(300, 400)
+    table.show()
+    qtbot.waitExposed(table)
+    model = table.parameter_model
+    alone = [model.row_of(name) for name in ("Qts", "Cms", "L2")]      # not Vas's reason, not the section
+    for column in (VALUE, STD, UNIT):
+        widest = max(table.sizeHintForIndex(model.index(row, column)).width() for row in alone)
+        assert table.columnWidth(column) >= widest, column
+    metrics = table.fontMetrics()
+    for name in ("Qts", "Cms"):
+        text = _cell(table, name, VALUE)
+        assert len(text) >= 6 and metrics.horizontalAdvance(text) < table.columnWidth(VALUE), (name, text)
+    longest_name = metrics.horizontalAdvance(_cell(table, "SPL_1W_1m", NAME))
+    assert table.columnWidth(NAME) < longest_name      # the names give way
+    assert sum(table.columnWidth(c) for c in range(len(COLUMNS))) <= table.viewport().width() + 1
