@@ -90,6 +90,49 @@ def test_partitioned_convolution_equals_direct_convolution_for_any_cut():
     assert np.max(np.abs(y - direct)) < 1e-10
 
 
+@pytest.mark.parametrize("seed", [4, 5, 6])
+def test_silences_longer_than_the_filter_pass_over_and_the_output_is_still_the_direct_convolution(seed):
+    """Bursts between silences longer and shorter than the delay line, cut anywhere: a silent state passed
+    over (no transform) must leave the stream what direct convolution gives."""
+    rng = np.random.default_rng(seed)
+    h = rng.normal(size=(2, 3000))
+    x = np.concatenate([np.zeros(500), rng.normal(size=2000), np.zeros(9000), rng.normal(size=700),
+                        np.zeros(2100), rng.normal(size=1500), np.zeros(6000), [1e-300], np.zeros(4000)])
+    conv = PartitionedConvolver(h, 256)
+    pieces, pos = [], 0
+    while pos < x.size:
+        n = int(rng.integers(0, 1500))
+        pieces.append(conv.process(x[pos:pos + n]))
+        pos += n
+    y = np.concatenate(pieces, axis=1)
+    direct = np.stack([np.convolve(x, h[i])[:x.size] for i in range(2)])
+    assert np.max(np.abs(y - direct)) < 1e-10
+    conv.process(np.zeros(4000))
+    assert not np.any(conv.process(np.zeros(700)))       # long silent: zeros exactly (a transform leaves ~1e-17)
+    conv.reset()                         # back to rest, then a burst right away: nothing passed over wrongly
+    assert np.max(np.abs(conv.process(x[:5000]) - direct[:, :5000])) < 1e-10
+
+
+def test_a_rig_nobody_plays_to_transforms_nothing(monkeypatch):
+    """Once the silence is longer than the delay line, a block of zeros costs no FFT (the idle virtual rig's
+    2.5 ms every cycle); the first sample that is not zero is transformed again."""
+    import instruments.simulation.linear_driver as linear_driver
+    transforms = []
+    forward = linear_driver.scipy.fft.rfft
+    monkeypatch.setattr(linear_driver.scipy.fft, "rfft", lambda *a, **k: transforms.append(1) or forward(*a, **k))
+    rng = np.random.default_rng(7)
+    conv = PartitionedConvolver(rng.normal(size=(2, 3000)), 256)
+    conv.process(rng.normal(size=1000))
+    for _ in range(14):                  # (12 partitions + 2) x 256 samples: the state is all zero after these
+        conv.process(np.zeros(256))
+    transforms.clear()
+    for _ in range(20):
+        conv.process(np.zeros(256))
+    assert transforms == []
+    conv.process(np.r_[np.zeros(100), 1.0, np.zeros(155)])
+    assert transforms
+
+
 def test_dc_uses_the_first_bin_so_creep_does_not_make_the_filter_infinite(driver):
     # creep-log diverges at w = 0: the filter must still be finite, and a constant
     # voltage must give the current of the first bin (about 1/RE).
