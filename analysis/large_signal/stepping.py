@@ -151,13 +151,20 @@ def distortion_db(per_period: np.ndarray, excited: np.ndarray) -> float:
     return 10.0 * math.log10(distortion / signal) if distortion > 0 and signal > 0 else -math.inf
 
 
-def stop_reason(step: StepMeasures, limits: StepLimits, re_reference: float) -> tuple[str, str] | None:
-    """(code, words) when this step reached a limit or its displacement cannot be trusted, else None."""
+def displacement_not_repeating(step: StepMeasures) -> str:
+    """What a step whose displacement did not repeat says about it: the change, and its likely cause."""
+    peak = "" if step.peak_m is None else f" (its peak {step.peak_m * 1e3:.2f} mm may be too low)"
+    return f"the displacement at {step.level_v:.3g} V changed by {step.displacement_change:.0%} from period to " \
+           f"period while the voltage repeated{peak}: the laser's stream was not placed right in time (a busy machine?)"
+
+
+def stop_reason(step: StepMeasures, limits: StepLimits, re_reference: float, measured_again: bool = False
+                ) -> tuple[str, str] | None:
+    """(code, words) when this step reached a limit or its displacement cannot be trusted, else None.
+    `measured_again`: this level was measured a second time because the first did not repeat."""
     if not step.displacement_repeats:
-        peak = "" if step.peak_m is None else f" (its peak {step.peak_m * 1e3:.2f} mm may be too low)"
-        return "fault", f"the displacement at {step.level_v:.3g} V changed by {step.displacement_change:.0%} " \
-                        f"from period to period while the voltage repeated{peak}: the laser's stream was not " \
-                        f"placed right in time (a busy machine?); the plan stops rather than step on past the " \
+        again = ", and so it did when measured again" if measured_again else ""
+        return "fault", f"{displacement_not_repeating(step)}{again}; the plan stops rather than step on past the " \
                         f"excursion limit: measure again with the machine less busy"
     if step.clipped:
         return "clipping", f"the {' and '.join(step.clipped)} input reached its full scale at {step.level_v:.3g} V: " \

@@ -29,9 +29,8 @@ from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
 COLUMNS = ("Parameter", "Value", "±1σ", "Unit")
 NAME, VALUE, STD, UNIT = range(4)
-# As wide as their contents; the name takes the rest (a long name elides, its cell's tooltip has it whole).
-# A value needs every digit it shows: elided, "0.4906" read "0.4…" in a narrow window.
-SIZED_COLUMNS = (VALUE, STD, UNIT)
+SIZED_COLUMNS = (NAME, STD, UNIT)       # as wide as their contents (the name gives way when room is short)
+MIN_NAME_WIDTH = 40                     # px: a name never elides to less than its first letters
 
 INTERNAL_TITLE = "Model's internal quantities"
 DEFAULT_DIGITS = 4          # significant digits shown unless "All digits" is on
@@ -266,8 +265,9 @@ class ParameterTable(QTableView):
         self.setTextElideMode(Qt.ElideRight)
         self.verticalHeader().setVisible(False)
         self.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 8)
-        self.horizontalHeader().setSectionResizeMode(NAME, QHeaderView.Stretch)
+        self.horizontalHeader().setSectionResizeMode(VALUE, QHeaderView.Stretch)
         sized_when_filled(self, SIZED_COLUMNS)       # measured at each fill, not at each show of the page
+        self._name_width = 0                         # what the names need, measured at each fill
         fit_to_contents(self, SIZED_COLUMNS)         # empty: as wide as their titles
         self.internal_folded = False
         self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
@@ -298,10 +298,28 @@ class ParameterTable(QTableView):
             if model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
         fit_to_contents(self, SIZED_COLUMNS)        # the rows shown changed: the widths they need, once
+        self._name_width = self.columnWidth(NAME)
+        self._share_width()
+
+    def _share_width(self) -> None:
+        """The names as wide as they need, unless the values would then not fit whole: then the names give way
+        (eliding; the tooltip has them). The value column takes what is left, so a reason spanned over it and
+        the sigma has the room there is. A value elided read "0.4…" for Qts in a narrow Model lab."""
+        header = self.horizontalHeader()
+        values = max(self.sizeHintForColumn(VALUE), header.sectionSizeHint(VALUE))
+        room = self.viewport().width() - values - self.columnWidth(STD) - self.columnWidth(UNIT)
+        name = max(MIN_NAME_WIDTH, min(self._name_width, room))
+        if name != self.columnWidth(NAME):
+            self.setColumnWidth(NAME, name)
+
+    def resizeEvent(self, event) -> None:
+        super().resizeEvent(event)
+        self._share_width()
 
     def sizeHintForColumn(self, column: int) -> int:
         """The widest cell of the column that has it alone: a section title and the reason of a missing value
-        span columns and elide (their tooltips hold them whole), so they do not widen the one they start in."""
+        span columns (and elide when the spanned columns are narrow; their tooltips hold them whole), so they
+        do not widen the one they start in."""
         model = self.parameter_model
         widest = 0
         for row in range(model.rowCount()):

@@ -20,8 +20,9 @@ after a crash.
 
 A step whose displacement did not repeat from period to period (its laser
 stream was placed wrong in time: the host's moment, not the driver's) is
-measured once more at the same level before the plan stops on it; the first
-recording stays on disk, marked unusable, with the reason in its message.
+measured once more at the same level before the plan stops on it, as one of
+its max_steps (the last of them stops it at once); the first recording stays
+on disk, marked unusable, with the reason in its message.
 """
 from __future__ import annotations
 
@@ -39,7 +40,8 @@ from analysis.errors import LinparError
 from analysis.files import check_output
 from analysis.large_signal.data import LargeSignalError
 from analysis.large_signal.plan_summary import SUMMARY_SUFFIX
-from analysis.large_signal.stepping import StepLimits, StepMeasures, next_level, step_measures, stop_reason
+from analysis.large_signal.stepping import (StepLimits, StepMeasures, displacement_not_repeating, next_level,
+                                            step_measures, stop_reason)
 from instruments.measurement.errors import MeasurementError
 from instruments.measurement.plan import MeasurementPlan
 
@@ -146,10 +148,12 @@ def run_large_signal(plan: LargeSignalPlan, audio, laser=None, out_dir: Path | s
         measures, re_lines = step_measures(outcome.recording, level, re_lines)
         if index == 1:
             re_reference = measures.re_per_period[0] if measures.re_per_period else float("nan")
-        reached = stop_reason(measures, plan.limits, re_reference)
-        again = reached is not None and reached[0] == "fault" and not measured_again
+        reached = stop_reason(measures, plan.limits, re_reference, measured_again)
+        again = (reached is not None and reached[0] == "fault" and not measured_again
+                 and index < plan.max_steps)
         step = PlanStep(index, level, outcome.recording_path, measures,
-                        message=f"measured again at the same level, because {reached[1]}" if again else "")
+                        message=f"measured again at the same level: {displacement_not_repeating(measures)}"
+                        if again else "")
         steps.append(step)
         _write_summary(summary, plan, steps, None, "", re_reference)
         if on_step is not None:
@@ -159,8 +163,6 @@ def run_large_signal(plan: LargeSignalPlan, audio, laser=None, out_dir: Path | s
             continue
         if reached is not None:
             stopped, message = reached
-            if measured_again and stopped == "fault":
-                message += " (it did not repeat when measured again either)"
             break
         measured_again = False
         nxt, why = next_level(measures, plan.limits, plan.step)

@@ -50,7 +50,8 @@ def test_the_plan_runs_on_the_nonlinear_rig_and_its_steps_are_identified(plan_on
     doc = json.loads(out)
     assert doc["plan"]["stopped_by"] == "excursion", doc["plan"]["message"]
     summary = json.loads((folder / "ls.large-signal.json").read_text())
-    peaks = [s["measures"]["peak_displacement_m"] for s in summary["steps"]]
+    # A step measured again (its displacement did not repeat: a busy host) is kept but not usable.
+    peaks = [s["measures"]["peak_displacement_m"] for s in summary["steps"] if s["usable"]]
     assert len(peaks) >= 3 and all(b > a for a, b in zip(peaks, peaks[1:])) and peaks[-1] >= 0.98 * 1.5e-3
     assert all((folder / s["recording"]).is_file() for s in summary["steps"])
     assert "step 1 at 0.5 V" in err

@@ -293,28 +293,40 @@ def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, rec
     assert [str(e[1]) for e in exceptions] == ["a plot failed"]
 
 
-def test_a_narrow_table_shows_every_value_whole_and_elides_the_names(qtbot):
-    """At 1280x720 the Model lab's table is ~350 px wide: the values used to give way ("0.46…" for Qts) to a
-    name column as wide as its longest name. Now the names give way; a spanned cell (the section title, the
-    reason of a missing value) widens no column."""
+def _table_of(qtbot, width: int, parameters: dict):
     from app.results.parameter_table import ParameterTable
     table = ParameterTable()
     qtbot.addWidget(table)
-    parameters = {
+    table.set_parameters(parameters)
+    table.resize(width, 400)
+    table.show()
+    qtbot.waitExposed(table)
+    return table
+
+
+def _mixed_parameters() -> dict:
+    return {
         "Qts": ParameterValue(name="Qts", value=0.463812, std=1.3e-6, unit="1", display_unit="1", display_scale=1.0),
         "Cms": ParameterValue(name="Cms", value=4.2963e-4, std=1.9e-9, unit="m/N", display_unit="mm/N",
                               display_scale=1e3),
         "Vas": ParameterValue(name="Vas", value=None, std=None, unit="m^3", display_unit="l", display_scale=1e3,
-                              reason="no Sd: enter the diaphragm's area to derive Vas, the sensitivity and η0"),
+                              reason="no Sd: enter the diaphragm's area to derive Vas"),
         "L2": ParameterValue(name="L2", value=1.23e-4, std=2e-7, unit="H", display_unit="mH", display_scale=1e3,
                              fitted=True),
         "SPL_1W_1m": ParameterValue(name="SPL_1W_1m", value=90.03, std=1.6e-5, unit="dB", display_unit="dB SPL",
                                     display_scale=1.0),
     }
-    table.set_parameters(parameters)
-    table.resize(300, 400)
-    table.show()
-    qtbot.waitExposed(table)
+
+
+def _spanned_width(table) -> int:
+    return table.columnWidth(VALUE) + table.columnWidth(STD)
+
+
+def test_a_narrow_table_shows_every_value_whole_and_elides_the_names(qtbot):
+    """At 1280x720 the Model lab's table is ~350 px wide: the values used to give way ("0.46…" for Qts) to a
+    name column as wide as its longest name. Now the names give way; a spanned cell (the section title, the
+    reason of a missing value) widens no column."""
+    table = _table_of(qtbot, 300, _mixed_parameters())
     model = table.parameter_model
     alone = [model.row_of(name) for name in ("Qts", "Cms", "L2")]      # not Vas's reason, not the section
     for column in (VALUE, STD, UNIT):
@@ -327,3 +339,25 @@ def test_a_narrow_table_shows_every_value_whole_and_elides_the_names(qtbot):
     longest_name = metrics.horizontalAdvance(_cell(table, "SPL_1W_1m", NAME))
     assert table.columnWidth(NAME) < longest_name      # the names give way
     assert sum(table.columnWidth(c) for c in range(len(COLUMNS))) <= table.viewport().width() + 1
+
+
+def test_a_wide_table_gives_names_and_reasons_their_room(qtbot):
+    """With room to spare the names are whole and a missing value's reason, spanned over the value and the
+    sigma, has the rest of the width (it elided to "n/a: no Sd: ent…" when the names took the rest)."""
+    table = _table_of(qtbot, 700, _mixed_parameters())
+    metrics = table.fontMetrics()
+    assert table.columnWidth(NAME) >= metrics.horizontalAdvance(_cell(table, "SPL_1W_1m", NAME))
+    assert _spanned_width(table) > metrics.horizontalAdvance(_cell(table, "Vas", VALUE)) + 8
+    table.resize(300, 400)                             # narrowed: the names give way again
+    qtbot.waitUntil(lambda: table.columnWidth(NAME) < metrics.horizontalAdvance(_cell(table, "SPL_1W_1m", NAME)))
+    assert metrics.horizontalAdvance(_cell(table, "Qts", VALUE)) < table.columnWidth(VALUE)
+
+
+def test_a_broken_lead_s_not_measured_cells_are_whole(qtbot):
+    unmeasured = {name: ParameterValue(name=name, value=None, std=None, unit="1", display_unit="1",
+                                       display_scale=1.0, reason="the current lead is broken")
+                  for name in ("fs", "Qts", "RE", "Bl")}
+    table = _table_of(qtbot, 500, unmeasured)
+    text = _cell(table, "Qts", VALUE)
+    assert text == "not measured"
+    assert _spanned_width(table) > table.fontMetrics().horizontalAdvance(text) + 8

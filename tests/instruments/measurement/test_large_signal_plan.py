@@ -97,19 +97,19 @@ def test_the_plan_steps_up_to_the_excursion_limit_and_keeps_every_step(tmp_path)
     finally:
         rig.close()
     assert outcome.stopped_by == "excursion", outcome.message
-    levels = [s.level_v for s in outcome.steps]
+    levels = [s.level_v for s in outcome.steps if s.usable]    # a step measured again is kept, not usable
     assert levels[0] == 1.0 and all(b > a for a, b in zip(levels, levels[1:]))
     last = outcome.steps[-1].measures
     assert 0.98 * 2.0e-3 <= last.peak_m <= 2.3e-3          # shortened near the limit, not overshot
     assert [s.index for s in steps_seen] == [s.index for s in outcome.steps]
-    assert len(outcome.recordings) == len(outcome.steps) and all(p.is_file() for p in outcome.recordings)
+    assert len(outcome.recordings) == len(levels) and all(p.is_file() for p in outcome.recordings)
     summary = json.loads(outcome.summary_path.read_text())
     assert summary["stopped_by"] == "excursion"
-    assert [s["recording"] for s in summary["steps"]] == [p.name for p in outcome.recordings]
+    assert [s["recording"] for s in summary["steps"] if s["usable"]] == [p.name for p in outcome.recordings]
     assert all(len(s["measures"]["re_ohm_per_period"]) == 2 for s in summary["steps"])
 
 
-def _plan_with_late_audio(tmp_path, monkeypatch, late_measurements: int):
+def _plan_with_late_audio(tmp_path, monkeypatch, late_measurements: int, max_steps: int = 24):
     """The plan from 2 V on the in-process rig, the audio's blocks of the first ``late_measurements``
     measurements at 4 V noted 0.3 s late (injected in the time stamps, so the same whatever the load)."""
     lateness = {"s": 0.0}
@@ -124,8 +124,8 @@ def _plan_with_late_audio(tmp_path, monkeypatch, late_measurements: int):
     rig = InProcessRig(known_driver(8192), "simulated", calibration=LARGE_SIGNAL_CHAIN)
     limits = StepLimits(max_excursion_m=2.0e-3, max_voltage_v=20.0)
     try:
-        return run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits), rig.audio,
-                                rig.laser, tmp_path, name="ls", measure=measure)
+        return run_large_signal(LargeSignalPlan(plan(8192, 2), 2.0, step=2.0, limits=limits, max_steps=max_steps),
+                                rig.audio, rig.laser, tmp_path, name="ls", measure=measure)
     finally:
         rig.close()
 
@@ -139,9 +139,10 @@ def test_a_step_whose_audio_was_timed_late_twice_is_not_trusted_and_the_plan_sto
     outcome = _plan_with_late_audio(tmp_path, monkeypatch, late_measurements=2)
     assert [s.level_v for s in outcome.steps] == [2.0, 4.0, 4.0], outcome.message
     assert outcome.stopped_by == "fault" and "displacement" in outcome.message
-    assert "did not repeat when measured again either" in outcome.message
+    assert "and so it did when measured again; the plan stops" in outcome.message
     first, again = outcome.steps[1:]
-    assert first.message.startswith("measured again at the same level, because the displacement at 4 V")
+    assert first.message.startswith("measured again at the same level: the displacement at 4 V")
+    assert "the plan stops" not in first.message and again.message == ""
     for late in (first, again):
         assert late.measures.displacement_change > 0.2 and not late.usable
         assert late.recording_path.is_file() and late.recording_path not in outcome.recordings
@@ -212,3 +213,11 @@ def test_a_fault_mid_plan_stops_it_safely_keeping_what_it_has(tmp_path):
     assert outcome.recordings == [first.recording_path]
     summary = json.loads(outcome.summary_path.read_text())
     assert summary["stopped_by"] == "fault" and summary["steps"][1]["partial"] is True
+
+
+def test_a_step_timed_late_as_the_plans_last_stops_it_rather_than_pass_for_all_steps_measured(tmp_path,
+                                                                                              monkeypatch):
+    outcome = _plan_with_late_audio(tmp_path, monkeypatch, late_measurements=1, max_steps=2)
+    assert [s.level_v for s in outcome.steps] == [2.0, 4.0]
+    assert outcome.stopped_by == "fault" and "measured again" not in outcome.message
+    assert outcome.steps[-1].message == "" and not outcome.steps[-1].usable
