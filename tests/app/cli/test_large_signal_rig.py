@@ -68,9 +68,11 @@ def test_bl0_and_kms0_on_the_jack_rig_come_within_1_percent(plan_on_the_rig):
     assert kms0 == pytest.approx(5.23**2 / 11.75e-3, rel=0.01)
     for recording in json.loads(out)["large_signal"]["validity"]["recordings"]:
         assert recording["laser_delay_found"] and not recording["laser_delay_at_limit"]
-        # Its 1-sigma: below 5 us in 14 plans on a quiet machine, 7.1 us at load 6 (a busy host places the
-        # stream a little less well, which the sigma reports). The delay against the emulation's truth is
-        # bounded in tests/instruments/measurement/test_large_signal_plan.py (20 us).
+        # Its 1-sigma: below 5 us in 14 plans on a quiet machine, 7.1 us in one at load 6 (a busy host places
+        # the stream a little less well, and the sigma says so). The bound catches a delay not pinned down
+        # (a tenth of the laser's 250 us sample period); the delay found against the emulation's truth is
+        # tested in-process (tests/instruments/measurement/test_large_signal_plan.py, within 20 us), and the
+        # curves it leads to just below.
         assert 0 < recording["laser_delay_std_s"] < 20e-6
     # Bl(x) / Bl(0) = 1 - 0.03 x - 0.01 x^2 (x in mm): its slope at rest, -0.03 per mm
     assert curves["Bl"]["coefficients"][1] / bl0 == pytest.approx(-30.0, rel=0.15)
