@@ -4,10 +4,10 @@ On a loaded 2-core machine the rig's JACK server now and then reports an xrun by
 late). With the serial laser an xrun ends the measurement (a large-signal plan's step too), which
 tests/instruments/measurement/test_measure_rig.py tests on its own. A large-signal plan also stops when a
 step's displacement did not repeat from period to period (analysis/large_signal/stepping.py, tested on its
-own in tests/analysis/large_signal/test_displacement_repeat.py): on the rig that happens when a starved
-machine moved the time base the rig's laser reads its cone by, and the product says "a busy machine?" and
-"measure again". A test that injects neither measures again, as the product says, instead of failing on
-the host's scheduling; it fails when every attempt ends so.
+own in tests/analysis/large_signal/test_displacement_repeat.py) twice in a row: on the rig that happened
+once, on a fresh CI machine with nothing injected, and the product says "a busy machine?" and "measure
+again". A test that injects neither measures again, as the product says, instead of failing on the host's
+scheduling; it fails when every attempt ends so.
 """
 from __future__ import annotations
 

@@ -97,7 +97,7 @@ class PartitionedConvolver:
         self._tail = np.zeros((n_filters, B + 1), dtype=np.complex128)
         self._head = 0
         self._fill = 0
-        # Zero input samples in a row up to now; beyond _QUIET of them every spectrum held is zero (module doc).
+        # Zero input samples in a row up to now; from _quiet of them on, every spectrum held is zero (module doc).
         self._zero_run = self._quiet = (P + 2) * B
 
     @property
