@@ -267,8 +267,8 @@ class ParameterTable(QTableView):
         self.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 8)
         self.horizontalHeader().setSectionResizeMode(VALUE, QHeaderView.Stretch)
         sized_when_filled(self, SIZED_COLUMNS)       # measured at each fill, not at each show of the page
-        self._name_width = 0                         # what the names need, measured at each fill
-        fit_to_contents(self, SIZED_COLUMNS)         # empty: as wide as their titles
+        self._name_width = self._value_width = 0     # what the names and values need, measured at each fill
+        self._fit_columns()                          # empty: as wide as their titles
         self.internal_folded = False
         self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
         self.parameter_model.modelReset.connect(self._apply_spans)
@@ -297,17 +297,20 @@ class ParameterTable(QTableView):
             self.setRowHidden(row, below_section and self.internal_folded)
             if model.parameter(row).value is None:
                 self.setSpan(row, VALUE, 1, 2)
-        fit_to_contents(self, SIZED_COLUMNS)        # the rows shown changed: the widths they need, once
+        self._fit_columns()                         # the rows shown changed: the widths they need, once
+
+    def _fit_columns(self) -> None:
+        """Measure what the names and values need (once per fill) and share the width by it."""
+        fit_to_contents(self, SIZED_COLUMNS)
         self._name_width = self.columnWidth(NAME)
+        self._value_width = max(self.sizeHintForColumn(VALUE), self.horizontalHeader().sectionSizeHint(VALUE))
         self._share_width()
 
     def _share_width(self) -> None:
         """The names as wide as they need, unless the values would then not fit whole: then the names give way
         (eliding; the tooltip has them). The value column takes what is left, so a reason spanned over it and
         the sigma has the room there is. A value elided read "0.4…" for Qts in a narrow Model lab."""
-        header = self.horizontalHeader()
-        values = max(self.sizeHintForColumn(VALUE), header.sectionSizeHint(VALUE))
-        room = self.viewport().width() - values - self.columnWidth(STD) - self.columnWidth(UNIT)
+        room = self.viewport().width() - self._value_width - self.columnWidth(STD) - self.columnWidth(UNIT)
         name = max(MIN_NAME_WIDTH, min(self._name_width, room))
         if name != self.columnWidth(NAME):
             self.setColumnWidth(NAME, name)
