@@ -59,7 +59,9 @@ def test_a_fit_gives_the_numbers_lmfit_gave(case):
     assert result.varying == tuple(n for n in START if not (case == "phi fixed" and n == "phi"))
     for name, value in want["values"].items():
         assert result.values[name] == pytest.approx(value, rel=1e-9, abs=1e-12), name
-    assert np.diag(result.covar) == pytest.approx(want["variances"], rel=1e-6)
+    # The values agree to 1e-9; the variances, the diagonal of an inverse formed through the machine's BLAS, to
+    # what its kernels round: 1.65e-6 apart on a machine other than the one that printed them.
+    assert np.diag(result.covar) == pytest.approx(want["variances"], rel=1e-5)
     assert result.chisqr == pytest.approx(want["chisqr"], rel=1e-9)
     assert (result.nfev, len(seen), result.message, result.success) == (want["nfev"], want["calls"],
                                                                         want["message"], want["success"])
