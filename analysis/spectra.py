@@ -18,7 +18,7 @@ by Z) is propagated correctly:
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -86,6 +86,10 @@ class Spectra:
     channels: dict[str, ChannelSpectrum]
     impedance: TransferFunction
     displacement: TransferFunction | None
+    # Each analysed channel's per-period spectra at the excited lines (periods x lines), as estimate_spectra
+    # transformed them: the drift check compares the first periods with the last, and would otherwise transform
+    # every period once more (a third of `linpar analyze`'s own work on a standard recording).
+    excited_per_period: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def freqs(self) -> np.ndarray:
@@ -232,8 +236,8 @@ def estimate_spectra(recording: Recording) -> Spectra:
     span = np.arange(excited[0], excited[-1] + 1)
     unexcited = np.setdiff1d(span, excited, assume_unique=True)
 
-    u = per_period["voltage"][:, excited]
-    i = per_period["current"][:, excited]
+    excited_per_period = {name: spec[:, excited] for name, spec in per_period.items()}
+    u, i = excited_per_period["voltage"], excited_per_period["current"]
     impedance = transfer_from_periods("impedance", "ohm", u, i, excited, bin_width)
     displacement = None
     if "displacement" in per_period:
@@ -245,4 +249,5 @@ def estimate_spectra(recording: Recording) -> Spectra:
         displacement = transfer_from_periods("displacement", "m/V", per_period["displacement"][:, x_lines],
                                              u[:, in_band], x_lines, bin_width, displacement_noise_factor(recording))
     return Spectra(recording.sample_rate, n, recording.n_periods, excited, unexcited,
-                   channels, impedance, displacement)
+                   channels, impedance, displacement,
+                   excited_per_period=excited_per_period)

@@ -90,7 +90,9 @@ class Effect:
 
     Subclasses implement `response` (and `guess` when the data say more than
     the default start values). The docstring of each subclass carries its
-    equations.
+    equations. A subclass that adds no field is a plain class: it inherits
+    the methods generated here, and a @dataclass of its own would generate
+    them again at every start (~0.4 ms a class, 10 ms of the catalogue).
     """
 
     id: str

@@ -31,7 +31,6 @@ f2/sqrt(1 - mu2) (cone and m2 move against each other: a peak in Z and Hx).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -64,7 +63,6 @@ def upper_band_grid(ctx, ratio: float) -> list[float] | None:
     return [float(f) for f in np.geomspace(lo, hi, n)]
 
 
-@dataclass(frozen=True)
 class Breakup(Effect):
     """Y2(s) = -mu2*CMES * s^3 / (s^2 + s*w2/Q2 + w2^2), w2 = 2*pi*f2, added to Y = Zm/Bl^2.
 
@@ -119,7 +117,6 @@ breakup = Breakup(
 )
 
 
-@dataclass(frozen=True)
 class SpotMode(Effect):
     """Hx_measured(s) = Hx(s) * (s*w2/Q2 + w2^2) / (s^2 + s*w2/Q2 + w2^2),  w2 = 2*pi*f2x.
 
@@ -170,7 +167,6 @@ COIL_SHARE_START = 0.25
 COIL_GRID_RATIO = 2.0
 
 
-@dataclass(frozen=True)
 class CoilDecoupling(Effect):
     """The coil rides on the cone through the former's joint; the force and the laser are on the coil.
 

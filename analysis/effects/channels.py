@@ -9,7 +9,6 @@ voltage channel (its samples arrive tau later than they should).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -34,7 +33,6 @@ def _clipped(value: float, spec: ParamSpec) -> float:
     return float(min(max(value, spec.min), spec.max))
 
 
-@dataclass(frozen=True)
 class CurrentDelay(Effect):
     """Z_measured(s) = Z(s) * exp(s*tau_i).
 
@@ -76,7 +74,6 @@ delay_current = CurrentDelay(
 )
 
 
-@dataclass(frozen=True)
 class CurrentLowPass(Effect):
     """Z_measured(s) = Z(s) * (1 + s/wc),  wc = 2*pi*fc_i.
 
@@ -112,7 +109,6 @@ lowpass_current = CurrentLowPass(
 )
 
 
-@dataclass(frozen=True)
 class DisplacementDelay(Effect):
     """Hx_measured(s) = Hx(s) * exp(-s*tau_x).
 
@@ -155,7 +151,6 @@ delay_x = DisplacementDelay(
 )
 
 
-@dataclass(frozen=True)
 class DisplacementLowPass(Effect):
     """Hx_measured(s) = Hx(s) / (1 + s/wc), wc = 2*pi*fc_x: a first-order low-pass.
 
@@ -187,7 +182,6 @@ lowpass_x = DisplacementLowPass(
 )
 
 
-@dataclass(frozen=True)
 class DisplacementLowPass2(Effect):
     """Hx_measured(s) = Hx(s) / (1 + s/(Q_x*wc) + (s/wc)^2), wc = 2*pi*fc_x: a second-order low-pass.
 

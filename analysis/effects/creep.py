@@ -12,7 +12,6 @@ the causal laws cannot avoid one (Kramers-Kronig).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,7 +32,6 @@ def _ws(p) -> float:
     return 2.0 * np.pi * resonance_frequency(p)
 
 
-@dataclass(frozen=True)
 class CreepLog(Effect):
     """CMS(jw) = CMS * [1 - lambda*log10(w/ws)], ws = 2*pi*fs (Knudsen and Jensen; real-valued)."""
 
@@ -61,7 +59,6 @@ creep_log = CreepLog(
 )
 
 
-@dataclass(frozen=True)
 class CreepLogCausal(Effect):
     """CMS(s) = CMS * [1 - lambda*log10(s/ws)], s = jw, ws = 2*pi*fs.
 
@@ -94,7 +91,6 @@ creep_log_causal = CreepLogCausal(
 )
 
 
-@dataclass(frozen=True)
 class CreepThreeParameter(Effect):
     """CMS(s) = CMS * [1 + kappa / (1 + s*tau_r)]: the standard linear solid (three-parameter model).
 
@@ -142,7 +138,6 @@ creep_3p = CreepThreeParameter(
 )
 
 
-@dataclass(frozen=True)
 class CreepFractional(Effect):
     """CMS(s) = CMS * (s/ws)^(-beta), s = jw, ws = 2*pi*fs: a fractional-derivative (springpot) stiffness.
 
@@ -178,7 +173,6 @@ creep_fractional = CreepFractional(
 )
 
 
-@dataclass(frozen=True)
 class CreepRetardationSpectrum(Effect):
     """CMS(s) = CMS * [1 + lambda*log10(1 + w0/s)], w0 = 1.5*ws: creep from a flat retardation spectrum.
 
@@ -221,7 +215,6 @@ _FRACTIONAL_REFERENCE = ("W. King, F. T. Agerkvist, 'Fractional derivative louds
                          "fractional calculus model of viscoelastic behavior', J. Rheology 30(1), 1986")
 
 
-@dataclass(frozen=True)
 class CreepKelvinVoigtFractional(Effect):
     """CMS(s) = CMS * (1 + kappa) / (1 + kappa*(s/ws)^beta), s = jw, ws = 2*pi*fs.
 
@@ -262,7 +255,6 @@ creep_kv = CreepKelvinVoigtFractional(
 )
 
 
-@dataclass(frozen=True)
 class CreepZenerFractional(Effect):
     """CMS(s) = CMS * [1 + kappa / (1 + (s*tau_r)^beta)]: the fractional standard linear solid (Zener).
 

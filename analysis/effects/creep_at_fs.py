@@ -18,7 +18,6 @@ and the Qs come within 1-2 %.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,7 +27,6 @@ from analysis.effects.creep import CATEGORY, LAMBDA, _LOG_LAW_REFERENCE, _ws
 _LOG10_J = 1j * np.pi / (2.0 * np.log(10.0))
 
 
-@dataclass(frozen=True)
 class CreepLogCausalAtFs(Effect):
     """CMS(s) = CMS / k'(s), k'(s) = (k(s) - s*b/ws) / a, k(s) = 1 / [1 - lambda*log10(s/ws)], a + j*b = k(j*ws)."""
 

@@ -35,7 +35,6 @@ _REFERENCE = ("R. H. Small, 'Closed-box loudspeaker systems, part I: analysis', 
               "Australia, 1961); R. H. Small, 'Vented-box loudspeaker systems, part I', JAES 21(5), 1973")
 
 
-@dataclass(frozen=True)
 class ClosedBox(Effect):
     """Zm += Kb/s with Kb = alpha_b*Kms: in the model's admittance Y += alpha_b / (s*LCES); alpha_b = Vas/Vb."""
 
@@ -67,7 +66,6 @@ closed_box = ClosedBox(
 )
 
 
-@dataclass(frozen=True)
 class VentedBox(Effect):
     """Zm += Kb*s / (s^2 + s*wb/QL + wb^2), Kb = alpha_b*Kms, wb = 2*pi*fb: in the model's admittance
     Y += (alpha_b/LCES) * s / (s^2 + s*wb/QL + wb^2). See the module docstring for the network."""

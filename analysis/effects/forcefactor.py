@@ -24,7 +24,6 @@ Bl at low frequencies, Bl*(1 - dBl) far above f_Bl; halfway (in the log) at f_Bl
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,7 +32,6 @@ from analysis.effects.base import Effect, ParamSpec, Site
 CATEGORY = "force-factor"
 
 
-@dataclass(frozen=True)
 class EddyForceFactor(Effect):
     """g(s) = 1 - dBl * s*tau / (1 + s*tau), tau = 1 / (2*pi*f_Bl): the factor on Bl in the force and the
     back-EMF (Z = Ze + g^2*Bl^2/Zm, Hx = g*Bl / (s*Zm*Z)); see the module docstring for the derivation."""

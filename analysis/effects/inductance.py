@@ -9,7 +9,6 @@ LE_high = Im(Z)/w at the top lines, the whole inductance seen there.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,7 +24,6 @@ def _top_angular_frequency(ctx) -> float:
     return 2.0 * np.pi * ctx.f_max
 
 
-@dataclass(frozen=True)
 class LR2(Effect):
     """ZP(s) = s*L2*R2 / (s*L2 + R2): an inductance L2 shunted by R2 in series with LE."""
 
@@ -54,7 +52,6 @@ lr2 = LR2(
 )
 
 
-@dataclass(frozen=True)
 class LR3(Effect):
     """ZP(s) = s*L2*R2 / (s*L2 + R2) + s*L3*R3 / (s*L3 + R3): two shunted inductances in series with LE.
 
@@ -96,7 +93,6 @@ lr3 = LR3(
 )
 
 
-@dataclass(frozen=True)
 class Leach(Effect):
     """ZL(s) = K * s^n, with s = jw: K*w^n*[cos(n*pi/2) + j*sin(n*pi/2)], added to RE + s*LE.
 
@@ -138,7 +134,6 @@ leach = Leach(
 )
 
 
-@dataclass(frozen=True)
 class Wright(Effect):
     """ZL(jw) = Rw*(w/w_ref)^Er + j*Xw*(w/w_ref)^Ei, added to RE + s*LE; w_ref = 2*pi*1 kHz.
 

@@ -6,7 +6,6 @@ Both add to Zm; the model's admittance is Y = Zm / Bl^2, so a term in kg/s enter
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -87,7 +86,6 @@ def air_mass(a: float) -> float:
     return 8.0 * RHO * a**3 / 3.0
 
 
-@dataclass(frozen=True)
 class AirLoad(Effect):
     """Zm += Zr(w) - s*8*rho*a^3/3, Zr = rho*c*pi*a^2*[R1(2ka) + j*X1(2ka)] (one side, infinite baffle).
 
@@ -135,7 +133,6 @@ air_load = AirLoad(
 )
 
 
-@dataclass(frozen=True)
 class PowerLawDamping(Effect):
     """Rms(w) = Rms * [1 + r_v*((w/ws)^n_v - 1)], ws = 2*pi*fs: Zm += Rms*r_v*((w/ws)^n_v - 1).
 

@@ -49,7 +49,8 @@ def drift_findings(recording: Recording, spectra: Spectra,
     excited = spectra.excited_bins
     if k < 1 or p < 3:
         return {name: ([], float("nan")) for name in spectra.channels}
-    per_period = {name: period_spectra(recording.periods(name))[:, excited] for name in spectra.channels}
+    per_period = {name: spectra.excited_per_period[name] if name in spectra.excited_per_period
+                  else period_spectra(recording.periods(name))[:, excited] for name in spectra.channels}
     u_mean = spectra.channels["voltage"].mean[excited]
     out = {}
     for name, spec in spectra.channels.items():

@@ -20,14 +20,27 @@ COMMAND_GROUPS = (analyze, diagnose, added_mass, stats, rig, measure, recover, a
                   qa, effects, gui)
 
 
+class _Version(argparse.Action):
+    """`--version`: the installed version, looked up only when asked. Looking it up (importlib.metadata) cost
+    15-30 ms of every command's start when argparse's own version action was given it at the parser's building."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                 help="show the program's version number and exit"):
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from app.crash_report import version
+        print(f"linpar {version()}")
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="linpar", description="Loudspeaker linear parameters from voltage, current and "
                                                "laser displacement.")
     parser.add_argument("--size-limit", action="append", type=size_limit, metavar="KIND=SIZE", default=[],
                         help="read larger files than the defaults, which fit any real measurement: KIND is "
                              f"{', '.join(SIZE_KINDS)}; SIZE like 500M or 4G (before the command; repeatable)")
-    from app.crash_report import version
-    parser.add_argument("--version", action="version", version=f"linpar {version()}")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for group in COMMAND_GROUPS:
         group.register(sub)

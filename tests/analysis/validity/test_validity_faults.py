@@ -86,3 +86,29 @@ def test_a_small_share_of_laser_errors_is_only_yellow():
 def test_a_slow_drift_is_yellow():
     _, found = _judged(faults.heating_drift(rise=0.04))
     assert found["current"].get("drift") == "yellow"
+
+
+def test_the_drift_check_reuses_the_spectra_transform_and_finds_the_same(monkeypatch):
+    """drift_findings reads the per-period spectra estimate_spectra kept, and gets what transforming the periods
+    again gives: a spectra object without them (built elsewhere) takes the old path."""
+    import dataclasses
+
+    from analysis.spectra import estimate_spectra
+    from analysis.thresholds import DEFAULT_THRESHOLDS
+    from analysis.validity import drift
+
+    recording = faults.heating_drift(rise=0.04)
+    spectra = estimate_spectra(recording)
+    assert set(spectra.excited_per_period) == set(spectra.channels)
+    again = drift.drift_findings(recording, dataclasses.replace(spectra, excited_per_period={}), DEFAULT_THRESHOLDS)
+
+    def no_second_transform(_periods):
+        raise AssertionError("the periods were transformed again")
+
+    monkeypatch.setattr(drift, "period_spectra", no_second_transform)
+    kept = drift.drift_findings(recording, spectra, DEFAULT_THRESHOLDS)
+    assert kept.keys() == again.keys()
+    for name in kept:
+        assert kept[name][1] == pytest.approx(again[name][1], rel=1e-12, nan_ok=True)
+        assert [f.code for f in kept[name][0]] == [f.code for f in again[name][0]]
+    assert kept["current"][0] and kept["current"][1] > 0.01        # the injected 4 % rise is found
