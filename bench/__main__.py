@@ -8,6 +8,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import app.cli  # noqa: F401 - first: one BLAS thread per process, as `linpar` and its window run (app/cli/__init__.py)
 from bench import (analysis_bench, archive_bench, gui_bench, large_signal_bench, production_bench, report_bench,
                    rig_bench, validity_bench)
 from bench.common import RESULTS_DIR

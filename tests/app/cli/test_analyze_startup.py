@@ -3,6 +3,7 @@ startup rows), and every library it loads without calling is paid on every run."
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -56,3 +57,24 @@ def test_export_still_offers_every_format_of_the_registry(capsys):
     shown = " ".join(capsys.readouterr().out.split())      # argparse wraps at the terminal's width
     for kind, what in export_options():
         assert f"--{kind.replace('_', '-')} FILE" in shown and what in shown
+
+
+BLAS_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+THREADS_AFTER_NUMPY = ("import os, sys\n"
+                       "import app.cli, numpy\n"
+                       "print(os.environ['OPENBLAS_NUM_THREADS'], len(os.listdir('/proc/self/task')))\n")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="counts the process's threads in /proc")
+def test_the_command_runs_one_blas_thread_unless_the_user_chose_another_number():
+    """app/cli/__init__.py: set before numpy is imported, so that no BLAS thread spins beside the command's own."""
+    bare = {k: v for k, v in os.environ.items() if k not in BLAS_VARIABLES}
+    ours = subprocess.run([sys.executable, "-c", THREADS_AFTER_NUMPY], cwd=REPO, env=bare, capture_output=True,
+                          text=True, timeout=paced(60))
+    assert ours.returncode == 0, ours.stderr
+    assert ours.stdout.split() == ["1", "1"]            # the variable, and the process's one thread
+    chosen = subprocess.run([sys.executable, "-c", THREADS_AFTER_NUMPY], cwd=REPO,
+                            env={**bare, "OPENBLAS_NUM_THREADS": "3"}, capture_output=True, text=True,
+                            timeout=paced(60))
+    assert chosen.returncode == 0, chosen.stderr
+    assert chosen.stdout.split()[0] == "3"
