@@ -24,11 +24,20 @@ def _top_angular_frequency(ctx) -> float:
     return 2.0 * np.pi * ctx.f_max
 
 
+def _shunted(s, inductance: float, resistance: float):
+    """s*L*R / (s*L + R), an inductance shunted by a resistance: 0 when either is 0 (no inductance, or a short),
+    the limit the fraction tends to. Both bounds admit 0, and a fit at both read 0/0: NaN, and a RuntimeWarning on
+    the user's terminal."""
+    if inductance == 0.0 or resistance == 0.0:
+        return np.zeros_like(s)
+    return s * inductance * resistance / (s * inductance + resistance)
+
+
 class LR2(Effect):
     """ZP(s) = s*L2*R2 / (s*L2 + R2): an inductance L2 shunted by R2 in series with LE."""
 
     def response(self, s, p):
-        return s * p["L2"] * p["R2"] / (s * p["L2"] + p["R2"])
+        return _shunted(s, p["L2"], p["R2"])
 
     def guess(self, ctx):
         return {"L2": max(ctx.LE_high, 1e-6), "R2": max(ctx.RE, 0.1)}
@@ -61,8 +70,7 @@ class LR3(Effect):
     """
 
     def response(self, s, p):
-        return (s * p["L2"] * p["R2"] / (s * p["L2"] + p["R2"])
-                + s * p["L3"] * p["R3"] / (s * p["L3"] + p["R3"]))
+        return _shunted(s, p["L2"], p["R2"]) + _shunted(s, p["L3"], p["R3"])
 
     def guess(self, ctx):
         L = max(ctx.LE_high, 1e-6)

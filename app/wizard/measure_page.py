@@ -185,10 +185,14 @@ class MeasurePage(WizardPage):
     def on_large_signal(self, done) -> None:
         self.large_signal_done = done
         plan = done.plan
-        steps = f"{len(plan.steps)} step(s) recorded in {html.escape(str(self.out_dir()))}; stopped: " \
-                f"{html.escape(plan.message)}. "
+        # Plain text: coloured() escapes it (escaped here too, a folder or a message with "&" read "&amp;").
+        steps = f"{len(plan.steps)} step(s) recorded in {self.out_dir()}; stopped: {plan.message}. "
+        # A complete step with words of its own was measured again at its level (its laser stream misplaced in
+        # time): said here, as the CLI says it, or the user would count one step more than the levels shown.
+        steps += "".join(f"Step {step.index} ({step.level_v:.3g} V): {step.message}. "
+                         for step in plan.steps if step.message and not step.partial)
         if done.result is None:
-            self.result.setText(coloured(steps + "Not identified: " + html.escape(done.error), ERROR_COLOUR))
+            self.result.setText(coloured(steps + "Not identified: " + done.error, ERROR_COLOUR))
         else:
             self.result.setText(coloured(steps, OK_COLOUR) + "The curves are on the Large-signal page.")
             self.large_signal_measured.emit(done)

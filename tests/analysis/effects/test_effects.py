@@ -1,5 +1,6 @@
 """The effects catalogue: every effect's equation and its limits (the bookkeeping: test_catalogue.py)."""
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -177,6 +178,17 @@ def test_blocked_impedance_terms_vanish_at_dc(effect_id):
 def test_lr3_contains_lr2():
     values = {"L2": 0.264e-3, "R2": 3.52, "L3": 0.0, "R3": 1.0}
     np.testing.assert_allclose(_response("lr3", values, FREQS), _response("lr2", values, FREQS), rtol=1e-12)
+
+
+@pytest.mark.parametrize("stage", [{"L3": 0.0, "R3": 0.0}, {"L3": 0.5e-3, "R3": 0.0}])
+def test_a_shunted_stage_at_its_bounds_adds_nothing_and_warns_of_nothing(stage):
+    """Both of a stage's bounds admit 0: at L = R = 0 the fraction was 0/0, a NaN in the fit and a RuntimeWarning
+    on the user's terminal. Its limit is 0, as at either alone (no inductance; a short)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lr3 = _response("lr3", {"L2": 0.264e-3, "R2": 3.52, **stage}, FREQS)
+        assert np.all(_response("lr2", {"L2": 0.0, "R2": 0.0}, FREQS) == 0)
+    np.testing.assert_allclose(lr3, _response("lr2", {"L2": 0.264e-3, "R2": 3.52}, FREQS), rtol=1e-12)
 
 
 def test_leach_has_a_constant_phase_of_n_times_90_degrees():

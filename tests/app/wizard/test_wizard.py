@@ -180,6 +180,22 @@ def test_a_failing_device_is_a_message_not_a_crash(qtbot, wizard, monkeypatch):
     assert wizard.next_button.isEnabled()          # a test is advice; the user may go on
 
 
+def test_a_large_signal_step_measured_again_is_said_with_its_reason(qtbot, wizard, tmp_path):
+    """The plan's outcome as the Measure step shows it: a step measured again at its level (its laser stream
+    misplaced in time) is named with the plan's words, escaped, beside the count of steps."""
+    from app.wizard.tasks import LargeSignalMeasured
+    from instruments.measurement.large_signal_plan import LargeSignalOutcome, PlanStep
+
+    again = "measured again at the same level: the displacement at 4 V changed by 10% <from period to period>"
+    steps = (PlanStep(1, 2.0, None, None), PlanStep(2, 4.0, None, None, message=again),
+             PlanStep(3, 4.0, None, None), PlanStep(4, 6.0, None, None, partial=True, message="cancelled"))
+    plan = LargeSignalOutcome(steps, "cancelled", "cancelled during step 4 (6 V)", tmp_path / "summary.json")
+    wizard.measure_page.on_large_signal(LargeSignalMeasured(plan, None, "no usable step"))
+    shown = plain(wizard.measure_page.result)
+    assert "4 step(s) recorded" in shown and f"Step 2 (4 V): {again}." in shown
+    assert "Step 4" not in shown and "Step 1" not in shown      # the stop's words are the plan's; step 1 has none
+
+
 def test_the_large_signal_template_runs_the_plan_and_hands_the_curves_over(qtbot, wizard):
     """On the simulator (the paper's driver, linear): the plan steps up to the excursion set here, each step a
     recording, and the identification of the steps goes to the Large-signal page (flat curves: no nonlinearity)."""
