@@ -135,8 +135,12 @@ class MeasurePage(WizardPage):
         if self.jobs.busy:
             return "Wait for the measurement to finish, or cancel it."
         if self.is_large_signal():
-            return ("The curves are on the Large-signal page." if self.large_signal_done is not None
-                    else "Start the large-signal plan.")
+            done = self.large_signal_done
+            if done is None:
+                return "Start the large-signal plan."
+            # Not "the curves are on the Large-signal page" when none were identified: the words above say why.
+            return ("The curves are on the Large-signal page." if done.result is not None
+                    else "No curves were identified (the reason is above): start the large-signal plan again.")
         if self.state.outcome is None:
             return "Start the measurement."
         return None

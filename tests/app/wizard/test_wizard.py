@@ -183,9 +183,11 @@ def test_a_failing_device_is_a_message_not_a_crash(qtbot, wizard, monkeypatch):
 def test_a_large_signal_step_measured_again_is_said_with_its_reason(qtbot, wizard, tmp_path):
     """The plan's outcome as the Measure step shows it: a step measured again at its level (its laser stream
     misplaced in time) is named with the plan's words, escaped, beside the count of steps."""
+    from app.wizard.plans import DriverInfo
     from app.wizard.tasks import LargeSignalMeasured
     from instruments.measurement.large_signal_plan import LargeSignalOutcome, PlanStep
 
+    wizard.state.driver = DriverInfo("woofer", "1", 0.0133, 8.0, "large-signal")
     again = "measured again at the same level: the displacement at 4 V changed by 10% <from period to period>"
     steps = (PlanStep(1, 2.0, None, None), PlanStep(2, 4.0, None, None, message=again),
              PlanStep(3, 4.0, None, None), PlanStep(4, 6.0, None, None, partial=True, message="cancelled"))
@@ -194,6 +196,7 @@ def test_a_large_signal_step_measured_again_is_said_with_its_reason(qtbot, wizar
     shown = plain(wizard.measure_page.result)
     assert "4 step(s) recorded" in shown and f"Step 2 (4 V): {again}." in shown
     assert "Step 4" not in shown and "Step 1" not in shown      # the stop's words are the plan's; step 1 has none
+    assert wizard.measure_page.missing().startswith("No curves were identified")     # not "the curves are on…"
 
 
 def test_the_large_signal_template_runs_the_plan_and_hands_the_curves_over(qtbot, wizard):
