@@ -93,6 +93,9 @@ class Effect:
     equations. A subclass that adds no field is a plain class: it inherits
     the methods generated here, and a @dataclass of its own would generate
     them again at every start (~0.4 ms a class, 10 ms of the catalogue).
+    Its fields stay frozen; an attribute that is not a field could be added
+    to such an instance (the generated __setattr__ refuses it only on Effect
+    itself), and nothing does.
     """
 
     id: str

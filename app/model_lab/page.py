@@ -26,6 +26,7 @@ from analysis.diagnosis.refit_words import refit_text
 from app.jobs.controls import JobControls
 from app.jobs.lab_outcome import DiagnosisOutcome, LabFit, first_version
 from app.jobs.lab_worker import LabWorker
+from app.jobs.next_turn import in_a_later_turn
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
@@ -33,8 +34,11 @@ from app.model_lab.sites import SitePanel
 from app.model_lab.session import LabSession
 from app.model_lab.versions import LabVersion, changed_model, move_text
 from app.results.parameter_table import titled_parameter_table
+from app.widgets.layout_room import LinesLabel
 from app.jobs.workers import AnalysisOutcome
 
+HEADER_LINES = 3        # the version and its fit's headline, and a third line (the fit did not converge; wrapping)
+_DONE = object()        # what next() gives a generator of steps that has none left
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")
 
@@ -51,17 +55,18 @@ class ModelLab(QWidget):
         self.worker = LabWorker(self)
         self.session = LabSession()                 # the recording, the versions, the diagnosis (no Qt)
         self.new_effect_dialog = None               # the "New effect…" dialog while it is open
+        self._in_turns = None                       # the steps left of a version shown in turns (a refit's)
 
         self.empty = QLabel(EMPTY_TEXT)
         self.empty.setAlignment(Qt.AlignCenter)
         self.empty.setWordWrap(True)
 
-        self.model_label = QLabel()
+        # The header's texts keep HEADER_LINES lines whatever they say (LinesLabel): its height changing with a
+        # refit's words resized the chart and the residual plots below it.
+        self.model_label = LinesLabel(HEADER_LINES, whole_in_tooltip=False)     # its tooltip: the fit's report
         self.model_label.setTextFormat(Qt.RichText)
-        self.model_label.setWordWrap(True)
         self.model_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
-        self.status_label = QLabel()
-        self.status_label.setWordWrap(True)
+        self.status_label = LinesLabel(HEADER_LINES)
         self.status_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
         # The refit or diagnosis running: what it does, a busy indicator and Cancel.
         self.jobs = JobControls(self.worker, cancel_tip="Stop the refit or diagnosis; the current version stays",
@@ -167,6 +172,7 @@ class ModelLab(QWidget):
                 self._show_parameters()
             return
         self.jobs.drop()
+        self._in_turns = None           # the steps left of a version of the old recording
         self.session.restart(result)
         if result.fit is None:          # a broken measurement: nothing the lab could start from
             self.empty.setText(f"Nothing to model: {result.not_fitted}")
@@ -187,10 +193,25 @@ class ModelLab(QWidget):
         return self.worker.shutdown(wait_ms)
 
     def _add_version(self, fitted: LabFit, how: str, adopt: bool = True, announce: bool = True) -> LabVersion:
+        self._in_turns = None           # a version still being shown in turns is overtaken by this one
         version = self.session.add(fitted, how)
         for _ in self._showing_added(version, adopt, announce):
             pass
         return version
+
+    def _add_version_in_turns(self, fitted: LabFit, how: str) -> None:
+        """_add_version, each step of the page's update in a turn of its own (in_a_later_turn): for a refit that a
+        checkbox asked for. In one turn, the residual plots, the table and the chart, with the paints their scenes
+        start at once (a QGraphicsView sends the window's pending paint when its scene has processed a change),
+        held the GUI thread 50-80 ms of CPU. A newer version, shown in turns or at once, drops the steps left."""
+        version = self.session.add(fitted, how)
+        steps = self._showing_added(version, adopt=True, announce=True)
+        self._in_turns = steps
+
+        def step() -> None:
+            if self._in_turns is steps and next(steps, _DONE) is not _DONE:
+                in_a_later_turn(self, step)
+        step()
 
     def _showing_added(self, version: LabVersion, adopt: bool, announce: bool) -> Iterator[None]:
         yield from self._showing_current()
@@ -330,8 +351,8 @@ class ModelLab(QWidget):
     # -- the jobs' outcomes ------------------------------------------------
     def on_refit_finished(self, fitted: LabFit) -> None:
         old = self.current
-        self._add_version(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
         self.status_label.setText(refit_text(old.fitted.fit, fitted.fit))
+        self._add_version_in_turns(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
 
     def on_diagnosis_finished(self, outcome: DiagnosisOutcome, follow: bool = False) -> None:
         start = self.current.number

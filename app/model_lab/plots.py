@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QLabel, QVBoxLayout, QWidget
 
 from app.widgets import style
 from app.widgets.grid_axis import OpaqueGridAxis, show_grid
+from app.widgets.layout_room import LinesLabel
 from app.widgets.plots import LEFT_AXIS_WIDTH, RESIDUAL_MIN_RANGE, LogFrequencyAxis
 from app.widgets.still_scene import StillPlotWidget, StillScene
 from app.results.curves import ChannelCurves, ResultCurves
@@ -22,6 +23,7 @@ CHANNEL_COLOURS = {"impedance": style.MEASURED, "displacement": style.RESIDUAL_I
 NOISE_FLOOR_COLOUR = "#2e7d32"
 PIXELS_PER_VERSION_LABEL = 36
 LISTED_VERSIONS = 8
+LEGEND_LINES = 3            # the chart's list of versions: cut beyond, whole in its tooltip
 PIXELS_PER_DECADE_LABEL = 22
 
 
@@ -220,8 +222,7 @@ class ChiSquareChart(QWidget):
             item.scatter.setAcceptHoverEvents(True)
             plot.addItem(item)
             self.series[channel] = item
-        self.legend_label = QLabel()
-        self.legend_label.setWordWrap(True)
+        self.legend_label = LinesLabel(LEGEND_LINES)       # a line more per version moved the plot above it
         self.legend_label.setTextFormat(Qt.RichText)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)

@@ -1,7 +1,7 @@
 """Widgets that come and go without moving the rest of the page."""
 from __future__ import annotations
 
-from PySide6.QtWidgets import QWidget
+from PySide6.QtWidgets import QLabel, QSizePolicy, QWidget
 
 
 def keep_room_when_hidden(*widgets: QWidget) -> None:
@@ -15,3 +15,26 @@ def keep_room_when_hidden(*widgets: QWidget) -> None:
         policy = widget.sizePolicy()
         policy.setRetainSizeWhenHidden(True)
         widget.setSizePolicy(policy)
+
+
+class LinesLabel(QLabel):
+    """A word-wrapped label always `lines` tall, whatever it says: a longer text is cut, and (unless the page gives
+    the label a tooltip of its own) the tooltip has the whole of it.
+
+    A text that wrapped to one line more or less than the one before changed its row's height and so resized
+    every plot below it: after each refit of the Model lab its header (56 -> 112 px and back) and the chart's list
+    of versions (a line more each time) moved the chart and the residual plots, which pyqtgraph then laid out and
+    redrew, ~30 ms of the GUI thread each.
+    """
+
+    def __init__(self, lines: int, whole_in_tooltip: bool = True, parent=None):
+        super().__init__(parent)
+        self.whole_in_tooltip = whole_in_tooltip
+        self.setWordWrap(True)
+        self.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Fixed)
+        self.setFixedHeight(lines * self.fontMetrics().lineSpacing())
+
+    def setText(self, text: str) -> None:
+        super().setText(text)
+        if self.whole_in_tooltip:
+            self.setToolTip(text)

@@ -78,3 +78,9 @@ def test_the_command_runs_one_blas_thread_unless_the_user_chose_another_number()
                             timeout=paced(60))
     assert chosen.returncode == 0, chosen.stderr
     assert chosen.stdout.split()[0] == "3"
+    # OpenBLAS reads its own variable before OMP_NUM_THREADS: a user's OMP_NUM_THREADS alone must not be overridden.
+    omp = subprocess.run([sys.executable, "-c", "import os, app.cli\nprint(os.environ.get('OPENBLAS_NUM_THREADS'))"],
+                         cwd=REPO, env={**bare, "OMP_NUM_THREADS": "2"}, capture_output=True, text=True,
+                         timeout=paced(60))
+    assert omp.returncode == 0, omp.stderr
+    assert omp.stdout.split() == ["None"]
