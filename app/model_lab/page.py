@@ -37,7 +37,7 @@ from app.results.parameter_table import titled_parameter_table
 from app.widgets.layout_room import LinesLabel
 from app.jobs.workers import AnalysisOutcome
 
-HEADER_LINES = 3        # the version and its fit's headline, and a third line (the fit did not converge; wrapping)
+HEADER_LINES = 4        # the version (two lines with the how of a first version), its fit's headline (one or two)
 _DONE = object()        # what next() gives a generator of steps that has none left
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")
@@ -214,10 +214,14 @@ class ModelLab(QWidget):
         step()
 
     def _showing_added(self, version: LabVersion, adopt: bool, announce: bool) -> Iterator[None]:
+        """The page's update for a new version, in steps (see _showing_current), then the diagnosis marked stale and
+        the version announced (the Results page's first step runs in the announcing turn), each a step of its own."""
         yield from self._showing_current()
         if self.diagnosis is not None and not self.session.diagnosis_is_current:
+            yield
             self.candidates.mark_stale(version.number)
             self.site_panel.mark_stale(version.number)
+        yield
         if adopt and announce:
             result = version.fitted.result
             self.model_adopted.emit(AnalysisOutcome(version.number, result.source or Path(), result,

@@ -24,6 +24,7 @@ NOISE_FLOOR_COLOUR = "#2e7d32"
 PIXELS_PER_VERSION_LABEL = 36
 LISTED_VERSIONS = 8
 LEGEND_LINES = 3            # the chart's list of versions: cut beyond, whole in its tooltip
+RESIDUAL_WORDS_LINES = 3    # where the residual sits, in words, over the residual plots
 PIXELS_PER_DECADE_LABEL = 22
 
 
@@ -91,8 +92,7 @@ class ResidualPanel(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.text = QLabel()
-        self.text.setWordWrap(True)
+        self.text = LinesLabel(RESIDUAL_WORDS_LINES)      # as many lines for every version: the plots stay put
         self.text.setTextFormat(Qt.RichText)
         self.text.setTextInteractionFlags(Qt.TextSelectableByMouse)
         self.impedance = ResidualPlot("impedance", bottom_label=False)

@@ -1,6 +1,7 @@
 """Widgets that come and go without moving the rest of the page."""
 from __future__ import annotations
 
+from PySide6.QtCore import QSize, Qt
 from PySide6.QtWidgets import QLabel, QSizePolicy, QWidget
 
 
@@ -18,21 +19,36 @@ def keep_room_when_hidden(*widgets: QWidget) -> None:
 
 
 class LinesLabel(QLabel):
-    """A word-wrapped label always `lines` tall, whatever it says: a longer text is cut, and (unless the page gives
-    the label a tooltip of its own) the tooltip has the whole of it.
+    """A word-wrapped label `lines` tall whatever it says: a longer text is cut, and (unless the page gives the
+    label a tooltip of its own) the tooltip has the whole of it. Squeezed (a window at its smallest), it gives way
+    down to one line: it asks for its lines without adding them to the window's minimum size.
 
     A text that wrapped to one line more or less than the one before changed its row's height and so resized
-    every plot below it: after each refit of the Model lab its header (56 -> 112 px and back) and the chart's list
-    of versions (a line more each time) moved the chart and the residual plots, which pyqtgraph then laid out and
-    redrew, ~30 ms of the GUI thread each.
+    every plot below it: after each refit of the Model lab its header (56 -> 112 px and back), the words over the
+    residual plots and the chart's list of versions (a line more each time) moved the chart and the residual
+    plots, which pyqtgraph then laid out and redrew, ~30 ms of the GUI thread each.
     """
 
     def __init__(self, lines: int, whole_in_tooltip: bool = True, parent=None):
         super().__init__(parent)
         self.whole_in_tooltip = whole_in_tooltip
+        self.lines = lines
         self.setWordWrap(True)
-        self.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Fixed)
-        self.setFixedHeight(lines * self.fontMetrics().lineSpacing())
+        self.setAlignment(Qt.AlignLeft | Qt.AlignTop)      # a short text where a long one starts, not mid-box
+        self.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Maximum)
+        self.setMaximumHeight(self._line_height() * lines)
+
+    def _line_height(self) -> int:
+        return self.fontMetrics().lineSpacing()
+
+    def hasHeightForWidth(self) -> bool:
+        return False            # the text's wrapping never asks the layout for another height
+
+    def sizeHint(self) -> QSize:
+        return QSize(super().sizeHint().width(), self._line_height() * self.lines)
+
+    def minimumSizeHint(self) -> QSize:
+        return QSize(super().minimumSizeHint().width(), self._line_height())
 
     def setText(self, text: str) -> None:
         super().setText(text)

@@ -198,6 +198,39 @@ def test_checking_a_second_effect_of_a_category_swaps_it(qtbot, lab):
     assert "R3" in version.fitted.fit.values and "R2" in version.fitted.fit.values
 
 
+def test_refits_leave_the_plots_where_they_were(qtbot, lab):
+    """The header's words and the chart's list of versions keep their lines (LinesLabel): a refit whose words
+    wrapped to more lines resized the chart and the residual plots, which pyqtgraph then laid out and redrew."""
+    from app.model_lab.page import HEADER_LINES
+    plots = (lab.chart.plot_widget, lab.residual_panel.impedance, lab.residual_panel.displacement)
+    qtbot.wait(50)
+    sizes = [plot.size() for plot in plots]
+    header = lab.model_label.height()
+    for effect_id, checked in (("creep-log", True), ("lr3", True), ("lr2", True), ("creep-log", False)):
+        _toggle(qtbot, lab, effect_id, checked)
+        qtbot.wait(20)
+        assert [plot.size() for plot in plots] == sizes, effect_id
+        assert lab.model_label.height() == header == HEADER_LINES * lab.model_label.fontMetrics().lineSpacing()
+    assert lab.status_label.toolTip() == lab.status_label.text() != ""      # a cut text is whole in its tooltip
+    assert len(lab.versions) == 5 and "Versions:" in lab.chart.legend_label.toolTip()
+
+
+def test_a_newer_version_drops_the_steps_left_of_one_shown_in_turns(qtbot, lab, full_result):
+    """A refit's version is shown a step per turn; a version added meanwhile (here at once, as a diagnosis adds
+    its path) takes the page, and the older one's steps left never run: nothing of it is drawn over the newer."""
+    from app.jobs.lab_outcome import first_version
+    fitted, _how = first_version(full_result)
+    older, _ = first_version(lab.base)
+    adopted = []
+    lab.model_adopted.connect(adopted.append)
+    lab._add_version_in_turns(older, "shown in turns")
+    lab._add_version(fitted, "added at once")
+    qtbot.wait(100)
+    assert [o.job for o in adopted] == [3]                  # the version added at once; not the one in turns
+    assert lab.model_label.text().startswith("<b>Version 3</b>")
+    assert lab.current.fitted is fitted
+
+
 def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
     threads = []
 
