@@ -258,9 +258,9 @@ class MainWindow(QMainWindow):
     def on_model_adopted(self, outcome: AnalysisOutcome) -> None:
         """A version of the Model lab's, adopted: shown, and its model part estimated as for an opened file's.
 
-        The Results page fills in turns of its own (show_outcome_in_turns): the lab has just drawn the new version
-        in this turn, and the two pages' updates in one turn held the GUI thread 85-160 ms of CPU after a refit
-        that a checkbox asked for."""
+        The Results page fills in turns of its own (show_outcome_in_turns): the lab has just drawn the new version,
+        and the Results page's update of it (~25 ms of the GUI thread) came in the same turn after a refit that a
+        checkbox asked for."""
         self.results.show_outcome_in_turns(
             outcome, then=lambda: self.result_pages.after(lambda: self.start_model_part(outcome)))
 
