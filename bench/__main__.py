@@ -8,10 +8,13 @@ import tempfile
 import time
 from pathlib import Path
 
-import app.cli  # noqa: F401 - first: one BLAS thread per process, as `linpar` and its window run (app/cli/__init__.py)
-from bench import (analysis_bench, archive_bench, gui_bench, large_signal_bench, production_bench, report_bench,
-                   rig_bench, validity_bench)
-from bench.common import RESULTS_DIR
+from app.blas_threads import one_blas_thread
+
+one_blas_thread()       # first: one BLAS thread per process, as `linpar` and its window run
+
+from bench import (analysis_bench, archive_bench, gui_bench, large_signal_bench,  # noqa: E402 - after that
+                   production_bench, report_bench, rig_bench, validity_bench)
+from bench.common import RESULTS_DIR  # noqa: E402
 
 SUITES = {"analysis": analysis_bench.run, "validity": validity_bench.run, "rig": rig_bench.run, "archive": archive_bench.run,
           "production": production_bench.run, "report": report_bench.run, "gui": gui_bench.run, "large-signal": large_signal_bench.run}

@@ -80,11 +80,10 @@ def model_part_rows(standard: Path) -> list[Row]:
 
 
 # The floor of `linpar analyze`: a process that reads the recording and takes its FFTs, and nothing else; with the
-# one BLAS thread linpar's command sets itself (app/cli/__init__.py), so that both are timed alike.
-FLOOR = ("import os, sys\n"
-         "names = ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS', 'MKL_NUM_THREADS')\n"
-         "if not any(os.environ.get(name) for name in names):\n"
-         "    os.environ.update(dict.fromkeys(names, '1'))\n"
+# one BLAS thread linpar's command sets itself (app/blas_threads.py), so that both are timed alike.
+FLOOR = ("import sys\n"
+         "from app.blas_threads import one_blas_thread\n"
+         "one_blas_thread()\n"
          "from analysis.recording.format import read_recording\n"
          "from analysis.spectra import estimate_spectra\n"
          "estimate_spectra(read_recording(sys.argv[1]))")

@@ -8,12 +8,13 @@ from collections import Counter
 
 import pytest
 
+from app.blas_threads import one_blas_thread
+
 # One BLAS thread per test process (its workers and subprocesses inherit it). OpenBLAS starts a thread per core
 # and spins them while it waits; with make test's three workers on two cores they spun against each other: three
 # noise seeds of the large-signal band test took 29.8 s of CPU with two threads, 4.3 s with one, same results.
-# Set here, before anything imports numpy; a value the user set stands.
-for _blas_threads in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_blas_threads, "1")
+# Set here, before anything imports numpy, as linpar itself does (app/blas_threads.py); a value the user set stands.
+one_blas_thread()
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -26,7 +26,7 @@ from analysis.diagnosis.refit_words import refit_text
 from app.jobs.controls import JobControls
 from app.jobs.lab_outcome import DiagnosisOutcome, LabFit, first_version
 from app.jobs.lab_worker import LabWorker
-from app.jobs.next_turn import in_a_later_turn
+from app.jobs.next_turn import in_turns
 from app.model_lab.candidates import APPLY_TIP, CandidatesPanel, fit_words
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import ChartPoint, ChiSquareChart, ResidualPanel
@@ -38,7 +38,6 @@ from app.widgets.layout_room import LinesLabel
 from app.jobs.workers import AnalysisOutcome
 
 HEADER_LINES = 4        # the version (two lines with the how of a first version), its fit's headline (one or two)
-_DONE = object()        # what next() gives a generator of steps that has none left
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")
 
@@ -200,18 +199,13 @@ class ModelLab(QWidget):
         return version
 
     def _add_version_in_turns(self, fitted: LabFit, how: str) -> None:
-        """_add_version, each step of the page's update in a turn of its own (in_a_later_turn): for a refit that a
+        """_add_version, each step of the page's update in a turn of its own (next_turn.in_turns): for a refit that a
         checkbox asked for. In one turn, the residual plots, the table and the chart, with the paints their scenes
         start at once (a QGraphicsView sends the window's pending paint when its scene has processed a change),
         held the GUI thread 50-80 ms of CPU. A newer version, shown in turns or at once, drops the steps left."""
         version = self.session.add(fitted, how)
-        steps = self._showing_added(version, adopt=True, announce=True)
-        self._in_turns = steps
-
-        def step() -> None:
-            if self._in_turns is steps and next(steps, _DONE) is not _DONE:
-                in_a_later_turn(self, step)
-        step()
+        steps = self._in_turns = self._showing_added(version, adopt=True, announce=True)
+        in_turns(self, steps, going_on=lambda: self._in_turns is steps)
 
     def _showing_added(self, version: LabVersion, adopt: bool, announce: bool) -> Iterator[None]:
         """The page's update for a new version, in steps (see _showing_current), then the diagnosis marked stale and

@@ -18,9 +18,8 @@ from app.results.parameter_table import titled_parameter_table
 from app.widgets.plots import TransferPlot
 from app.results.spl_panel import SplPanel
 from app.jobs.workers import AnalysisOutcome
-from app.jobs.next_turn import in_a_later_turn
+from app.jobs.next_turn import in_turns
 
-_DONE = object()
 EMPTY_TEXT = ("No recording loaded.\n\nOpen one with File ▸ Open recording… (Ctrl+O), "
               "or drop a recording's .wav or .json file on this window.")
 
@@ -154,19 +153,8 @@ class ResultsView(QWidget):
         once a newer result (show_outcome, clear) replaced it on its way: what waits for it (the archive's store)
         is never lost."""
         self._filling += 1
-        filling, steps = self._filling, self._showing(outcome)
-
-        def step() -> None:
-            try:
-                more = filling == self._filling and next(steps, _DONE) is not _DONE
-            except Exception:
-                then()          # a step that failed must not keep the archive's store waiting; Qt logs the error
-                raise
-            if more:
-                in_a_later_turn(self, step)
-            else:
-                then()
-        step()
+        filling = self._filling
+        in_turns(self, self._showing(outcome), going_on=lambda: filling == self._filling, then=then)
 
     def _showing(self, outcome: AnalysisOutcome) -> Iterator[None]:
         """The page filled in four steps, each up to a `yield`: the words and the table, |Z|, Hx, the rest."""

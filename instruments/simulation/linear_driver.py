@@ -69,6 +69,16 @@ def frequency_sampled_fir(response: Callable[[np.ndarray], np.ndarray], sample_r
     return scipy.fft.irfft(spectrum, length)
 
 
+def _trailing_zeros(x: np.ndarray) -> int:
+    """How many samples at the end of `x` are zero (all of them for a silent block). A block being played ends
+    on a sample that is not zero: answered without a search, which would index every sample of every block."""
+    if x.size == 0 or x[-1] != 0.0:
+        return 0
+    if not x.any():
+        return x.size
+    return x.size - 1 - int(np.flatnonzero(x)[-1])
+
+
 class PartitionedConvolver:
     """Several FIRs of equal length applied to one input stream, UPOLS, no latency.
 
@@ -114,13 +124,13 @@ class PartitionedConvolver:
 
     def process(self, x: np.ndarray) -> np.ndarray:
         x = np.asarray(x, dtype=np.float64).ravel()
-        nonzero = np.flatnonzero(x)
-        if nonzero.size == 0 and self._zero_run >= self._quiet:
+        trailing = _trailing_zeros(x)
+        if trailing == x.size and self._zero_run >= self._quiet:
             # Silence into a silent state (module doc): the partitions it completes are zero, as is all held.
             self._fill = (self._fill + x.size) % self._B
             self._zero_run += x.size
             return np.zeros((self._n_filters, x.size))
-        self._zero_run = self._zero_run + x.size if nonzero.size == 0 else x.size - 1 - int(nonzero[-1])
+        self._zero_run = self._zero_run + x.size if trailing == x.size else trailing
         out = np.empty((self._n_filters, x.size))
         B, pos = self._B, 0
         while pos < x.size:
