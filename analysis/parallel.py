@@ -23,8 +23,17 @@ def worker_count() -> int:
     return max(1, min(os.cpu_count() or 1, 4))
 
 
-def _run_in_the_background() -> None:
+def run_in_the_background() -> None:
+    """A worker's initializer: lower than its caller (BACKGROUND_NICENESS)."""
     os.nice(BACKGROUND_NICENESS)
+
+
+def pool_context() -> multiprocessing.context.BaseContext:
+    """'forkserver', its server preloaded with what every fit builds first: one server, whoever starts a pool."""
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates",
+                                     "analysis.pool_preload"])
+    return context
 
 
 @contextlib.contextmanager
@@ -35,9 +44,6 @@ def fit_executor(workers: int | None = None, *, background: bool = False) -> Ite
     if n <= 1:
         yield None
         return
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates",
-                                     "analysis.pool_preload"])
-    with ProcessPoolExecutor(max_workers=n, mp_context=context,
-                             initializer=_run_in_the_background if background else None) as pool:
+    with ProcessPoolExecutor(max_workers=n, mp_context=pool_context(),
+                             initializer=run_in_the_background if background else None) as pool:
         yield pool

@@ -264,6 +264,11 @@ class ModelLab(QWidget):
         self.candidates.apply_button.setToolTip(refusal or APPLY_TIP)
 
     # -- jobs --------------------------------------------------------------
+    def showEvent(self, event) -> None:
+        super().showEvent(event)
+        if self.current is not None:
+            self.worker.refits.start()      # the user came to refit: no process start in the first one's wait
+
     def _run(self, job, text: str, finished) -> None:
         self.status_label.setText("")           # the job controls say what is being done
         self.jobs.run(job, text, finished, self.on_failed, self.on_cancelled)

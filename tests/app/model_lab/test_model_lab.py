@@ -19,6 +19,7 @@ from PySide6.QtWidgets import QHeaderView
 import analysis.diagnosis.candidates
 import app.jobs.background_pool
 import app.jobs.lab_worker
+import app.jobs.refit_process
 from analysis.diagnosis.candidates import MIN_BIC_GAIN
 from analysis.effects import CATALOGUE, categories, get_effect
 from analysis.fit.least_squares import FitCancelled, FitError
@@ -239,13 +240,23 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
             threads.append(threading.current_thread())
             return real(*args, **kwargs)
         return call
-    monkeypatch.setattr(app.jobs.lab_worker, "fit_model", spy(app.jobs.lab_worker.fit_model))
+    monkeypatch.setattr(app.jobs.refit_process.RefitProcess, "fit", spy(app.jobs.refit_process.RefitProcess.fit))
     monkeypatch.setattr(app.jobs.lab_worker, "diagnose", spy(app.jobs.lab_worker.diagnose))
     _toggle(qtbot, lab, "creep-log", checked=True)
     _diagnose(qtbot, lab)
     assert len(threads) == 2
     assert all(t is not threading.main_thread() for t in threads)
     assert threading.current_thread() is threading.main_thread()
+
+
+@pytest.mark.skipif(worker_count() < 2, reason="one core: no process, the refit runs in the job's thread")
+def test_a_refit_fits_on_the_labs_process_not_in_the_window_s(qtbot, lab, monkeypatch):
+    """A refit in a thread of the GUI process took the GIL from the paint (app.jobs.refit_process)."""
+    here = []
+    monkeypatch.setattr(app.jobs.refit_process, "fit_model", lambda *a, **k: here.append(a))
+    _toggle(qtbot, lab, "creep-log", checked=True)
+    assert here == [] and lab.current.fitted.fit.model.effect_ids == ("lr2", "creep-log")
+    assert lab.worker.refits._running() is not None
 
 
 @pytest.mark.skipif(worker_count() < 2, reason="one core: no pool, the diagnosis runs in the job's thread")
@@ -262,12 +273,12 @@ def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, l
 def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
     started = threading.Event()
 
-    def blocked(data, model, start=None, cancel=None):
+    def blocked(refits, data, model, start, cancel):
         started.set()
         if not cancel.wait(240):           # only the Cancel button ends this "fit"
             raise AssertionError("never cancelled")
         raise FitCancelled("fit cancelled")
-    monkeypatch.setattr(app.jobs.lab_worker, "fit_model", blocked)
+    monkeypatch.setattr(app.jobs.refit_process.RefitProcess, "fit", blocked)
     lab.catalogue.item("creep-log").setCheckState(0, Qt.Checked)
     qtbot.waitUntil(started.is_set, timeout=wait_ms(10))
     assert lab.busy and lab.jobs.cancel_button.isVisible() and lab.jobs.progress.isVisible()

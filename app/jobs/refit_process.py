@@ -1,0 +1,117 @@
+"""The Model lab's refits on one worker process that lives as long as the lab.
+
+A refit is 15-400 ms of numpy on arrays of a few hundred lines, and holds the GIL all along. In a thread of the
+GUI process it took the GIL from the GUI thread in turns of sys.getswitchinterval() (5 ms): a paint that let
+the GIL go waited for it, and a refit asked for by a checkbox stalled the window 58-83 ms on a quiet two-core
+machine (`make bench gui`, "a refit in the Model lab", target 50 ms). On a process of its own the job's thread
+only waits. The process is started when the lab is shown (start) or at its first refit, and kept (a pool per
+refit, as a diagnosis has, paid its start each time), niced like a diagnosis's workers (analysis.parallel).
+
+The worker cannot see a job's threading.Event. A counter shared with it says up to which refit the lab has
+cancelled; the fit in the worker reads it at each of its checks, so a refit overtaken by a newer one stops
+within one iteration and the newer one does not wait behind it.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import itertools
+import logging
+import threading
+from concurrent.futures.process import BrokenProcessPool, ProcessPoolExecutor
+
+from analysis.fit.least_squares import FitData, FitResult, fit_model
+from analysis.model.composed import Model
+from analysis.parallel import pool_context, run_in_the_background, worker_count
+from app.jobs.background_pool import CANCEL_POLL_S, PoolCancelled
+
+log = logging.getLogger(__name__)
+
+_cancelled_up_to = None         # in the worker: the shared counter (RefitProcess._cancelled_up_to)
+
+
+def _start_worker(cancelled_up_to) -> None:
+    global _cancelled_up_to
+    _cancelled_up_to = cancelled_up_to
+    run_in_the_background()
+
+
+class _CancelledFrom:
+    """fit_model's cancel flag in the worker: set once the lab has cancelled refit `number` or a later one."""
+
+    def __init__(self, number: int):
+        self.number = number
+
+    def is_set(self) -> bool:
+        return _cancelled_up_to.value >= self.number
+
+
+def _fit_in_worker(number: int, data: FitData, model: Model, start: dict[str, float]) -> FitResult:
+    return fit_model(data, model, start=start, cancel=_CancelledFrom(number))
+
+
+class RefitProcess:
+    """fit_model on the lab's worker process, the wait cancellable; in the caller's thread on a one-core machine."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()       # the lab's refits run one at a time, but a shutdown may come from the GUI
+        self._pool: ProcessPoolExecutor | None = None
+        self._cancelled_up_to = None
+        self._numbers = itertools.count(1)
+
+    def start(self) -> None:
+        """Have the process running before the first refit is asked for; not waited for (0.03-0.7 s: the fork
+        server may have to start first)."""
+        if self._pool is None:
+            pool = self._running()
+            if pool is not None:
+                pool.submit(int)        # a process pool forks its worker at its first call
+
+    def fit(self, data: FitData, model: Model, start: dict[str, float], cancel: threading.Event) -> FitResult:
+        if cancel.is_set():
+            raise PoolCancelled("refit cancelled")
+        pool, number = self._running(), next(self._numbers)
+        if pool is None:
+            return fit_model(data, model, start=start, cancel=cancel)
+        try:
+            future = pool.submit(_fit_in_worker, number, data, model, start)
+            while True:
+                try:
+                    return future.result(timeout=CANCEL_POLL_S)
+                except concurrent.futures.TimeoutError:
+                    if cancel.is_set():
+                        self._cancel(number)
+                        raise PoolCancelled("refit cancelled") from None
+        except BrokenProcessPool:
+            # The worker died (killed, out of memory): the next refit starts another; this one fits here.
+            log.warning("the Model lab's refit process ended unexpectedly; refitting in the window's process")
+            self._drop(pool)
+            return fit_model(data, model, start=start, cancel=cancel)
+
+    def shutdown(self) -> None:
+        """Stop the worker: a refit still running is cancelled at its next check; the caller does not wait."""
+        with self._lock:
+            pool, self._pool = self._pool, None
+            if pool is not None:
+                self._cancelled_up_to.value = next(self._numbers)
+                pool.shutdown(wait=False, cancel_futures=True)
+
+    def _running(self) -> ProcessPoolExecutor | None:
+        with self._lock:
+            if self._pool is None and worker_count() > 1:
+                context = pool_context()
+                self._cancelled_up_to = context.Value("q", 0)
+                self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=_start_worker,
+                                                 initargs=(self._cancelled_up_to,))
+            return self._pool
+
+    def _cancel(self, number: int) -> None:
+        with self._lock:
+            if self._cancelled_up_to is not None:
+                with self._cancelled_up_to.get_lock():
+                    self._cancelled_up_to.value = max(self._cancelled_up_to.value, number)
+
+    def _drop(self, pool: ProcessPoolExecutor) -> None:
+        with self._lock:
+            if self._pool is pool:
+                self._pool = None
+        pool.shutdown(wait=False, cancel_futures=True)

@@ -1,0 +1,94 @@
+"""The Model lab's refit process: the fit the window's thread would make, cancellable, and a dead worker replaced."""
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import pytest
+
+import analysis
+from analysis.effects import parse_effects
+from analysis.fit.least_squares import FitCancelled, FitData, fit_model
+from analysis.model import Model
+from analysis.parallel import worker_count
+from analysis.spectra import estimate_spectra
+from app.jobs import refit_process
+from app.jobs.background_pool import PoolCancelled
+from app.jobs.refit_process import RefitProcess
+
+pytestmark = pytest.mark.skipif(worker_count() < 2, reason="one core: the lab refits in its own thread, no process")
+
+
+@pytest.fixture(scope="module")
+def data() -> FitData:
+    return FitData.from_spectra(estimate_spectra(analysis.synthesize(noise=analysis.TYPICAL_NOISE)))
+
+
+@pytest.fixture
+def refits():
+    process = RefitProcess()
+    yield process
+    process.shutdown()
+
+
+MODEL = Model(parse_effects("lr3,creep-log"))
+
+
+def test_a_refit_on_the_process_is_the_fit_of_the_callers_thread(data, refits):
+    here = fit_model(data, MODEL, start={})
+    there = refits.fit(data, MODEL, {}, threading.Event())
+    assert there.values == pytest.approx(here.values, rel=1e-12)
+    assert there.model.effect_ids == MODEL.effect_ids
+
+
+def _wait_for(path: str) -> None:
+    while not os.path.exists(path):
+        time.sleep(0.01)
+
+
+def test_a_refit_cancelled_while_it_waits_ends_at_once_and_the_next_one_still_fits(data, refits, tmp_path):
+    go_on = tmp_path / "go on"
+    refits._running().submit(_wait_for, str(go_on))         # the worker is busy with an older refit
+    cancel = threading.Event()
+    timer = threading.Timer(0.05, cancel.set)
+    timer.start()
+    with pytest.raises(PoolCancelled):
+        refits.fit(data, MODEL, {}, cancel)
+    timer.join()
+    go_on.touch()
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+
+
+def test_a_refit_cancelled_before_it_was_sent_is_not_sent(data, refits):
+    cancel = threading.Event()
+    cancel.set()
+    with pytest.raises(PoolCancelled):
+        refits.fit(data, MODEL, {}, cancel)
+    assert refits._pool is None
+
+
+def test_the_worker_stops_a_fit_the_lab_has_cancelled_and_not_a_later_one(data, refits):
+    """What the worker reads at each of the fit's checks: the shared counter, not the job's Event."""
+    refits.fit(data, MODEL, {}, threading.Event())          # the process is running
+    refits._cancel(5)
+    pool = refits._running()
+    with pytest.raises(FitCancelled):
+        pool.submit(refit_process._fit_in_worker, 5, data, MODEL, {}).result()
+    assert pool.submit(refit_process._fit_in_worker, 6, data, MODEL, {}).result().values["Bl"] > 0
+
+
+def test_a_killed_worker_does_not_lose_the_refit_and_a_new_one_is_started(data, refits):
+    refits.fit(data, MODEL, {}, threading.Event())
+    first = refits._running()
+    for pid in list(first._processes):
+        os.kill(pid, signal.SIGKILL)
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0      # fitted in this thread
+    assert refits._running() is not first
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0      # and on the new process
+
+
+def test_the_worker_runs_below_its_caller(refits):
+    pool = refits._running()
+    assert pool.submit(os.nice, 0).result() > os.nice(0)
