@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from importlib import import_module
 from typing import Sequence
@@ -87,7 +88,20 @@ def _check_encoding(argv: Sequence[str]) -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; the CLI's only error boundary (analysis.errors): exit 2 for the user's errors,
-    70 for a bug (one line, the details in a crash report), 130 for Ctrl-C."""
+    70 for a bug (one line, the details in a crash report), 130 for Ctrl-C. Without `argv` it runs the process's
+    own command line (`linpar`, `python -m app.cli`), and the process ends when it returns."""
+    try:
+        return _run(argv)
+    finally:
+        if argv is None:
+            # The interpreter's exit collects the garbage of every object still alive: all the command imported
+            # (3-5 % of `linpar analyze`'s CPU time, in instructions counted). Frozen, they are left to the
+            # process's end; output is still flushed, atexit handlers and the finalizers of what reference
+            # counting frees still run; only reference cycles still there at exit are not collected.
+            gc.freeze()
+
+
+def _run(argv: Sequence[str] | None) -> int:
     try:
         given = sys.argv[1:] if argv is None else argv
         _check_encoding(given)

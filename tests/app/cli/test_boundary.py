@@ -56,3 +56,14 @@ def test_an_unknown_command_is_refused_with_every_command_named(capsys):
 def test_the_parser_of_one_command_parses_as_the_whole_one():
     argv = ["--size-limit", "wav=2G", "analyze", "rec", "--model", "lr2", "--json"]
     assert vars(build_parser("analyze").parse_args(argv)) == vars(build_parser().parse_args(argv))
+
+
+def test_only_the_processs_own_command_line_freezes_its_objects_for_the_exit(monkeypatch, capsys):
+    import gc
+    frozen = []
+    monkeypatch.setattr(gc, "freeze", lambda: frozen.append(True))
+    assert main(["effects", "--json"]) == 0                 # called with arguments (tests, scripts): the process goes on
+    assert frozen == []
+    monkeypatch.setattr("sys.argv", ["linpar", "effects", "--json"])
+    assert main() == 0
+    assert frozen == [True]
