@@ -17,6 +17,11 @@ import numpy as np
 
 from analysis.recording.format import Recording
 
+# The small-signal excursion limit: the level check raises the level until the peak reaches it, and the
+# plausibility check calls a peak far above it impossible (here, not in analysis.level_check, so that judging
+# a result does not load the level check and its validity limits).
+DEFAULT_X_LIMIT_M = 0.5e-3
+
 
 def peak_of_period(mean_period: np.ndarray, centre: float | None = None) -> float:
     """Largest |x - mean(x)| of one (averaged) period, m. `centre`: mean(x), when already known (a live frame

@@ -32,12 +32,12 @@ import math
 from dataclasses import dataclass
 from typing import Callable
 
+from analysis.excursion import DEFAULT_X_LIMIT_M
 from analysis.recording.format import Recording
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
 from analysis.validity.assessment import Validity, assess
 
 DEFAULT_STEP = 1.6
-DEFAULT_X_LIMIT_M = 0.5e-3
 SNR_MARGIN_DB = 10.0           # default target: this far above the green SNR limit
 _EXCURSION_MARGIN = 0.95
 _DISTORTION_GROWTH = 6.0       # power exponent of third-order products over a fixed noise

@@ -141,7 +141,8 @@ def user_effects_json(effects) -> list[dict]:
 
 def _user_effects(model: Mapping) -> dict:
     """The stored effects of the user's own, rebuilt from their text (by id)."""
-    from analysis.effects.user import EffectFileError, effect_from_text
+    from analysis.effects.file_error import EffectFileError
+    from analysis.effects.user import effect_from_text
     stored = model.get("user_effects") or []
     if not isinstance(stored, list):
         raise ResultsFormatError("model.user_effects: expected a list")

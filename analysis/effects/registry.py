@@ -7,7 +7,9 @@ Three sources, read in this order (a later one may not reuse an id or a paramete
    ~/Library/Application Support/linpar/effects on macOS); a folder that does not exist holds none;
 2. files named on the command line (--effects-file FILE, repeatable);
 3. the entry points of the group `linpar.effects` of installed packages (importlib.metadata): each
-   names an Effect, a sequence of them, or a callable returning either.
+   names an Effect, a sequence of them, or a callable returning either. importlib.metadata is imported
+   only when a package's metadata names the group (analysis.effects.entry_point_files), and the effect
+   files' reader (analysis.effects.user) only when there are files: most starts need neither.
 
 The registry is the process's list of these, as pytest's plugin manager is: the CLI and the GUI fill
 it once at start (the GUI again when the user saves a new effect); analysis.effects.get_effect and the
@@ -16,14 +18,14 @@ with its effect objects.
 """
 from __future__ import annotations
 
-import importlib.metadata
 import os
 from pathlib import Path
 from typing import Iterable, Sequence
 
 from analysis.config_folder import EFFECTS_FOLDER_ENV, config_folder
 from analysis.effects.base import Effect, ParamSpec
-from analysis.effects.user import EffectFileError, UserEffect, load_effect_file
+from analysis.effects.entry_point_files import may_declare
+from analysis.effects.file_error import EffectFileError
 
 ENTRY_POINT_GROUP = "linpar.effects"
 FOLDER_ENV = EFFECTS_FOLDER_ENV
@@ -83,6 +85,9 @@ def _folder_files(folder: Path) -> list[Path]:
 
 
 def _entry_point_effects(taken: dict[str, str], ids: set[str]) -> list[Effect]:
+    if not may_declare(ENTRY_POINT_GROUP):
+        return []
+    import importlib.metadata
     found = []
     for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
         source = f"entry point {ep.name} = {ep.value} ({ENTRY_POINT_GROUP})"
@@ -135,6 +140,7 @@ def load_user_effects(files: Sequence[str | Path] = (), folder: Path | None = No
         if key in seen:
             continue
         seen.add(key)
+        from analysis.effects.user import load_effect_file
         effect = attempt(lambda: load_effect_file(path, taken, frozenset(ids)))
         if effect is not None:
             _claim(effect, str(path), taken, ids)
@@ -172,7 +178,10 @@ def source_of(effect: Effect) -> str:
 
 
 def is_user_effect(effect: Effect) -> bool:
-    return isinstance(effect, UserEffect) or effect.id in _USER
+    if effect.id in _USER:
+        return True
+    from analysis.effects.user import UserEffect
+    return isinstance(effect, UserEffect)
 
 
 __all__ = ["ENTRY_POINT_GROUP", "FOLDER_ENV", "EffectFileError", "ParamSpec", "clear", "config_folder",

@@ -43,18 +43,10 @@ from pathlib import Path
 import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site, SITE_KEYS
+from analysis.effects.file_error import EffectFileError
 from analysis.effects.formula import RESERVED, Formula, FormulaError, parse_formula
-from analysis.errors import LinparError
 from analysis.model.lumped import resonance_frequency
 from analysis.text_boundary import CONTROL, CONTROL_BUT_NEWLINE, control_found
-
-
-class EffectFileError(LinparError, ValueError):
-    """An effect file (or an effect from a package) that cannot be used. One line: the file, the key, what was expected.
-
-    A LinparError (analysis.errors), so that the CLI's boundary says it as one line with exit 2; still a
-    ValueError, as it was before that error model, for code that catches that.
-    """
 
 
 REQUIRED = ("id", "title", "site", "formula", "physics")

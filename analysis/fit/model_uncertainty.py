@@ -46,8 +46,7 @@ import dataclasses
 import math
 import threading
 import time
-from concurrent.futures import Executor
-from typing import Mapping
+from typing import TYPE_CHECKING, Mapping
 
 import numpy as np
 
@@ -56,6 +55,9 @@ from analysis.effects import get_effect
 from analysis.fit.least_squares import FitData, FitError, FitResult
 from analysis.fit.methods import fit_with
 from analysis.model.composed import Model, ModelError
+
+if TYPE_CHECKING:       # a caller's pool, named for the reader: concurrent.futures (with logging) costs the
+    from concurrent.futures import Executor     # command line's start 2-3 ms, and `linpar analyze` fits serially
 
 # Each family: forms of one physics at one site, any of which a real driver may follow about as well. A model's
 # member is exchanged within the first family that holds it (creep-log-causal-fs, the causal creep with its loss

@@ -11,7 +11,7 @@ and the remedy; the ranges and their reasons are in docs/bounds.md.
 - efficiency eta0 above ETA0_RED (yellow above ETA0_YELLOW), or below 0;
 - moving mass per area Mms/Sd outside MASS_PER_AREA_RED;
 - a peak excursion above EXCURSION_FACTOR x the small-signal limit of the
-  level check (analysis.level_check.DEFAULT_X_LIMIT_M);
+  level check (analysis.excursion.DEFAULT_X_LIMIT_M);
 - RE far from the nominal impedance the user entered (the sidecar's
   driver.nominal_impedance_ohm) outside RE_OVER_NOMINAL_RED;
 - the WAV header's rate against the rate the sidecar says the capture ran at;
@@ -29,7 +29,7 @@ from typing import Mapping
 
 import numpy as np
 
-from analysis.level_check import DEFAULT_X_LIMIT_M
+from analysis.excursion import DEFAULT_X_LIMIT_M
 from analysis.validity.findings import Finding, Severity
 
 EFFICIENCY = "implausible-efficiency"

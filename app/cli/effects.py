@@ -46,7 +46,7 @@ def add_effects_file_option(parser: argparse.ArgumentParser) -> None:
 def load(args: argparse.Namespace) -> tuple[Effect, ...]:
     """Read and register the user's effects. Every file that cannot be used is named (not only the first); the
     good ones are registered. `linpar effects` lists the bad ones beside the good; any other command stops with
-    one line naming them all (registry.EffectFileError)."""
+    one line naming them all (EffectFileError)."""
     from analysis.effects import registry
     problems: list[str] = []
     effects = registry.load_user_effects(getattr(args, "effects_files", None) or (), problems=problems)
@@ -59,7 +59,7 @@ def load(args: argparse.Namespace) -> tuple[Effect, ...]:
 
 def _refuse_problems(args: argparse.Namespace) -> None:
     """One line naming every effect file that cannot be used, when there are any (exit 2)."""
-    from analysis.effects.registry import EffectFileError
+    from analysis.effects.file_error import EffectFileError
     problems = getattr(args, "effect_problems", [])
     if problems:
         many = f"{len(problems)} effect files cannot be used: " if len(problems) > 1 else ""

@@ -24,9 +24,10 @@ from PySide6.QtWidgets import (QComboBox, QDialog, QDialogButtonBox, QFormLayout
 from analysis.effect_preview import channel_misfit, signature
 from analysis.effects import registry
 from analysis.effects.base import SITE_KEYS, Site
+from analysis.effects.file_error import EffectFileError
 from analysis.effects.formula import FUNCTIONS
-from analysis.effects.user import (UNITS_AT_SITE, EffectFileError, ParameterEntry, UserEffect, effect_file_text,
-                                   effect_from_text, load_effect_file)
+from analysis.effects.user import (UNITS_AT_SITE, ParameterEntry, UserEffect, effect_file_text, effect_from_text,
+                                   load_effect_file)
 from analysis.fit.least_squares import FitResult
 from analysis.model.composed import ModelError
 from app.widgets import style

@@ -10,8 +10,9 @@ import pytest
 
 from analysis.effects import UnknownEffectError, get_effect, parse_effects, registry
 from analysis.effects.base import Site
+from analysis.effects.file_error import EffectFileError
 from analysis.effects.formula import FUNCTIONS, FormulaError, parse_formula
-from analysis.effects.user import EffectFileError, UserEffect, effect_from_text, load_effect_file
+from analysis.effects.user import UserEffect, effect_from_text, load_effect_file
 from analysis.fit.least_squares import FitData, fit_model
 from analysis.model.composed import Model, ModelError
 from analysis.spectra import estimate_spectra

@@ -15,7 +15,8 @@ import pytest
 
 from analysis.archive import Archive
 from analysis.archive.record import RECORD_FILE
-from analysis.effects.user import EffectFileError, effect_from_text
+from analysis.effects.file_error import EffectFileError
+from analysis.effects.user import effect_from_text
 from app.cli import main
 from tests.production_helpers import LIMITS, small_measurement, unit
 
