@@ -38,21 +38,24 @@ def median_time(fn: Callable[[], object], repeats: int = 5, warmup: int = 1,
     return statistics.median(times)
 
 
-def child_times(cmd: list[str], repeats: int = 5) -> tuple[float, float]:
-    """Median (CPU seconds, wall seconds) of running `cmd` as a child process. The CPU time is the child's user +
+def child_time(cmd: list[str]) -> tuple[float, float]:
+    """(CPU seconds, wall seconds) of running `cmd` once as a child process. The CPU time is the child's user +
     system time (its threads and the children it waited for, from wait4): on a machine shared with others it is
     what the wall time would be on an idle one, where the wall time measures the others too."""
-    cpu, wall = [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-        _, status, usage = os.wait4(child.pid, 0)
-        wall.append(time.perf_counter() - t0)
-        cpu.append(usage.ru_utime + usage.ru_stime)
-        if status != 0:
-            raise RuntimeError(f"{' '.join(cmd)}: exit status {status}: {child.stderr.read().decode()[-500:]}")
-        child.stderr.close()
-    return statistics.median(cpu), statistics.median(wall)
+    t0 = time.perf_counter()
+    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(child.pid, 0)
+    wall = time.perf_counter() - t0
+    if status != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: exit status {status}: {child.stderr.read().decode()[-500:]}")
+    child.stderr.close()
+    return usage.ru_utime + usage.ru_stime, wall
+
+
+def child_times(cmd: list[str], repeats: int = 5) -> tuple[float, float]:
+    """Median (CPU seconds, wall seconds) of `repeats` runs of `cmd` as a child process (child_time)."""
+    runs = [child_time(cmd) for _ in range(repeats)]
+    return statistics.median(cpu for cpu, _ in runs), statistics.median(wall for _, wall in runs)
 
 
 def at_most(name: str, value: float, unit: str, limit: float) -> Row:
