@@ -7,24 +7,27 @@
     SPL(1 W, 1 m) = 10 log10(rho c eta0 / (2 pi p0^2))   SPL(2.83 V, 1 m) = SPL(1 W) + 10 log10(2.83^2 / RE)
 
 Uncertainties are propagated to first order through the full covariance of
-the fitted parameters (the `uncertainties` package), so correlations count:
-fs is far better known than CMES or LCES alone.
+the fitted parameters, so correlations count: fs is far better known than
+CMES or LCES alone. The gradient of each formula is taken by central
+differences (relative step STEP): the same first-order propagation the
+`uncertainties` package makes with exact derivatives, to 1e-8 of the value
+(tests/analysis/test_derived.py compares them), without its import, 7 ms of
+each `linpar analyze` (a fifth of its start beyond reading the recording).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Callable, Mapping
+from typing import TYPE_CHECKING, Callable, Mapping, Sequence
 
 import numpy as np
-import uncertainties
-from uncertainties import umath
 
 from analysis.model.lumped import C_SOUND, RHO     # air at 20 C, shared with the air-load effect
 
 if TYPE_CHECKING:       # the fit needs scipy.optimize (half a second to import): not for a table of units (`qa stats`)
     from analysis.fit.least_squares import FitResult
 
+STEP = 1e-6      # a parameter's relative step for the gradient: truncation ~STEP^2, rounding ~1e-16 / STEP
 P_REF = 20e-6     # Pa
 V_283 = 2.83      # V, the customary sensitivity drive (1 W into 8 ohm)
 
@@ -71,7 +74,7 @@ class _Derived:
 
 
 def _fs(p):
-    return 1.0 / (2 * np.pi * umath.sqrt(p["CMES"] * p["LCES"]))
+    return 1.0 / (2 * np.pi * math.sqrt(p["CMES"] * p["LCES"]))
 
 
 def _qes(p):
@@ -88,7 +91,7 @@ def _eta0(p, sd):
 
 
 def _spl_1w(p, sd):
-    return 10 * umath.log10(RHO * C_SOUND * _eta0(p, sd) / (2 * np.pi * P_REF**2))
+    return 10 * math.log10(RHO * C_SOUND * _eta0(p, sd) / (2 * np.pi * P_REF**2))
 
 
 DERIVED: tuple[_Derived, ...] = (
@@ -105,28 +108,47 @@ DERIVED: tuple[_Derived, ...] = (
     _Derived("eta0", "1", "%", 100.0, True, True, _eta0),
     _Derived("SPL_1W_1m", "dB", "dB SPL", 1.0, True, True, _spl_1w),
     _Derived("SPL_2.83V_1m", "dB", "dB SPL", 1.0, True, True,
-             lambda p, sd: _spl_1w(p, sd) + 10 * umath.log10(V_283**2 / p["RE"])),
+             lambda p, sd: _spl_1w(p, sd) + 10 * math.log10(V_283**2 / p["RE"])),
 )
 
 
-def _correlated(fit: FitResult) -> dict[str, object]:
-    """Fitted values as correlated ufloats (fixed ones as plain floats)."""
-    values: dict[str, object] = dict(fit.values)
-    if fit.covar is not None and fit.varying:
-        nominal = [fit.values[n] for n in fit.varying]
+def _covariance(fit: FitResult) -> np.ndarray | None:
+    """The fit's covariance as the propagation uses it: through the correlation matrix, its negative eigenvalues
+    (rounding) set to zero, as the `uncertainties` package does; None when there is none or it is not a matrix
+    of numbers."""
+    if fit.covar is None or not fit.varying:
+        return None
+    covar = np.asarray(fit.covar, dtype=float)
+    if covar.shape != (len(fit.varying),) * 2:
+        return None
+    std = np.sqrt(np.diag(covar))
+    scale = np.where(std == 0, 1.0, std)
+    try:
+        variances, axes = np.linalg.eigh(covar / scale / scale[:, np.newaxis])
+    except np.linalg.LinAlgError:
+        return None         # not positive semi-definite, or not finite: values without uncertainty
+    return std[:, np.newaxis] * ((axes * np.maximum(variances, 0.0)) @ axes.T) * std[np.newaxis, :]
+
+
+def _value_and_std(formula: Callable, values: Mapping[str, float], sd_m2: float | None, varying: Sequence[str],
+                   covar: np.ndarray | None) -> tuple[float, float | None]:
+    """formula(values, sd_m2), and its standard uncertainty sqrt(g C g) with g its gradient in the varying
+    parameters (central differences); None when the gradient cannot be taken there (a domain's edge)."""
+    value = float(formula(values, sd_m2))
+    if covar is None:
+        return value, None
+    gradient = np.empty(len(varying))
+    for i, name in enumerate(varying):
+        step = STEP * (abs(values[name]) or 1.0)
         try:
-            for name, u in zip(fit.varying, uncertainties.correlated_values(nominal, fit.covar)):
-                values[name] = u
-        except (np.linalg.LinAlgError, ValueError):
-            pass   # a covariance that is not positive semi-definite: values without uncertainty
-    return values
-
-
-def _split(x) -> tuple[float, float | None]:
-    if hasattr(x, "nominal_value"):
-        std = float(x.std_dev)
-        return float(x.nominal_value), std if np.isfinite(std) else None
-    return float(x), None
+            up = formula({**values, name: values[name] + step}, sd_m2)
+            down = formula({**values, name: values[name] - step}, sd_m2)
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return value, None
+        gradient[i] = (up - down) / (2 * step)
+    variance = float(gradient @ covar @ gradient)
+    std = math.sqrt(variance) if variance >= 0 else math.nan
+    return value, std if math.isfinite(std) else None
 
 
 def parameter_table(fit: FitResult, sd_m2: float | None,
@@ -144,7 +166,7 @@ def parameter_table(fit: FitResult, sd_m2: float | None,
     if not has_bl:
         table["Bl"] = ParameterValue(name="Bl", value=None, std=None, unit="T*m", display_unit="T*m",
                                      display_scale=1.0, reason=no_displacement)
-    p = _correlated(fit)
+    values, covar = dict(fit.values), _covariance(fit)
     for d in DERIVED:
         if d.needs_bl and not has_bl:
             table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
@@ -156,7 +178,7 @@ def parameter_table(fit: FitResult, sd_m2: float | None,
                                            display_unit=d.display_unit, display_scale=d.display_scale, reason=NO_SD)
             continue
         try:
-            value, std = _split(d.formula(p, sd_m2))
+            value, std = _value_and_std(d.formula, values, sd_m2, fit.varying, covar)
         except (ValueError, ZeroDivisionError, OverflowError) as exc:     # math of extreme fitted values
             table[d.name] = ParameterValue(name=d.name, value=None, std=None, unit=d.unit,
                                            display_unit=d.display_unit, display_scale=d.display_scale,

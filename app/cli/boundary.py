@@ -93,11 +93,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _run(argv)
     finally:
-        if argv is None:
+        if argv is None and command_named(sys.argv[1:]) != "gui":
             # The interpreter's exit collects the garbage of every object still alive: all the command imported
             # (3-5 % of `linpar analyze`'s CPU time, in instructions counted). Frozen, they are left to the
             # process's end; output is still flushed, atexit handlers and the finalizers of what reference
-            # counting frees still run; only reference cycles still there at exit are not collected.
+            # counting frees still run; only reference cycles still there at exit are not collected. Not for the
+            # window, whose Qt objects in such cycles would then never be destroyed: its exit is not timed.
             gc.freeze()
 
 

@@ -4,10 +4,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from analysis.derived import ParameterValue, derived_from_values, parameter_table
+from analysis.derived import DERIVED, P_REF, V_283, ParameterValue, derived_from_values, parameter_table
 from analysis.effects import parse_effects
 from analysis.fit.least_squares import FitData, fit_model
 from analysis.model.composed import Model
+from analysis.model.lumped import C_SOUND, RHO
 from analysis.spectra import estimate_spectra
 from tests.builders import PAPER, TYPICAL_NOISE, recording
 
@@ -49,6 +50,42 @@ def test_derived_parameters_have_propagated_uncertainties_consistent_with_truth(
         p = table[name]
         assert p.std is not None and p.std > 0, name
         assert abs(p.value - value) < 4.5 * p.std, name
+
+
+def _by_uncertainties_package(fit, sd):
+    """The same propagation with exact derivatives: the `uncertainties` package's correlated values."""
+    import uncertainties
+    from uncertainties import umath
+    p = dict(fit.values)
+    p.update(zip(fit.varying, uncertainties.correlated_values([fit.values[n] for n in fit.varying], fit.covar)))
+    fs = 1 / (2 * np.pi * umath.sqrt(p["CMES"] * p["LCES"]))
+    qes, qms = 2 * np.pi * fs * p["CMES"] * p["RE"], 2 * np.pi * fs * p["CMES"] * p["RES"]
+    eta0 = RHO * p["Bl"] ** 2 * sd**2 / (2 * np.pi * C_SOUND * p["RE"] * (p["CMES"] * p["Bl"] ** 2) ** 2)
+    spl = 10 * umath.log10(RHO * C_SOUND * eta0 / (2 * np.pi * P_REF**2))
+    return {"fs": fs, "Mms": p["CMES"] * p["Bl"] ** 2, "Rms": p["Bl"] ** 2 / p["RES"], "Cms": p["LCES"] / p["Bl"] ** 2,
+            "Kms": p["Bl"] ** 2 / p["LCES"], "Qes": qes, "Qms": qms, "Qts": qes * qms / (qes + qms),
+            "Vas": RHO * C_SOUND**2 * sd**2 * p["LCES"] / p["Bl"] ** 2, "eta0": eta0, "SPL_1W_1m": spl,
+            "SPL_2.83V_1m": spl + 10 * umath.log10(V_283**2 / p["RE"])}
+
+
+@pytest.mark.parametrize("effects", ["lr2,creep-log", "none", "lr3,creep-log-causal-fs"])
+def test_the_propagation_is_the_uncertainties_packages_to_its_last_digits(effects):
+    """Central differences (analysis.derived.STEP) against exact derivatives: values and std to 1e-7."""
+    rec = recording(noise=TYPICAL_NOISE, n_periods=8, seed=3)
+    fit = fit_model(FitData.from_spectra(estimate_spectra(rec)), Model(parse_effects(effects)))
+    table = parameter_table(fit, 0.0133)
+    exact = _by_uncertainties_package(fit, 0.0133)
+    assert set(exact) == {d.name for d in DERIVED}
+    for name, x in exact.items():
+        assert table[name].value == pytest.approx(x.nominal_value, rel=1e-12), name
+        assert table[name].std == pytest.approx(x.std_dev, rel=1e-7), name
+
+
+def test_a_covariance_that_is_not_a_matrix_of_numbers_leaves_values_without_uncertainty():
+    fit, _ = _table()
+    broken = dataclasses.replace(fit, covar=np.full_like(fit.covar, np.nan))
+    table = parameter_table(broken, 0.0133)
+    assert table["fs"].value == pytest.approx(derived_from_values(fit.values)["fs"]) and table["fs"].std is None
 
 
 def test_fs_is_better_known_than_cmes_and_lces_thanks_to_their_correlation():

@@ -21,14 +21,15 @@ from tests.pace import paced
 # the statistics, the plots, Qt, and lmfit (no longer used). The other commands' parsers (app/cli/boundary.py
 # builds the one named) and what they import (the devices, the measurement plans); importlib.metadata (read only
 # when a package's metadata names linpar.effects) and the effect files' reader (only when there are files); the
-# level check (the plausibility check needs its excursion limit only); a pool's concurrent.futures.
+# level check (the plausibility check needs its excursion limit only); a pool's concurrent.futures; the
+# uncertainties package (analysis.derived propagates by central differences; the added-mass method uses it).
 NOT_LOADED = ("analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
               "scipy.stats", "matplotlib", "PySide6", "pyqtgraph", "lmfit",
               "app.cli.added_mass", "app.cli.archive", "app.cli.devices", "app.cli.diagnose", "app.cli.gui",
               "app.cli.large_signal", "app.cli.levels", "app.cli.measure", "app.cli.qa", "app.cli.recover",
               "app.cli.report", "app.cli.rig", "app.cli.stats", "instruments",
               "importlib.metadata", "analysis.effects.user", "analysis.effects.formula", "tomllib",
-              "analysis.level_check", "concurrent.futures")
+              "analysis.level_check", "concurrent.futures", "uncertainties")
 
 # Packages whose compiled routines a fit calls, loaded from their files (analysis.fit.minpack): importing the
 # packages themselves took 0.4 s.

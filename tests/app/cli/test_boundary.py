@@ -67,3 +67,6 @@ def test_only_the_processs_own_command_line_freezes_its_objects_for_the_exit(mon
     monkeypatch.setattr("sys.argv", ["linpar", "effects", "--json"])
     assert main() == 0
     assert frozen == [True]
+    monkeypatch.setattr("sys.argv", ["linpar", "gui", "--no-such-option"])
+    assert main() == 2                                      # the window's process: its Qt objects are collected
+    assert frozen == [True]
