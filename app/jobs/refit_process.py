@@ -16,6 +16,7 @@ from __future__ import annotations
 import concurrent.futures
 import itertools
 import logging
+import pickle
 import threading
 from concurrent.futures.process import BrokenProcessPool, ProcessPoolExecutor
 
@@ -49,6 +50,17 @@ def _fit_in_worker(number: int, data: FitData, model: Model, start: dict[str, fl
     return fit_model(data, model, start=start, cancel=_CancelledFrom(number))
 
 
+def _travels(model: Model) -> bool:
+    """Whether `model` can be sent to the worker. A package's effect may be an object pickle cannot send (its class
+    made inside the factory its entry point names, a lambda among its fields): that refit fits in the caller's
+    thread, as all did before the worker, instead of failing as an internal error. 0.05 ms for lr3,creep-log."""
+    try:
+        pickle.dumps(model)
+    except (pickle.PicklingError, TypeError, AttributeError):
+        return False
+    return True
+
+
 class RefitProcess:
     """fit_model on the lab's worker process, the wait cancellable; in the caller's thread on a one-core machine."""
 
@@ -70,7 +82,7 @@ class RefitProcess:
         if cancel.is_set():
             raise PoolCancelled("refit cancelled")
         pool, number = self._running(), next(self._numbers)
-        if pool is None:
+        if pool is None or not _travels(model):
             return fit_model(data, model, start=start, cancel=cancel)
         try:
             future = pool.submit(_fit_in_worker, number, data, model, start)
