@@ -108,3 +108,16 @@ def test_a_model_whose_effect_cannot_be_sent_to_the_worker_is_fitted_here(data, 
     here = fit_model(data, model, start={})
     there = refits.fit(data, model, {}, threading.Event())
     assert there.values == pytest.approx(here.values, rel=1e-12)
+
+
+def test_no_process_is_started_after_the_lab_shut_down(data, refits):
+    """A refit job still on its way when the window closed (its wait ran out) reaches fit() after shutdown(): it
+    started a new worker no one would shut down, or, shut down between _running() and submit, failed as an
+    internal error ("cannot schedule new futures after shutdown") with a crash report."""
+    pool = refits._running()
+    refits.shutdown()
+    refits.start()
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+    assert refits._pool is None
+    refits._running = lambda: pool                    # the pool it took just before the shutdown
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
