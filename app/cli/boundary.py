@@ -90,10 +90,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one command; the CLI's only error boundary (analysis.errors): exit 2 for the user's errors,
     70 for a bug (one line, the details in a crash report), 130 for Ctrl-C. Without `argv` it runs the process's
     own command line (`linpar`, `python -m app.cli`), and the process ends when it returns."""
+    ran: list[str] = []
     try:
-        return _run(argv)
+        return _run(argv, ran)
     finally:
-        if argv is None and command_named(sys.argv[1:]) != "gui":
+        if argv is None and "gui" not in ran and command_named(sys.argv[1:]) != "gui":
             # The interpreter's exit collects the garbage of every object still alive: all the command imported
             # (3-5 % of `linpar analyze`'s CPU time, in instructions counted). Frozen, they are left to the
             # process's end; output is still flushed, atexit handlers and the finalizers of what reference
@@ -102,11 +103,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             gc.freeze()
 
 
-def _run(argv: Sequence[str] | None) -> int:
+def _run(argv: Sequence[str] | None, ran: list[str]) -> int:
+    """main's work; `ran` gets the command parsed (argparse's reading: `--size-lim X gui` runs the window too)."""
     try:
         given = sys.argv[1:] if argv is None else argv
         _check_encoding(given)
         args = build_parser(command_named(given)).parse_args(given)
+        ran.append(args.command)
         with size_limits_set(**dict(args.size_limit)):
             if effects.builds_models(args):
                 effects.load(args)      # a bad effect file stops every command that builds models: one line

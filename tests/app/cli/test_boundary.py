@@ -70,3 +70,8 @@ def test_only_the_processs_own_command_line_freezes_its_objects_for_the_exit(mon
     monkeypatch.setattr("sys.argv", ["linpar", "gui", "--no-such-option"])
     assert main() == 2                                      # the window's process: its Qt objects are collected
     assert frozen == [True]
+    monkeypatch.setattr("app.cli.gui.run", lambda args: 0)
+    for shape in (["--size-lim", "wav=1G", "gui"], ["--size-limit", "wav=1G", "--size-l", "wav=2G", "gui"]):
+        monkeypatch.setattr("sys.argv", ["linpar", *shape])     # argparse's abbreviation: the window all the same
+        assert main() == 0
+        assert frozen == [True], shape

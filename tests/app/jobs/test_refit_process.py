@@ -1,6 +1,7 @@
 """The Model lab's refit process: the fit the window's thread would make, cancellable, and a dead worker replaced."""
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import threading
@@ -92,3 +93,31 @@ def test_a_killed_worker_does_not_lose_the_refit_and_a_new_one_is_started(data, 
 def test_the_worker_runs_below_its_caller(refits):
     pool = refits._running()
     assert pool.submit(os.nice, 0).result() > os.nice(0)
+
+
+def test_a_model_whose_effect_cannot_be_sent_to_the_worker_is_fitted_here(data, refits):
+    """A package's entry point may name a factory whose effects are of a class made inside it: pickle cannot send
+    them. Before the fix the refit failed as an internal error ("Can't pickle local object")."""
+    creep = parse_effects("creep-log")[0]
+
+    class PackagesCreep(type(creep)):       # a class pickle cannot find by its name
+        pass
+
+    made = PackagesCreep(**{f.name: getattr(creep, f.name) for f in dataclasses.fields(creep) if f.init})
+    model = Model((*parse_effects("lr3"), made))
+    here = fit_model(data, model, start={})
+    there = refits.fit(data, model, {}, threading.Event())
+    assert there.values == pytest.approx(here.values, rel=1e-12)
+
+
+def test_no_process_is_started_after_the_lab_shut_down(data, refits):
+    """A refit job still on its way when the window closed (its wait ran out) reaches fit() after shutdown(): it
+    started a new worker no one would shut down, or, shut down between _running() and submit, failed as an
+    internal error ("cannot schedule new futures after shutdown") with a crash report."""
+    pool = refits._running()
+    refits.shutdown()
+    refits.start()
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+    assert refits._pool is None
+    refits._running = lambda: pool                    # the pool it took just before the shutdown
+    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
