@@ -23,10 +23,10 @@ from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome, LabFit, diagnos
 from app.jobs.refit_process import RefitProcess
 
 
-def _refit(job: Job, refits: RefitProcess, base: AnalysisResult, data: FitData, model: Model,
+def _refit(job: Job, refits: RefitProcess, ticket: int, base: AnalysisResult, data: FitData, model: Model,
            start: dict[str, float]) -> LabFit:
     job.say(f"fitting {model.describe()}")
-    fit = refits.fit(data, model, start, job.cancel_event)
+    fit = refits.fit(ticket, data, model, start, job.cancel_event)
     job.check()
     return lab_fit(base, fit)       # 2-5 ms here: sending the base (its spectra, 2.6 MB) to the worker costs more
 
@@ -66,8 +66,8 @@ class LabWorker(JobRunner):
         self.refits = RefitProcess()
 
     def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> Job:
-        start = dict(start)
-        return self.run("refit", lambda job: _refit(job, self.refits, base, data, model, start),
+        start, ticket = dict(start), self.refits.ticket()      # in the GUI thread: app.jobs.refit_process
+        return self.run("refit", lambda job: _refit(job, self.refits, ticket, base, data, model, start),
                         "the model lab's refit")
 
     def shutdown(self, wait_ms: int) -> bool:

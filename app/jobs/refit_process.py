@@ -9,7 +9,9 @@ refit, as a diagnosis has, paid its start each time), niced like a diagnosis's w
 
 The worker cannot see a job's threading.Event. A counter shared with it says up to which refit the lab has
 cancelled; the fit in the worker reads it at each of its checks, so a refit overtaken by a newer one stops
-within one iteration and the newer one does not wait behind it.
+within one iteration and the newer one does not wait behind it. "Up to" holds because each refit takes its
+number (ticket) in the GUI thread as its job is made, after the lab has cancelled the one it replaces: numbers
+taken in the jobs' threads could come in either order, and cancelling the older refit then cancelled the newer.
 """
 from __future__ import annotations
 
@@ -79,10 +81,16 @@ class RefitProcess:
             if pool is not None:
                 pool.submit(int)        # a process pool forks its worker at its first call
 
-    def fit(self, data: FitData, model: Model, start: dict[str, float], cancel: threading.Event) -> FitResult:
+    def ticket(self) -> int:
+        """The next refit's number; taken where the refits are asked for, one after the other (the GUI thread)."""
+        return next(self._numbers)
+
+    def fit(self, number: int, data: FitData, model: Model, start: dict[str, float],
+            cancel: threading.Event) -> FitResult:
+        """Refit `number` (a ticket) of `model`; PoolCancelled once `cancel` is set."""
         if cancel.is_set():
             raise PoolCancelled("refit cancelled")
-        pool, number = self._running(), next(self._numbers)
+        pool = self._running()
         if pool is None or not _travels(model):
             return fit_model(data, model, start=start, cancel=cancel)
         try:
@@ -110,7 +118,7 @@ class RefitProcess:
         with self._lock:
             pool, self._pool, self._closed = self._pool, None, True
             if pool is not None:
-                self._cancelled_up_to.value = next(self._numbers)
+                self._cancelled_up_to.value = self.ticket()     # every refit so far
                 pool.shutdown(wait=False, cancel_futures=True)
 
     def _running(self) -> ProcessPoolExecutor | None:

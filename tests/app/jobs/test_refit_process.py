@@ -39,7 +39,7 @@ MODEL = Model(parse_effects("lr3,creep-log"))
 
 def test_a_refit_on_the_process_is_the_fit_of_the_callers_thread(data, refits):
     here = fit_model(data, MODEL, start={})
-    there = refits.fit(data, MODEL, {}, threading.Event())
+    there = refits.fit(refits.ticket(), data, MODEL, {}, threading.Event())
     assert there.values == pytest.approx(here.values, rel=1e-12)
     assert there.model.effect_ids == MODEL.effect_ids
 
@@ -56,23 +56,23 @@ def test_a_refit_cancelled_while_it_waits_ends_at_once_and_the_next_one_still_fi
     timer = threading.Timer(0.05, cancel.set)
     timer.start()
     with pytest.raises(PoolCancelled):
-        refits.fit(data, MODEL, {}, cancel)
+        refits.fit(refits.ticket(), data, MODEL, {}, cancel)
     timer.join()
     go_on.touch()
-    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0
 
 
 def test_a_refit_cancelled_before_it_was_sent_is_not_sent(data, refits):
     cancel = threading.Event()
     cancel.set()
     with pytest.raises(PoolCancelled):
-        refits.fit(data, MODEL, {}, cancel)
+        refits.fit(refits.ticket(), data, MODEL, {}, cancel)
     assert refits._pool is None
 
 
 def test_the_worker_stops_a_fit_the_lab_has_cancelled_and_not_a_later_one(data, refits):
     """What the worker reads at each of the fit's checks: the shared counter, not the job's Event."""
-    refits.fit(data, MODEL, {}, threading.Event())          # the process is running
+    refits.fit(refits.ticket(), data, MODEL, {}, threading.Event())          # the process is running
     refits._cancel(5)
     pool = refits._running()
     with pytest.raises(FitCancelled):
@@ -81,13 +81,13 @@ def test_the_worker_stops_a_fit_the_lab_has_cancelled_and_not_a_later_one(data, 
 
 
 def test_a_killed_worker_does_not_lose_the_refit_and_a_new_one_is_started(data, refits):
-    refits.fit(data, MODEL, {}, threading.Event())
+    refits.fit(refits.ticket(), data, MODEL, {}, threading.Event())
     first = refits._running()
     for pid in list(first._processes):
         os.kill(pid, signal.SIGKILL)
-    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0      # fitted in this thread
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0      # fitted in this thread
     assert refits._running() is not first
-    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0      # and on the new process
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0      # and on the new process
 
 
 def test_the_worker_runs_below_its_caller(refits):
@@ -106,7 +106,7 @@ def test_a_model_whose_effect_cannot_be_sent_to_the_worker_is_fitted_here(data, 
     made = PackagesCreep(**{f.name: getattr(creep, f.name) for f in dataclasses.fields(creep) if f.init})
     model = Model((*parse_effects("lr3"), made))
     here = fit_model(data, model, start={})
-    there = refits.fit(data, model, {}, threading.Event())
+    there = refits.fit(refits.ticket(), data, model, {}, threading.Event())
     assert there.values == pytest.approx(here.values, rel=1e-12)
 
 
@@ -117,7 +117,7 @@ def test_no_process_is_started_after_the_lab_shut_down(data, refits):
     pool = refits._running()
     refits.shutdown()
     refits.start()
-    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0
     assert refits._pool is None
     refits._running = lambda: pool                    # the pool it took just before the shutdown
-    assert refits.fit(data, MODEL, {}, threading.Event()).values["Bl"] > 0
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0

@@ -242,9 +242,14 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
         return call
     monkeypatch.setattr(app.jobs.refit_process.RefitProcess, "fit", spy(app.jobs.refit_process.RefitProcess.fit))
     monkeypatch.setattr(app.jobs.lab_worker, "diagnose", spy(app.jobs.lab_worker.diagnose))
+    tickets = spy(app.jobs.refit_process.RefitProcess.ticket)
+    monkeypatch.setattr(app.jobs.refit_process.RefitProcess, "ticket", tickets)
     _toggle(qtbot, lab, "creep-log", checked=True)
     _diagnose(qtbot, lab)
-    assert len(threads) == 2
+    # The refit's ticket, then the refit and the diagnosis. The ticket in the GUI thread: refits are numbered in
+    # the order the user asked for them (app.jobs.refit_process: cancelling "up to" a number relies on it).
+    assert len(threads) == 3 and threads[0] is threading.main_thread()
+    threads = threads[1:]
     assert all(t is not threading.main_thread() for t in threads)
     assert threading.current_thread() is threading.main_thread()
 
@@ -273,7 +278,7 @@ def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, l
 def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
     started = threading.Event()
 
-    def blocked(refits, data, model, start, cancel):
+    def blocked(refits, ticket, data, model, start, cancel):
         started.set()
         if not cancel.wait(240):           # only the Cancel button ends this "fit"
             raise AssertionError("never cancelled")
