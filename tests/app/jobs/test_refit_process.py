@@ -121,3 +121,20 @@ def test_no_process_is_started_after_the_lab_shut_down(data, refits):
     assert refits._pool is None
     refits._running = lambda: pool                    # the pool it took just before the shutdown
     assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0
+
+
+def test_start_does_not_wait_for_the_process_in_the_callers_thread(refits, monkeypatch):
+    """start() is called by the Model lab's showEvent, in the GUI thread: the fork (and, the first time, the fork
+    server's own start, 0.57 s) happens in a thread of its own."""
+    forked_in = []
+    real = RefitProcess._running
+
+    def running(self):
+        forked_in.append(threading.current_thread())
+        return real(self)
+    monkeypatch.setattr(RefitProcess, "_running", running)
+    refits.start()
+    deadline = time.monotonic() + 60
+    while refits._pool is None and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert refits._pool is not None and forked_in and threading.current_thread() not in forked_in
