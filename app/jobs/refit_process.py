@@ -132,7 +132,10 @@ class RefitProcess:
         with self._lock:
             if self._pool is None and not self._closed and worker_count() > 1:
                 context = pool_context()
-                self._cancelled_up_to = context.Value("q", 0)
+                # Shared memory without a lock: only this side writes (under self._lock), the worker only reads
+                # an aligned 8-byte integer. A lock would be a named semaphore, gone once this side drops it:
+                # a worker still starting then failed to open it (a traceback on the terminal).
+                self._cancelled_up_to = context.Value("q", 0, lock=False)
                 self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=_start_worker,
                                                  initargs=(self._cancelled_up_to,))
             return self._pool
@@ -140,8 +143,7 @@ class RefitProcess:
     def _cancel(self, number: int) -> None:
         with self._lock:
             if self._cancelled_up_to is not None:
-                with self._cancelled_up_to.get_lock():
-                    self._cancelled_up_to.value = max(self._cancelled_up_to.value, number)
+                self._cancelled_up_to.value = max(self._cancelled_up_to.value, number)
 
     def _drop(self, pool: ProcessPoolExecutor) -> None:
         with self._lock:
