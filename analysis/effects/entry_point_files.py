@@ -3,10 +3,10 @@
 importlib.metadata finds entry points in the entry_points.txt of each *.dist-info and *.egg-info folder of
 every sys.path folder (and in the EGG-INFO of an .egg folder). Importing it (email, zipfile, csv ...) and
 its scan cost each start of a command that fits 10-15 ms of CPU time, to learn, nearly always, that no
-package ships an effect; reading the files takes about 1 ms. Those files' text answers the same question first: when none names the group, importlib.metadata
-finds none either. Where this reading does not look as importlib.metadata would (a zip archive on sys.path,
-another finder that lists distributions, a file it cannot read), the answer is "maybe" and the caller asks
-importlib.metadata itself.
+package ships an effect; reading the files takes about 1 ms. Those files' text answers the same question
+first: when none names the group, importlib.metadata finds none either. Where this reading does not look as
+importlib.metadata would (a zip archive on sys.path, another finder that lists distributions, a file it
+cannot read), the answer is "maybe" and the caller asks importlib.metadata itself.
 """
 from __future__ import annotations
 

@@ -9,7 +9,6 @@ LE_high = Im(Z)/w at the top lines, the whole inductance seen there.
 """
 from __future__ import annotations
 
-
 import numpy as np
 
 from analysis.effects.base import Effect, ParamSpec, Site

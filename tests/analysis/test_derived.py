@@ -81,6 +81,19 @@ def test_the_propagation_is_the_uncertainties_packages_to_its_last_digits(effect
         assert table[name].std == pytest.approx(x.std_dev, rel=1e-7), name
 
 
+def test_the_propagation_is_the_packages_on_a_real_like_woofer_too():
+    """Six physics at once, none in the catalogue's form (tests/real_like.py), fitted with the default model: a fit
+    far from the noise, its covariance wide and strongly correlated. Whether the total uncertainty covers the
+    truth is the model part's matter (analysis.fit.model_uncertainty); this one is the noise's, and it must be
+    the package's."""
+    from tests.real_like import SD, real_like_recording
+    data = FitData.from_spectra(estimate_spectra(real_like_recording()))
+    fit = fit_model(data, Model(parse_effects("lr2,creep-log")))
+    table, exact = parameter_table(fit, SD), _by_uncertainties_package(fit, SD)
+    for name, x in exact.items():
+        assert table[name].std == pytest.approx(x.std_dev, rel=1e-7), name
+
+
 def test_a_covariance_that_is_not_a_matrix_of_numbers_leaves_values_without_uncertainty():
     fit, _ = _table()
     broken = dataclasses.replace(fit, covar=np.full_like(fit.covar, np.nan))
