@@ -62,9 +62,9 @@ def analyze(source: Source, *, sd_m2: float | None = None, effects: str | Sequen
 
     sd_m2: the radiating area (default: the recording's sidecar's); effects: the model's effects (default
     lr2,creep-log; magnitude-only curves their own); method: 'joint' (Z and Hx together, the default) or 'paper'
-    (Z first, then Hx). model_part: estimate the
-    part of each uncertainty the model's form leaves open (refits with the other forms of the inductance and
-    the creep, when the model misses the data by more than the noise), as `linpar analyze` does.
+    (Z first, then Hx). model_part: estimate the part of each uncertainty the model's form leaves open (refits
+    with the other forms of the inductance and the creep, and for a recording with effects a real driver has
+    added, when the model misses the data by more than the noise), as `linpar analyze` does.
     """
     from analysis.fit.model_uncertainty import model_uncertainty
     chosen = None if effects is None else _effects(effects)

@@ -59,7 +59,8 @@ def run(workdir: Path) -> list[Row]:
 def model_part_rows(standard: Path) -> list[Row]:
     """The model part of the uncertainties (analysis.fit.model_uncertainty). On the standard recording the
     model describes the data: nothing is refitted, the full result is the statistical one. On a realistic
-    woofer (tests/realistic_drivers.py) it refits the other forms of the inductance and creep: the GUI shows
+    woofer (tests/realistic_drivers.py) it refits the other forms of the inductance and creep, and the model with
+    each effect of analysis.fit.added_physics added: the GUI shows
     the statistical result at once and the parts after these refits (in its background); the CLI waits."""
     from analysis.fit.model_uncertainty import model_uncertainty
     from analysis.pipeline import analyze_path, analyze_recording

@@ -21,12 +21,13 @@ import numpy as np
 from scipy.special import j1, struve
 
 from analysis.effects.base import Site
+from analysis.effects.mechanical import air_mass
 from analysis.model import Model
 from analysis.synthesis import synthesize_recording
 from tests.builders import PAPER, TYPICAL_NOISE, multitone
 from tests.odd_physics import OddEffect
 
-__all__ = ["REAL_LIKE", "real_like_recording", "real_like_effects", "structural_cone_mode"]
+__all__ = ["REAL_LIKE", "real_like_recording", "real_like_effects", "real_like_truth", "structural_cone_mode"]
 
 RHO_C = 1.204 * 343.0            # air's characteristic impedance, kg/(m^2 s)
 SD = 0.0133                      # m^2, the paper driver's cone area
@@ -111,3 +112,17 @@ def real_like_recording(names=tuple(REAL_LIKE), seed: int = 5, period_samples: i
     return synthesize_recording(model, dict(PAPER.parameters), mt.waveform, mt.excited_bins, mt.sample_rate,
                                 n_periods, 1, TYPICAL_NOISE, seed=seed,
                                 driver={"name": "synthetic, real-like", "sd_m2": SD})
+
+
+def real_like_truth(names=tuple(REAL_LIKE)) -> dict[str, float]:
+    """What a user means by the lumped values of `real_like_recording(names)`: RE and Bl as synthesized, Mms the
+    cone's with the air's on both sides (the radiation load at low frequencies), Kms the real part of the creeping
+    suspension's stiffness at fs, and fs where that stiffness and Mms resonate."""
+    p = PAPER.parameters
+    mms = p["CMES"] * p["Bl"] ** 2 + (2.0 * air_mass(RADIUS) if "radiation" in names else 0.0)
+    static = p["Bl"] ** 2 / p["LCES"]
+    fs = float(np.sqrt(static / mms) / (2.0 * np.pi))
+    for _ in range(20):         # Kms(fs) and fs depend on each other; the creep's slope makes this converge fast
+        kms = static * (float(np.real(1.0 / _cole_cole(np.array([fs]), p))[0]) if "creep" in names else 1.0)
+        fs = float(np.sqrt(kms / mms) / (2.0 * np.pi))
+    return {"RE": p["RE"], "Bl": p["Bl"], "Mms": mms, "Kms": kms, "fs": fs}

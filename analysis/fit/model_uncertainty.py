@@ -15,9 +15,13 @@ good fit of a real driver shows). The reported value stays the user's model's. A
 is the standard deviation of the parameter over the reported value and the members' (each counted once);
 imported curves (magnitude only, no phase to show what the model misses) keep the largest shift:
 
-    recording:   std_model = std over {value, value_member...}
+    recording:   std_model = sqrt(std over {value, value_member...}^2 + rms over added |value_added - value|^2)
     curves:      std_model = max over members |value_member - value|
     std = sqrt(std_noise^2 + std_model^2)
+
+The forms cover physics the model holds in another shape; `added` covers physics it has no term for: the user's
+model with one effect more each (air load, cone breakup, Bl's fall, rising damping, the laser spot's mode), those
+the data ask for (analysis.fit.added_physics).
 
 Why not the largest shift for recordings (issue 29): the user's model is usually not itself among the
 members (on the realistic drivers its chi^2 is 5-30 times the best one's), so it sits at one end and the
@@ -31,8 +35,8 @@ seeds each, fitted over their piston band, analysis.fit.bands): the truth of RE,
 total std, each interval inside the truth +- 15 % (tests/analysis/test_realistic_qa.py).
 
 When the model describes the recording (every channel's reduced chi^2 below MISFIT_FROM: the misfit
-within twice the noise) nothing is refitted and nothing changes: no model part is reported. The refits take a few seconds: a
-separate step after the statistical result (the GUI shows that at once and runs this in the background;
+within twice the noise) nothing is refitted and nothing changes: no model part is reported. The refits take
+a few seconds: a separate step after the statistical result (the GUI shows that at once and runs this in the background;
 `linpar analyze`, `measure`, `archive store` and `report` run it before they print or store).
 
 Every place that shows, stores or judges a result passes it through `model_uncertainty` (once: a result
@@ -52,6 +56,7 @@ import numpy as np
 
 from analysis.derived import ParameterValue, derived_from_values
 from analysis.effects import get_effect
+from analysis.fit.added_physics import asked_for, extended_models
 from analysis.fit.least_squares import FitData, FitError, FitResult
 from analysis.fit.methods import fit_with
 from analysis.model.composed import Model, ModelError
@@ -93,10 +98,14 @@ class ModelPart:
     # True: the spread is the std over the reported value and the members' (a recording's, module doc); False:
     # the largest distance of a member from the reported value (imported curves).
     ensemble: bool = False
+    # A recording's: the user's model with one effect more each, that the data ask for (analysis.fit.added_physics).
+    added: tuple[Member, ...] = ()
 
     def as_json(self) -> dict:
         return {"state": self.state, "seconds": round(self.seconds, 2),
-                "models": [list(m.effects) for m in self.members], **({"why": self.why} if self.why else {})}
+                "models": [list(m.effects) for m in self.members],
+                **({"added": [m.effects[-1] for m in self.added]} if self.added else {}),
+                **({"why": self.why} if self.why else {})}
 
     def spread(self, values: Mapping[str, float], sd_m2: float | None) -> dict[str, float]:
         """Each parameter's model part around `values` (the reported fit's), derived ones at `sd_m2`."""
@@ -111,6 +120,8 @@ class ModelPart:
                 spread[name] = float(np.std(others)) if others else 0.0
             else:
                 spread[name] = max((abs(v - value) for v in others), default=0.0)
+        for name, shift in _rms_shift(reported, [_with_derived(m.values, sd_m2) for m in self.added]).items():
+            spread[name] = math.hypot(spread.get(name, 0.0), shift)
         return spread
 
 
@@ -191,13 +202,14 @@ def estimate_model_part(fit: FitResult, data: FitData, cancel: threading.Event |
     drop = always if drop_degenerate is None else drop_degenerate
     indistinct = (members(fit, data, cancel, drop_degenerate=drop, executor=executor)
                   + _band_members(fit, other_bands, cancel, executor))
+    added = tuple(_added_physics(fit, data, cancel, executor)) if ensemble else ()
     seconds = time.perf_counter() - started
     if ensemble:
         reported = Member(effects=fit.model.effect_ids, chi2=fit.chi2, values=dict(fit.values))
         others = [m for m in indistinct if m.effects != reported.effects]
-        if not others:
+        if not others and not added:
             return ModelPart(state=NOT_ESTIMATED, seconds=seconds)
-        return ModelPart(state=ESTIMATED, members=(reported, *others), seconds=seconds, ensemble=True)
+        return ModelPart(state=ESTIMATED, members=(reported, *others), seconds=seconds, ensemble=True, added=added)
     if len(indistinct) < 2:
         # No alternative the data cannot reject (or none of either family to exchange, `--model none`):
         # the model part is not estimated, which is not the same as zero.
@@ -224,6 +236,27 @@ def degenerate(other: FitResult, data: FitData) -> bool:
     lowest = 2j * np.pi * np.array([data.impedance.freqs[0]])
     excess = float(other.model.blocked_impedance(lowest, other.values).real[0]) - other.values["RE"]
     return excess > DC_EXCESS * other.values["RE"]
+
+
+def _added_physics(fit: FitResult, data: FitData, cancel: threading.Event | None,
+                   executor: Executor | None = None) -> list[Member]:
+    """The user's model with each effect of analysis.fit.added_physics.EXTENSIONS it lacks, fitted from the
+    reported values; those the data ask for (asked_for) and whose base parameters are not degenerate."""
+    models = extended_models(fit.model)
+    fits = _refits(fit.method, [(data, model, dict(fit.values)) for model in models], cancel, executor)
+    return [Member(effects=model.effect_ids, chi2=other.chi2, values=dict(other.values))
+            for model, other in zip(models, fits)
+            if other is not None and asked_for(other, fit) and not degenerate(other, data)]
+
+
+def _rms_shift(reported: Mapping[str, float], theirs: list[Mapping[str, float]]) -> dict[str, float]:
+    """Each parameter's rms distance from `reported` over `theirs` (where it is finite)."""
+    shifts = {}
+    for name, value in reported.items():
+        moved = [t[name] - value for t in theirs if name in t and math.isfinite(t[name])]
+        if moved:
+            shifts[name] = math.sqrt(sum(d * d for d in moved) / len(moved))
+    return shifts
 
 
 def _band_members(fit: FitResult, bands: tuple[FitData, ...], cancel: threading.Event | None,
@@ -319,7 +352,10 @@ def model_part_words(validity) -> str:
     state = entry.get("state")
     if state == ESTIMATED:
         n = len(entry.get("models") or ())
-        return (f"model part: estimated from {n} models the data cannot tell apart (their refits took "
+        added = entry.get("added") or ()
+        asked = (f" and from the shift of {len(added)} effect{'s' if len(added) > 1 else ''} the data ask for "
+                 f"({', '.join(added)})" if added else "")
+        return (f"model part: estimated from {n} models the data cannot tell apart{asked} (their refits took "
                 f"{float(entry.get('seconds') or 0):.1f} s); each 1-sigma is its total with the noise's")
     if state == NOT_NEEDED:
         return "model part: none (the model describes the measurement within its noise)"

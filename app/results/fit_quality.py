@@ -34,8 +34,8 @@ def fit_error_words(result: AnalysisResult) -> str:
     return ", ".join(f"{name} {value:.2g} %" for name, value in errors.items()) + " (rms misfit of each curve)"
 
 
-ESTIMATING_TEXT = ("Model part: estimating… (refits with the other forms of the inductance and creep; until "
-                   "they end each ± is the noise's alone)")
+ESTIMATING_TEXT = ("Model part: estimating… (refits with the other forms of the inductance and creep, and with "
+                   "effects a real driver has added; until they end each ± is the noise's alone)")
 
 
 def model_part_html(result: AnalysisResult) -> str:
