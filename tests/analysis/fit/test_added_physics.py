@@ -6,12 +6,14 @@ within 0.3 %, so before analysis.fit.added_physics the model part stayed 0.1-0.4
 and Kms stood 2.8-4.3 reported std away (Bl 0.7-0.8 % low, Mms 1.6-1.8 %).
 """
 import dataclasses
+from pathlib import Path
 
 import pytest
 
 from analysis.effects import parse_effects
 from analysis.fit.added_physics import EXTENSIONS, extended_models
 from analysis.fit.model_uncertainty import model_part_words, model_uncertainty
+from analysis.limits import judge_result, parse_limits
 from analysis.model.composed import Model
 from analysis.pipeline import analyze_recording
 from tests.real_like import SD, real_like_recording, real_like_truth
@@ -55,3 +57,16 @@ def test_each_extension_is_added_alone_and_only_where_the_model_lacks_it():
     without_laser = extended_models(Model(parse_effects("lr2,creep-log"), with_displacement=False))
     # No laser: no spot, and no air load (a mass in kg needs the Bl only the displacement gives)
     assert [m.effect_ids[-1] for m in without_laser] == ["breakup", "bl-eddy", "damping-power"]
+
+
+@pytest.mark.parametrize("percent", [0.5, 1, 2])
+def test_qa_never_fails_the_real_like_woofer_at_its_own_nominal(real_like, percent):
+    # Limits centred on the truth: a unit at its nominal, whatever the tolerance. With the forms' spread alone
+    # the intervals of Mms and Kms (value +- 2 std) lay wholly below the truth -0.5 %: a FAIL of a good unit.
+    truth = real_like_truth()
+    units = {"RE": "ohm", "Bl": "T*m", "Mms": "kg", "Kms": "N/m"}
+    limits = parse_limits({"format": "linpar-limits/1", "name": f"truth ± {percent} %", "parameters": {
+        name: {"nominal": truth[name], "tolerance": f"{percent}%", "unit": unit} for name, unit in units.items()}},
+        "", Path(f"truth-{percent}.json"))
+    judged = judge_result(limits, real_like.parameters, real_like.validity)
+    assert judged["verdict"] in ("pass", "uncertain"), judged["why"]
