@@ -6,6 +6,7 @@ from pathlib import Path
 import pytest
 
 import app.jobs.workers
+from analysis.fit.added_physics import extended_models
 from analysis.fit.model_uncertainty import alternative_models
 from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
@@ -24,7 +25,8 @@ def test_the_model_parts_refits_are_handed_to_the_pool(qtbot, monkeypatch):
     worker = AnalysisWorker()
     with qtbot.waitSignal(worker.finished, timeout=analysis_wait_ms(4)) as done:
         worker.start_model_part(AnalysisOutcome(0, Path("midrange"), result, None))
-    assert handed == ["fit_with"] * len(alternative_models(result.fit.model))
+    model = result.fit.model        # the other forms, and the model with each effect a real driver has added
+    assert handed == ["fit_with"] * (len(alternative_models(model)) + len(extended_models(model)))
     mms = done.args[1].result.parameters["Mms"]
     assert mms.value == result.parameters["Mms"].value and mms.std_model > 0
     assert worker.shutdown(wait_ms(10))
