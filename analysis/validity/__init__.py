@@ -12,8 +12,8 @@ from analysis.lazy_exports import lazy_exports
 # importing one submodule of the package does not load the rest.
 _HOME = {
     "ABSENT": "assessment",
-    "CaptureInfo": "assessment",
-    "CaptureInfoError": "assessment",
+    "CaptureInfo": "capture",
+    "CaptureInfoError": "capture",
     "ChannelValidity": "assessment",
     "Finding": "assessment",
     "ImportedCurves": "result",

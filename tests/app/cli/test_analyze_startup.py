@@ -23,7 +23,10 @@ from tests.pace import paced
 # when a package's metadata names linpar.effects) and the effect files' reader (only when there are files); the
 # level check (the plausibility check needs its excursion limit only); a pool's concurrent.futures; the
 # uncertainties package (analysis.derived propagates by central differences; the added-mass method uses it).
-NOT_LOADED = ("analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
+# The coil's heating (only when the current drifts), the capture's checks (only when the sidecar has a "capture")
+# and the simulator (analysis.synthesis: TYPICAL_NOISE lives there): each made dataclasses at every start.
+NOT_LOADED = ("analysis.heating", "analysis.validity.capture", "analysis.synthesis",
+              "analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
               "scipy.stats", "matplotlib", "PySide6", "pyqtgraph", "lmfit",
               "app.cli.added_mass", "app.cli.archive", "app.cli.devices", "app.cli.diagnose", "app.cli.gui",
               "app.cli.large_signal", "app.cli.levels", "app.cli.measure", "app.cli.qa", "app.cli.recover",
