@@ -24,8 +24,12 @@ from tests.pace import paced
 # level check (the plausibility check needs its excursion limit only); a pool's concurrent.futures; the
 # uncertainties package (analysis.derived propagates by central differences; the added-mass method uses it).
 # The coil's heating (only when the current drifts), the capture's checks (only when the sidecar has a "capture")
-# and the simulator (analysis.synthesis: TYPICAL_NOISE lives there): each made dataclasses at every start.
+# and the simulator (analysis.synthesis: TYPICAL_NOISE lives there): each made dataclasses at every start. The
+# catalogue's effects beyond the default model's inductance and creep (analysis/effects/catalogue.py imports an
+# effect's module when it is first asked for).
 NOT_LOADED = ("analysis.heating", "analysis.validity.capture", "analysis.synthesis",
+              "analysis.effects.enclosure", "analysis.effects.breakup", "analysis.effects.channels",
+              "analysis.effects.forcefactor", "analysis.effects.mechanical", "analysis.effects.creep_at_fs",
               "analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
               "scipy.stats", "matplotlib", "PySide6", "pyqtgraph", "lmfit",
               "app.cli.added_mass", "app.cli.archive", "app.cli.devices", "app.cli.diagnose", "app.cli.gui",
