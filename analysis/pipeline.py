@@ -52,7 +52,9 @@ class NotAnalysable(LinparError):
     """A recording whose channels leave nothing to fit (message: which and why, with the remedy)."""
 
 
-@dataclass(frozen=True, kw_only=True)
+# eq=False: with its spectra's arrays, == raised for any two that were not the same object; so no __eq__ and
+# __hash__ are generated at every start (Python 3.11 execs each dataclass method).
+@dataclass(frozen=True, kw_only=True, eq=False)
 class AnalysisResult:
     """A recording's analysis: its parameters, the fit they came from and its judged channels.
 

@@ -53,6 +53,8 @@ CAPTURE_KEY = "capture"
 
 @dataclass(frozen=True, slots=True)
 class ChannelValidity:
+    """One channel's light, its findings and the numbers the checks measured."""
+
     signal: str
     # "green" | "yellow" | "red" | "absent"; None for imported curves' channel, which carries findings alone
     status: str | None
@@ -74,6 +76,8 @@ class ChannelValidity:
 
 @dataclass(frozen=True, slots=True)
 class Validity:
+    """The checks' judgement of a recording: the overall light and each channel's (module doc)."""
+
     overall: Severity
     channels: Mapping[str, ChannelValidity]      # always voltage, current and displacement
     peak_displacement_m: float | None
