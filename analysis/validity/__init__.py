@@ -16,7 +16,7 @@ _HOME = {
     "CaptureInfoError": "capture",
     "ChannelValidity": "assessment",
     "Finding": "assessment",
-    "ImportedCurves": "result",
+    "ImportedCurves": "imported_curves",
     "ResultValidity": "result",
     "ResultValidityError": "result",
     "Severity": "assessment",

@@ -26,8 +26,9 @@ from tests.pace import paced
 # The coil's heating (only when the current drifts), the capture's checks (only when the sidecar has a "capture")
 # and the simulator (analysis.synthesis: TYPICAL_NOISE lives there): each made dataclasses at every start. The
 # catalogue's effects beyond the default model's inductance and creep (analysis/effects/catalogue.py imports an
-# effect's module when it is first asked for).
+# effect's module when it is first asked for). Imported curves' validity (analysis.validity.imported_curves).
 NOT_LOADED = ("analysis.heating", "analysis.validity.capture", "analysis.synthesis",
+              "analysis.validity.imported_curves",
               "analysis.effects.enclosure", "analysis.effects.breakup", "analysis.effects.channels",
               "analysis.effects.forcefactor", "analysis.effects.mechanical", "analysis.effects.creep_at_fs",
               "analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
