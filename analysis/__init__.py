@@ -25,7 +25,7 @@ _HOME = {
     "LinparError": "errors",
     "Model": "model.composed",
     "Recording": "recording.format",
-    "TYPICAL_NOISE": "api",
+    "TYPICAL_NOISE": "synthesis",
     "analyze": "api",
     "diagnose": "api",
     "import_curves": "curves.imported",

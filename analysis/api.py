@@ -16,8 +16,6 @@ import threading
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping, Sequence, Union
 
-from analysis.synthesis import ChannelNoise
-
 if TYPE_CHECKING:
     from analysis.curves.fitting import CurveAnalysis
     from analysis.curves.imported import ImportedCurves
@@ -25,13 +23,13 @@ if TYPE_CHECKING:
     from analysis.effects import Effect
     from analysis.pipeline import AnalysisResult
     from analysis.recording.format import Recording
+    from analysis.synthesis import ChannelNoise
 
     Source = Union[str, Path, Recording, ImportedCurves]
 
-__all__ = ["TYPICAL_NOISE", "analyze", "diagnose", "synthesize"]
-
-# A realistic measurement's noise: about 60-70 dB SNR on the lines of a 1 V RMS multitone.
-TYPICAL_NOISE = ChannelNoise(voltage=1e-4, current=1e-4, displacement=1e-8)
+# The simulator (analysis.synthesis, where TYPICAL_NOISE is) is loaded by synthesize only: an analysis does not
+# pay for its dataclass at start-up.
+__all__ = ["analyze", "diagnose", "synthesize"]
 
 
 def _effects(effects: str | Sequence[str | Effect] | None) -> tuple[Effect, ...]:
@@ -109,7 +107,7 @@ def diagnose(source: Source, *, start: str | Sequence[str | Effect] = "none", sd
 
 
 def synthesize(*, driver: str | Path = "paper", values: Mapping[str, float] | None = None,
-               effects: str | None = None, noise: ChannelNoise = ChannelNoise(), level_v_rms: float = 1.0,
+               effects: str | None = None, noise: ChannelNoise | None = None, level_v_rms: float = 1.0,
                sample_rate: int = 48000, period_samples: int = 16384, n_periods: int = 8, settle_periods: int = 1,
                f_min: float = 5.0, f_max: float = 10000.0, displacement: bool = True, sd_m2: float | None = None,
                seed: int | None = 0) -> Recording:
@@ -117,14 +115,14 @@ def synthesize(*, driver: str | Path = "paper", values: Mapping[str, float] | No
 
     driver: a built-in driver's name or a driver file (analysis.drivers), whose effects, values and Sd are
     used unless `effects`, `values` (each overriding the driver's value of that name) or `sd_m2` are given.
-    noise: white noise per channel (TYPICAL_NOISE is a realistic measurement's); a multitone of `level_v_rms`
-    from f_min to f_max, `n_periods` periods of `period_samples` after `settle_periods`.
+    noise: white noise per channel (None: none; analysis.TYPICAL_NOISE is a realistic measurement's); a
+    multitone of `level_v_rms` from f_min to f_max, `n_periods` periods of `period_samples` after `settle_periods`.
     """
     from analysis.drivers import load_driver
     from analysis.effects import parse_effects
     from analysis.model.composed import Model, ModelError
     from analysis.multitone import design_multitone
-    from analysis.synthesis import synthesize_recording
+    from analysis.synthesis import ChannelNoise, synthesize_recording
     chosen = load_driver(driver)
     if effects is None:
         effects = ",".join(chosen.effects) or "none"
@@ -137,5 +135,6 @@ def synthesize(*, driver: str | Path = "paper", values: Mapping[str, float] | No
     multitone = design_multitone(sample_rate, period_samples, f_min, f_max, rms=level_v_rms)
     area = chosen.sd_m2 if sd_m2 is None else sd_m2
     return synthesize_recording(model, merged, multitone.waveform,
-                                multitone.excited_bins, sample_rate, n_periods, settle_periods, noise, seed=seed,
+                                multitone.excited_bins, sample_rate, n_periods, settle_periods,
+                                ChannelNoise() if noise is None else noise, seed=seed,
                                 driver={"name": chosen.name, **({"sd_m2": area} if area else {})})

@@ -38,6 +38,8 @@ NO_SD = "needs Sd: give the effective radiating area (--sd, or the driver's diap
 
 @dataclass(frozen=True, slots=True, kw_only=True)
 class ParameterValue:
+    """One parameter of the table: its value and standard uncertainty in SI, its display unit, or why it has none."""
+
     name: str
     value: float | None
     std: float | None
@@ -64,6 +66,8 @@ class ParameterValue:
 
 @dataclass(frozen=True, slots=True)
 class _Derived:
+    """How a derived parameter is computed from the fitted ones, and what it needs."""
+
     name: str
     unit: str
     display_unit: str

@@ -17,7 +17,7 @@ import threading
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator, Sequence
+from typing import TYPE_CHECKING, Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -28,17 +28,20 @@ from analysis.fit.bands import bands_hz, piston_band
 from analysis.fit.error import FIT_ERROR_DEFAULTS, fit_error_percent
 from analysis.fit.least_squares import FitCancelled, FitData, FitError, FitResult
 from analysis.fit.startvalues import StartValueError, start_context
-from analysis.heating import CoilHeating, coil_heating, without_heating
 from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model, ModelError
 from analysis.model.lumped import resonance_frequency
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.plausibility import plausibility_findings
-from analysis.validity.assessment import CaptureInfo, CaptureInfoError, Validity, assess, capture_of
+from analysis.validity.assessment import Validity, assess, capture_of
 from analysis.validity.findings import DRIFT
 from analysis.validity.fit import UnusableChannels, misfit_findings, unusable_channels
 from analysis.validity.result import ResultValidity
+
+if TYPE_CHECKING:   # loaded when used: a recording without a sidecar's "capture" or a drifting current needs neither
+    from analysis.heating import CoilHeating
+    from analysis.validity.capture import CaptureInfo
 
 
 # Displacement lines below which Hx carries too little to fit Bl (and a delay) from.
@@ -49,7 +52,9 @@ class NotAnalysable(LinparError):
     """A recording whose channels leave nothing to fit (message: which and why, with the remedy)."""
 
 
-@dataclass(frozen=True, kw_only=True)
+# eq=False: with its spectra's arrays, == raised for any two that were not the same object; so no __eq__ and
+# __hash__ are generated at every start (Python 3.11 execs each dataclass method).
+@dataclass(frozen=True, kw_only=True, eq=False)
 class AnalysisResult:
     """A recording's analysis: its parameters, the fit they came from and its judged channels.
 
@@ -213,6 +218,7 @@ def without_coil_heating(recording: Recording, spectra: Spectra, validity: Valid
     the validity check found the current drifting (analysis.heating); the spectra as they are otherwise."""
     if not any(f.code == DRIFT for f in validity.channels["current"].findings):
         return spectra, None
+    from analysis.heating import coil_heating, without_heating
     heating = coil_heating(recording, spectra, re_fit)
     if heating is None or not heating.significant:
         return spectra, heating
@@ -258,7 +264,11 @@ def checked_capture(recording: Recording) -> CaptureInfo | None:
     """The sidecar's "capture" object, or RecordingError naming the sidecar and the key."""
     try:
         return capture_of(recording)
-    except CaptureInfoError as exc:
+    except LinparError as exc:
+        # capture_of loads analysis.validity.capture only when the sidecar has a capture to read
+        from analysis.validity.capture import CaptureInfoError
+        if not isinstance(exc, CaptureInfoError):
+            raise
         where = recording_paths(recording.source)[1] if recording.source is not None else IN_MEMORY
         raise RecordingError(f"{where}: {exc}") from None
 

@@ -24,20 +24,38 @@ Where text leaves, each way out has its own escape:
 from __future__ import annotations
 
 import re
+from functools import cache
 
 from analysis.errors import LinparError
 
-# The class refused where a name enters and checked wherever a stored one is read.
-CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
-# The same, but a line break allowed: a multi-line description (an effect's physics).
-CONTROL_BUT_NEWLINE = re.compile(r"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+# The patterns, compiled on first use (PEP 562 below): a class holding the surrogates' 2048 characters takes
+# 0.2-0.6 ms to compile, and most starts of the command line use SURROGATES alone (its arguments' check).
+_PATTERNS = {
+    # The class refused where a name enters and checked wherever a stored one is read.
+    "CONTROL": r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]",
+    # The same, but a line break allowed: a multi-line description (an effect's physics).
+    "CONTROL_BUT_NEWLINE": r"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]",
+    # ESC [ ... final byte (CSI), ESC ] ... BEL or ESC \ (OSC), ESC and one byte: what a terminal acts on.
+    "_ESCAPE_SEQUENCE": r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x9b[0-?]*[ -/]*[@-~]"
+                        r"|\x9d[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?|\x1b[@-_]?",
+}
 # Python's stand-ins for bytes that were not UTF-8 (surrogateescape).
 SURROGATES = re.compile(r"[\ud800-\udfff]")
-# ESC [ ... final byte (CSI), ESC ] ... BEL or ESC \ (OSC), ESC and one byte: what a terminal acts on.
-_ESCAPE_SEQUENCE = re.compile(r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x9b[0-?]*[ -/]*[@-~]"
-                              r"|\x9d[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?|\x1b[@-_]?")
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 _NAMED = {"\t": "\\t", "\n": "\\n", "\r": "\\r", "\x00": "\\0"}
+
+
+@cache
+def _pattern(name: str) -> re.Pattern:
+    return re.compile(_PATTERNS[name])
+
+
+def __getattr__(name: str) -> re.Pattern:
+    """CONTROL and CONTROL_BUT_NEWLINE, compiled when first asked for (`from analysis.text_boundary import
+    CONTROL` too)."""
+    if name in _PATTERNS and not name.startswith("_"):
+        return _pattern(name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 class TextError(LinparError, ValueError):
@@ -59,13 +77,14 @@ def _visible(char: str) -> str:
     return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
-def control_found(text: str, pattern: re.Pattern = CONTROL) -> str | None:
-    """What the first refused character is, in words ("the control character \\t"), or None."""
-    bad = pattern.search(text)
+def control_found(text: str, pattern: re.Pattern | None = None) -> str | None:
+    """What the first refused character is, in words ("the control character \\t"), or None; `pattern`: the
+    class refused (default CONTROL)."""
+    bad = (pattern or _pattern("CONTROL")).search(text)
     return None if bad is None else _what(bad.group())
 
 
-def one_line(value, where: str, error: type[LinparError] = TextError, pattern: re.Pattern = CONTROL) -> str:
+def one_line(value, where: str, error: type[LinparError] = TextError, pattern: re.Pattern | None = None) -> str:
     """`value` when it is a string without refused characters; `error` naming `where` otherwise."""
     if not isinstance(value, str):
         raise error(f"{where}: found {type(value).__name__}, expected a string")
@@ -77,18 +96,19 @@ def one_line(value, where: str, error: type[LinparError] = TextError, pattern: r
 
 def cleaned(value: str, max_len: int = 200) -> str:
     """A string as it may be stored when it cannot be refused (a form's field): refused characters -> spaces."""
-    return CONTROL.sub(" ", value).strip()[:max_len]
+    return _pattern("CONTROL").sub(" ", value).strip()[:max_len]
 
 
-def shown(text: str, pattern: re.Pattern = CONTROL) -> str:
-    """Every refused character written visibly (\\t, \\x1b, \\xfc): safe to print, and still telling."""
-    return pattern.sub(lambda m: _visible(m.group()), text)
+def shown(text: str, pattern: re.Pattern | None = None) -> str:
+    """Every refused character written visibly (\\t, \\x1b, \\xfc): safe to print, and still telling; `pattern`:
+    the class refused (default CONTROL)."""
+    return (pattern or _pattern("CONTROL")).sub(lambda m: _visible(m.group()), text)
 
 
 def terminal(text: str) -> str:
     """Text for a terminal: escape sequences (colours, titles, hyperlinks) removed, other controls shown;
     line breaks kept."""
-    return shown(_ESCAPE_SEQUENCE.sub("", str(text)), CONTROL_BUT_NEWLINE)
+    return shown(_pattern("_ESCAPE_SEQUENCE").sub("", str(text)), _pattern("CONTROL_BUT_NEWLINE"))
 
 
 def spreadsheet_cell(text: str) -> str:

@@ -94,6 +94,8 @@ class ThresholdsError(LinparError, ValueError):
 
 @dataclass(frozen=True, slots=True)
 class ValidityThresholds:
+    """Every limit of the validity checks (module doc): the defaults, or a lab's overrides (load_thresholds)."""
+
     # Signal-to-noise on the excited lines (dB).
     snr_quantile: float = 0.1
     snr_yellow_db: float = 30.0

@@ -38,12 +38,13 @@ def median_time(fn: Callable[[], object], repeats: int = 5, warmup: int = 1,
     return statistics.median(times)
 
 
-def child_time(cmd: list[str]) -> tuple[float, float]:
-    """(CPU seconds, wall seconds) of running `cmd` once as a child process. The CPU time is the child's user +
-    system time (its threads and the children it waited for, from wait4): on a machine shared with others it is
-    what the wall time would be on an idle one, where the wall time measures the others too."""
+def child_time(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
+    """(CPU seconds, wall seconds) of running `cmd` once as a child process (in `env`, default this process's).
+    The CPU time is the child's user + system time (its threads and the children it waited for, from wait4): on
+    a machine shared with others it is what the wall time would be on an idle one, where the wall time measures
+    the others too."""
     t0 = time.perf_counter()
-    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    child = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
     _, status, usage = os.wait4(child.pid, 0)
     wall = time.perf_counter() - t0
     if status != 0:
@@ -56,6 +57,16 @@ def child_times(cmd: list[str], repeats: int = 5) -> tuple[float, float]:
     """Median (CPU seconds, wall seconds) of `repeats` runs of `cmd` as a child process (child_time)."""
     runs = [child_time(cmd) for _ in range(repeats)]
     return statistics.median(cpu for cpu, _ in runs), statistics.median(wall for _, wall in runs)
+
+
+def compiled_env(env: dict, workdir: Path) -> dict:
+    """`env` as an installed copy runs: linpar's modules compiled once (pip compiles what it installs), here into
+    a cache folder of the benchmark's own (PYTHONPYCACHEPREFIX), never into the source tree. A machine that sets
+    PYTHONDONTWRITEBYTECODE compiles every module of linpar at each start instead (0.05-0.1 s of `qa stats`), or
+    each module changed since its bytecode was last written (a checkout that has just been merged)."""
+    compiled = {k: v for k, v in env.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    compiled["PYTHONPYCACHEPREFIX"] = str(workdir / "pycache")
+    return compiled
 
 
 def at_most(name: str, value: float, unit: str, limit: float) -> Row:

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.common import Row, at_most, median_time
+from bench.common import Row, at_most, compiled_env, median_time
 
 N_UNITS = 100_000
 STATIONS = ("QA1", "QA2", "QA3")
@@ -148,15 +148,6 @@ def _command_time(archive: str, env: dict) -> tuple[float, str]:
     cmd = [sys.executable, "-m", "app.cli", "qa", "stats", "--archive", archive]
     out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env).stdout
     return median_time(lambda: subprocess.run(cmd, check=True, capture_output=True, env=env), repeats=5), out
-
-
-def compiled_env(env: dict, workdir: Path) -> dict:
-    """`env` as an installed copy runs: linpar's modules compiled once (pip compiles what it installs), here into
-    a cache folder of the benchmark's own (PYTHONPYCACHEPREFIX), never into the source tree. A machine that sets
-    PYTHONDONTWRITEBYTECODE compiles every module of linpar at each start instead (0.05-0.1 s of `qa stats`)."""
-    compiled = {k: v for k, v in env.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    compiled["PYTHONPYCACHEPREFIX"] = str(workdir / "pycache")
-    return compiled
 
 
 def _in_process(archive: str) -> float:

@@ -56,7 +56,8 @@ from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model
 from analysis.pipeline import model_json
 from analysis.spectra import TransferFunction
-from analysis.validity.result import ImportedCurves, ResultValidity
+from analysis.validity.imported_curves import ImportedCurves
+from analysis.validity.result import ResultValidity
 
 Z_MAX_OVER_FS = 5.0
 # The other Z bands whose fits the model part of magnitude-only curves spans (analysis.fit.model_uncertainty):

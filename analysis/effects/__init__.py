@@ -2,20 +2,30 @@
 
 CATALOGUE holds the built-in effects; effects of the user's own (files, packages) are registered in
 analysis.effects.registry and found by get_effect, parse_effects and available_effects beside them.
+get_effect imports the module of the effect asked for only; CATALOGUE (every module) is made on first use
+(analysis.effects.catalogue).
 """
 from __future__ import annotations
 
 from typing import Mapping
 
+from analysis.effects import catalogue
 from analysis.effects.base import Effect, ParamSpec, Site
-from analysis.effects.catalogue import CATALOGUE, FORMS
 from analysis.errors import LinparError
 from analysis.model.defaults import DEFAULT_EFFECTS
 
 
+def __getattr__(name: str):
+    """CATALOGUE, made on first use (analysis.effects.catalogue)."""
+    if name == "CATALOGUE":
+        value = globals()["CATALOGUE"] = catalogue.CATALOGUE
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def categories() -> dict[str, list[Effect]]:
     grouped: dict[str, list[Effect]] = {}
-    for effect in CATALOGUE.values():
+    for effect in catalogue.CATALOGUE.values():
         grouped.setdefault(effect.category, []).append(effect)
     return grouped
 
@@ -27,22 +37,21 @@ class UnknownEffectError(LinparError, LookupError):
 def available_effects() -> tuple[Effect, ...]:
     """The catalogue, then the registered effects of the user's own: what a diagnosis tries."""
     from analysis.effects import registry
-    return tuple(CATALOGUE.values()) + registry.user_effects()
+    return tuple(catalogue.CATALOGUE.values()) + registry.user_effects()
 
 
 def get_effect(effect_id: str, extra: Mapping[str, Effect] | None = None) -> Effect:
     """The effect of that id: from `extra` (e.g. a stored result's own user effects), the catalogue, the registry."""
     if extra and effect_id in extra:
         return extra[effect_id]
-    if effect_id in CATALOGUE:
-        return CATALOGUE[effect_id]
-    if effect_id in FORMS:
-        return FORMS[effect_id]
+    built_in = catalogue.built_in(effect_id)        # the catalogue's, then its FORMS
+    if built_in is not None:
+        return built_in
     from analysis.effects import registry
     for effect in registry.user_effects():
         if effect.id == effect_id:
             return effect
-    known = ", ".join(sorted(CATALOGUE))
+    known = ", ".join(sorted(catalogue.IDS))
     users = ", ".join(e.id for e in registry.user_effects())
     raise UnknownEffectError(f"unknown effect {effect_id!r}; known effects: {known}"
                              + (f"; effects of the user's own: {users}" if users else

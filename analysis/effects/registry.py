@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 from analysis.config_folder import EFFECTS_FOLDER_ENV, config_folder
 from analysis.effects.base import Effect, ParamSpec
@@ -84,9 +84,11 @@ def _folder_files(folder: Path) -> list[Path]:
         raise EffectFileError(f"{folder}: the effects folder cannot be read ({exc.strerror or exc})") from None
 
 
-def _entry_point_effects(taken: dict[str, str], ids: set[str]) -> list[Effect]:
+def _entry_point_effects(in_use: Callable[[], tuple[dict[str, str], set[str]]]) -> list[Effect]:
+    """The effects of the packages' entry points; `in_use()` gives the names and ids they may not reuse."""
     if not may_declare(ENTRY_POINT_GROUP):
         return []
+    taken, ids = in_use()
     import importlib.metadata
     found = []
     for ep in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
@@ -120,8 +122,16 @@ def load_user_effects(files: Sequence[str | Path] = (), folder: Path | None = No
     list (the GUI's way), its line is added there and the file is left out instead. Nothing is
     registered: pass the result to register().
     """
-    taken, builtin_ids = _builtin_names()
-    ids = set(builtin_ids)
+    # The names and ids in use, made when a file or a package first needs them: they import the whole
+    # catalogue, which a command without effects of the user's own does not load (analysis.effects.catalogue).
+    names: list[tuple[dict[str, str], set[str]]] = []
+
+    def in_use() -> tuple[dict[str, str], set[str]]:
+        if not names:
+            taken, builtin_ids = _builtin_names()
+            names.append((taken, set(builtin_ids)))
+        return names[0]
+
     loaded: list[Effect] = []
     seen: set[Path] = set()
 
@@ -141,12 +151,13 @@ def load_user_effects(files: Sequence[str | Path] = (), folder: Path | None = No
             continue
         seen.add(key)
         from analysis.effects.user import load_effect_file
+        taken, ids = in_use()
         effect = attempt(lambda: load_effect_file(path, taken, frozenset(ids)))
         if effect is not None:
             _claim(effect, str(path), taken, ids)
             loaded.append(effect)
     if packages:
-        loaded += attempt(lambda: _entry_point_effects(taken, ids)) or []
+        loaded += attempt(lambda: _entry_point_effects(in_use)) or []
     return tuple(loaded)
 
 

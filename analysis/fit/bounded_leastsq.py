@@ -64,8 +64,12 @@ class Start:
         return replace(self, values={n: _clip(float(values[n]), self.bounds[n]) for n in self.values})
 
 
-@dataclass(frozen=True)
+# eq=False: the fit's own result, never compared (its covariance array made == raise); so no __eq__ and
+# __hash__ are generated at every start (Python 3.11 execs each dataclass method).
+@dataclass(frozen=True, eq=False)
 class LeastSquaresResult:
+    """What bounded_leastsq found: the values, which varied, their covariance and MINPACK's outcome."""
+
     values: dict[str, float]        # every parameter, the fixed ones as they started
     varying: tuple[str, ...]
     covar: np.ndarray | None        # of the varying values, unscaled; None when MINPACK gave none

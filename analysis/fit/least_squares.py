@@ -50,7 +50,9 @@ class FitCancelled(FitError):
     pass
 
 
-@dataclass(frozen=True)
+# eq=False: with its arrays, == raised for any two that were not the same object; so no __eq__ and __hash__ are
+# generated at every start (Python 3.11 execs each dataclass method).
+@dataclass(frozen=True, eq=False)
 class FitData:
     """What the fit sees: Z and optionally Hx at their lines, with per-line uncertainties."""
 
@@ -85,8 +87,10 @@ def _usable(tf: TransferFunction) -> TransferFunction:
     return tf.restricted(keep)
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)     # eq=False: as FitData
 class ChannelFit:
+    """One channel's fit: its lines, what was measured and modelled there, and its chi^2."""
+
     name: str
     freqs: np.ndarray
     measured: np.ndarray
@@ -109,8 +113,10 @@ class ChannelFit:
         return (self.model - self.measured) / (self.std / np.sqrt(2.0))
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)     # eq=False: as FitData
 class FitResult:
+    """A fitted model: its values and standard errors, their covariance, each channel's fit and chi^2."""
+
     model: Model
     values: dict[str, float]
     stderr: dict[str, float | None]

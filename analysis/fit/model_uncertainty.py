@@ -82,6 +82,8 @@ ESTIMATING = "estimating"           # not a state of a result: what a page says 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class Member:
+    """One of the fits the data cannot tell apart: its model's effects, its chi^2 and values."""
+
     effects: tuple[str, ...]
     chi2: float
     values: dict[str, float]

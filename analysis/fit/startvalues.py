@@ -27,6 +27,8 @@ class StartValueError(LinparError, ValueError):
 
 @dataclass(frozen=True, slots=True)
 class StartContext:
+    """What the impedance says before any fit: the numbers the start values and the effects' guesses use."""
+
     RE: float
     fs: float
     RES: float

@@ -12,11 +12,11 @@ from analysis.lazy_exports import lazy_exports
 # importing one submodule of the package does not load the rest.
 _HOME = {
     "ABSENT": "assessment",
-    "CaptureInfo": "assessment",
-    "CaptureInfoError": "assessment",
+    "CaptureInfo": "capture",
+    "CaptureInfoError": "capture",
     "ChannelValidity": "assessment",
     "Finding": "assessment",
-    "ImportedCurves": "result",
+    "ImportedCurves": "imported_curves",
     "ResultValidity": "result",
     "ResultValidityError": "result",
     "Severity": "assessment",

@@ -10,7 +10,8 @@
 - from the capture (analysis.validity.capture, when a CaptureInfo is given or
   the recording's sidecar holds one under "capture"): clipping, headroom,
   dropouts, laser error codes and out-of-range share. A "capture" object
-  that cannot be read raises CaptureInfoError (it names the key).
+  that cannot be read raises CaptureInfoError (it names the key). The module
+  is loaded only then: a recording without one does not pay for it.
 
 Each channel's status is its worst finding (green when it has none); the
 overall light is the worst channel's. A recording without displacement has
@@ -31,19 +32,20 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Mapping, Sequence
+from typing import TYPE_CHECKING, Mapping, Sequence
 
 from analysis.excursion import recording_peak_displacement
 from analysis.recording.format import Recording
 from analysis.spectra import Spectra, estimate_spectra
 from analysis.thresholds import DEFAULT_THRESHOLDS, ValidityThresholds
-from analysis.validity.capture import CaptureInfo, CaptureInfoError, capture_findings
 from analysis.validity.drift import drift_findings
 from analysis.validity.findings import Finding, Severity, worst
 from analysis.validity.spectral import SIGNALS, spectral_checks
 
-__all__ = ["ABSENT", "CaptureInfo", "CaptureInfoError", "ChannelValidity", "Finding", "Severity", "Validity",
-           "assess", "capture_of"]
+if TYPE_CHECKING:   # analysis.validity.capture is loaded when a capture is there to judge (start-up time)
+    from analysis.validity.capture import CaptureInfo
+
+__all__ = ["ABSENT", "ChannelValidity", "Finding", "Severity", "Validity", "assess", "capture_of"]
 
 ABSENT = "absent"
 CAPTURE_KEY = "capture"
@@ -51,6 +53,8 @@ CAPTURE_KEY = "capture"
 
 @dataclass(frozen=True, slots=True)
 class ChannelValidity:
+    """One channel's light, its findings and the numbers the checks measured."""
+
     signal: str
     # "green" | "yellow" | "red" | "absent"; None for imported curves' channel, which carries findings alone
     status: str | None
@@ -72,6 +76,8 @@ class ChannelValidity:
 
 @dataclass(frozen=True, slots=True)
 class Validity:
+    """The checks' judgement of a recording: the overall light and each channel's (module doc)."""
+
     overall: Severity
     channels: Mapping[str, ChannelValidity]      # always voltage, current and displacement
     peak_displacement_m: float | None
@@ -109,7 +115,10 @@ class Validity:
 def capture_of(recording: Recording) -> CaptureInfo | None:
     """The CaptureInfo stored in the recording's sidecar, if any (CaptureInfoError if unreadable)."""
     doc = recording.extra.get(CAPTURE_KEY) if recording.extra else None
-    return None if doc is None else CaptureInfo.from_json(doc)
+    if doc is None:
+        return None
+    from analysis.validity.capture import CaptureInfo
+    return CaptureInfo.from_json(doc)
 
 
 def assess(recording: Recording, spectra: Spectra | None = None, capture: CaptureInfo | None = None,
@@ -125,6 +134,7 @@ def assess(recording: Recording, spectra: Spectra | None = None, capture: Captur
     drift = drift_findings(recording, spectra, thresholds)
     captured: dict[str, list[Finding]] = {}
     if capture is not None:
+        from analysis.validity.capture import capture_findings
         x = recording.signal("displacement")
         captured = capture_findings(capture, present, 0 if x is None else x.size, thresholds)
 

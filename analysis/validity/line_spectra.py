@@ -28,6 +28,8 @@ ROUNDING = 1e-12
 
 @dataclass(frozen=True, slots=True, eq=False, kw_only=True)
 class LineSpectra:
+    """The channels' lines gathered in arrays, row by channel, for the checks."""
+
     signals: tuple[str, ...]
     lines: np.ndarray           # (channels, excited) complex: the coherent mean at the excited lines
     line_var: np.ndarray        # (channels, excited): its variance of the mean, floored

@@ -23,57 +23,23 @@ import dataclasses
 import math
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 from analysis.errors import LinparError
 from analysis.validity.assessment import ChannelValidity, Validity
 from analysis.validity.findings import Finding, Severity
+from analysis.validity.frozen_json import frozen, rebuilt, thawed
 
-__all__ = ["UNKNOWN", "ImportedCurves", "ResultValidity", "ResultValidityError"]
+if TYPE_CHECKING:   # imported curves' validity: loaded by the curves' fitting and by a stored one read back
+    from analysis.validity.imported_curves import ImportedCurves
+
+__all__ = ["UNKNOWN", "ResultValidity", "ResultValidityError"]
 
 UNKNOWN = "unknown"         # the overall light of what no check judged (imported curves, a result without one)
 
 
 class ResultValidityError(LinparError, ValueError):
     """A stored "validity" object that cannot be read (message: the key and what was expected)."""
-
-
-def frozen(value: Any) -> Any:
-    """A JSON value made read-only: objects as mapping proxies, lists as tuples."""
-    if isinstance(value, Mapping):
-        return MappingProxyType({str(k): frozen(v) for k, v in value.items()})
-    if isinstance(value, (list, tuple)):
-        return tuple(frozen(v) for v in value)
-    return value
-
-
-def thawed(value: Any) -> Any:
-    """A frozen JSON value as plain dicts and lists again (what json.dumps and analysis.json_finite take)."""
-    if isinstance(value, Mapping):
-        return {k: thawed(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [thawed(v) for v in value]
-    return value
-
-
-@dataclass(frozen=True, kw_only=True, slots=True)
-class ImportedCurves:
-    """What imported curves' validity says instead of checks (analysis.curves.fitting): no per-line noise of their
-    own, and how far to trust the numbers."""
-
-    note: str
-    uncertainties: str
-    rms_relative_residual: Mapping[str, float | None]
-    magnitude_only: tuple[str, ...]                     # the curves without phase
-    ranges_hz: Mapping[str, tuple[float, float]]        # the band each curve was fitted over
-    notes: tuple[str, ...]
-
-    def __post_init__(self) -> None:
-        for name in ("rms_relative_residual", "magnitude_only", "ranges_hz", "notes"):
-            object.__setattr__(self, name, frozen(getattr(self, name)))
-
-    def __reduce__(self):
-        return _rebuilt, (type(self), {f.name: thawed(getattr(self, f.name)) for f in dataclasses.fields(self)})
 
 
 # The keys a ResultValidity knows; any other key of a stored document is kept in `other`.
@@ -113,7 +79,7 @@ class ResultValidity:
         fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
         plain = {name: dict(value) if name == "channels" else value if name == "imported" else thawed(value)
                  for name, value in fields.items()}
-        return _rebuilt, (type(self), plain)
+        return rebuilt, (type(self), plain)
 
     @classmethod
     def checked(cls, validity: Validity, **fit: Any) -> "ResultValidity":
@@ -175,6 +141,7 @@ class ResultValidity:
             raise ResultValidityError("validity: expected an object")
         imported = None
         if "note" in doc:
+            from analysis.validity.imported_curves import ImportedCurves
             imported = ImportedCurves(
                 note=str(doc.get("note") or ""), uncertainties=str(doc.get("uncertainties") or ""),
                 rms_relative_residual=_mapping(doc, "rms_relative_residual"),
@@ -190,10 +157,6 @@ class ResultValidity:
                    **{name: _optional_mapping(doc, name)
                       for name in ("fit_error_percent", "fit_band_hz", "heating", "laser_delay", "model_part")},
                    imported=imported, other={k: v for k, v in doc.items() if k not in known})
-
-
-def _rebuilt(cls: type, fields: dict) -> Any:
-    return cls(**fields)
 
 
 def _light(overall: Any) -> str:

@@ -133,3 +133,15 @@ def test_parse_effects_defaults_and_errors():
     with pytest.raises(UnknownEffectError, match="known effects") as error:
         parse_effects("lr2,no-such-effect")
     assert isinstance(error.value, LinparError)      # a user's --model: one line, exit 2
+
+
+def test_the_catalogue_table_names_each_effect_by_its_id_in_order():
+    """analysis/effects/catalogue.py names each effect's module and imports it when asked for: the table, the
+    objects and CATALOGUE's order agree."""
+    from analysis.effects import catalogue
+    table = catalogue._ALL + catalogue._FORMS
+    assert len({effect_id for effect_id, _, _ in table}) == len(table)
+    for effect_id, _, _ in table:
+        assert catalogue.built_in(effect_id).id == effect_id
+    assert tuple(CATALOGUE) == catalogue.IDS == tuple(effect_id for effect_id, _, _ in catalogue._ALL)
+    assert catalogue.built_in("no-such-effect") is None

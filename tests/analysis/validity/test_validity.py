@@ -9,7 +9,8 @@ from analysis.recording.format import make_recording, read_recording, write_reco
 from analysis.spectra import estimate_spectra, period_spectra
 from analysis.synthesis import ChannelNoise
 from analysis.thresholds import DEFAULT_THRESHOLDS, ThresholdsError, ValidityThresholds, load_thresholds
-from analysis.validity.assessment import ABSENT, CaptureInfo, CaptureInfoError, assess
+from analysis.validity.assessment import ABSENT, assess
+from analysis.validity.capture import CaptureInfo, CaptureInfoError
 from tests.builders import TYPICAL_NOISE, multitone, recording
 
 MT = multitone(period_samples=8192)

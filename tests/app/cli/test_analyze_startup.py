@@ -23,7 +23,15 @@ from tests.pace import paced
 # when a package's metadata names linpar.effects) and the effect files' reader (only when there are files); the
 # level check (the plausibility check needs its excursion limit only); a pool's concurrent.futures; the
 # uncertainties package (analysis.derived propagates by central differences; the added-mass method uses it).
-NOT_LOADED = ("analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
+# The coil's heating (only when the current drifts), the capture's checks (only when the sidecar has a "capture")
+# and the simulator (analysis.synthesis: TYPICAL_NOISE lives there): each made dataclasses at every start. The
+# catalogue's effects beyond the default model's inductance and creep (analysis/effects/catalogue.py imports an
+# effect's module when it is first asked for). Imported curves' validity (analysis.validity.imported_curves).
+NOT_LOADED = ("analysis.heating", "analysis.validity.capture", "analysis.synthesis",
+              "analysis.validity.imported_curves",
+              "analysis.effects.enclosure", "analysis.effects.breakup", "analysis.effects.channels",
+              "analysis.effects.forcefactor", "analysis.effects.mechanical", "analysis.effects.creep_at_fs",
+              "analysis.curves.", "analysis.export", "analysis.limits", "scipy.ndimage", "scipy.interpolate",
               "scipy.stats", "matplotlib", "PySide6", "pyqtgraph", "lmfit",
               "app.cli.added_mass", "app.cli.archive", "app.cli.devices", "app.cli.diagnose", "app.cli.gui",
               "app.cli.large_signal", "app.cli.levels", "app.cli.measure", "app.cli.qa", "app.cli.recover",
