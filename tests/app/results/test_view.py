@@ -275,6 +275,29 @@ def test_a_newer_result_stops_one_shown_in_turns_and_what_waits_for_it_still_run
     assert changed == [no_laser.result]
 
 
+def test_a_result_shown_behind_another_page_is_drawn_when_the_page_is_shown(qtbot, window, recordings):
+    # A version the Model lab adopts while it is in front: announced at once, drawn once the Results page is shown.
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+    at_once, paper_re = _plotted(results), _cell(results.parameter_table, "RE", VALUE)
+    open_and_wait(qtbot, window, recordings["no_laser"], "model_part_shown")
+    no_laser, no_laser_re = _plotted(results), _cell(results.parameter_table, "RE", VALUE)
+    assert no_laser != at_once
+    window.pages.setCurrentWidget(window.model_lab)
+    qtbot.waitUntil(lambda: not results.isVisible(), timeout=wait_ms(5))
+    changed, done = [], []
+    results.result_changed.connect(changed.append)
+    results.show_outcome_in_turns(paper, lambda: done.append(True))
+    qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert changed == [paper.result] and results.result is paper.result
+    assert _plotted(results) == no_laser and _cell(results.parameter_table, "RE", VALUE) == no_laser_re
+    window.pages.setCurrentWidget(results)
+    assert _plotted(results) == at_once and _cell(results.parameter_table, "RE", VALUE) == paper_re
+    assert results.source_label.text().startswith(f"<b>{recordings['paper'].name}")
+
+
 def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, recordings, monkeypatch):
     from app.jobs.workers import AnalysisOutcome
     results = window.results
@@ -361,3 +384,4 @@ def test_a_broken_lead_s_not_measured_cells_are_whole(qtbot):
     text = _cell(table, "Qts", VALUE)
     assert text == "not measured"
     assert _spanned_width(table) > table.fontMetrics().horizontalAdvance(text) + 8
+
