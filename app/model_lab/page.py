@@ -231,7 +231,7 @@ class ModelLab(QWidget):
 
     def _showing_current(self) -> Iterator[None]:
         """_show_current in five steps (the header's words; each residual plot; the table; the chart), each with
-        the paint it sets off 4-8 ms of the GUI thread's CPU (three steps held it 11-17 ms each)."""
+        the paint it sets off 2-8 ms of the GUI thread's CPU (three steps held it 17-26 ms each)."""
         version = self.versions[-1]
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
