@@ -19,6 +19,7 @@ with its effect objects.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 from typing import Callable, Iterable, Sequence
 
@@ -191,8 +192,10 @@ def source_of(effect: Effect) -> str:
 def is_user_effect(effect: Effect) -> bool:
     if effect.id in _USER:
         return True
-    from analysis.effects.user import UserEffect
-    return isinstance(effect, UserEffect)
+    # Not imported, no UserEffect can exist: the Model lab asks this of the candidate a first diagnosis selects,
+    # and the module's import (tomllib, the formula parser: 17 ms) held the GUI thread in that turn.
+    user = sys.modules.get("analysis.effects.user")
+    return user is not None and isinstance(effect, user.UserEffect)
 
 
 __all__ = ["ENTRY_POINT_GROUP", "FOLDER_ENV", "EffectFileError", "ParamSpec", "clear", "config_folder",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import html
 import math
+from collections.abc import Iterator
 
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QFont
@@ -138,6 +139,13 @@ class CandidatesPanel(QWidget):
 
     def set_outcome(self, outcome: DiagnosisOutcome | None, version: int = 0, effects: str = "") -> None:
         """Show the candidates of a diagnosis of version `version` (None: no diagnosis yet)."""
+        for _ in self.setting_outcome(outcome, version, effects):
+            pass
+
+    def setting_outcome(self, outcome: DiagnosisOutcome | None, version: int = 0,
+                        effects: str = "") -> Iterator[None]:
+        """set_outcome in two steps, for a caller that runs them in turns of their own: the table and the words,
+        then the candidate the diagnosis would take selected (its explanation, and the lab's catalogue entry)."""
         self.stale = False
         self.table.clearSelection()
         self.rows = outcome.candidates if outcome is not None else ()
@@ -197,8 +205,10 @@ class CandidatesPanel(QWidget):
                                               "from it.</p>")
         self.table.setCurrentItem(None)       # no current cell either: a key press must not select one
         if outcome is not None and not outcome.path and chosen is not None:
-            self.table.selectRow(chosen)
-        self.selected_changed.emit()
+            yield
+            self.table.selectRow(chosen)      # tells selected_changed
+        else:
+            self.selected_changed.emit()
 
     def show_verdict(self, outcome: DiagnosisOutcome) -> None:
         if not outcome.verdict:

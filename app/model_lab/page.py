@@ -55,6 +55,7 @@ class ModelLab(QWidget):
         self.session = LabSession()                 # the recording, the versions, the diagnosis (no Qt)
         self.new_effect_dialog = None               # the "New effect…" dialog while it is open
         self._in_turns = None                       # the steps left of a version shown in turns (a refit's)
+        self._diagnosis_turns = None                # the steps left of a diagnosis shown in turns
 
         self.empty = QLabel(EMPTY_TEXT)
         self.empty.setAlignment(Qt.AlignCenter)
@@ -171,7 +172,7 @@ class ModelLab(QWidget):
                 self._show_parameters()
             return
         self.jobs.drop()
-        self._in_turns = None           # the steps left of a version of the old recording
+        self._in_turns = self._diagnosis_turns = None       # the steps left of a version, a diagnosis of the old one
         self.session.restart(result)
         if result.fit is None:          # a broken measurement: nothing the lab could start from
             self.empty.setText(f"Nothing to model: {result.not_fitted}")
@@ -229,7 +230,8 @@ class ModelLab(QWidget):
             pass
 
     def _showing_current(self) -> Iterator[None]:
-        """_show_current in three steps (each residual plot; the table and the chart), ~5-12 ms of CPU each."""
+        """_show_current in five steps (the header's words; each residual plot; the table; the chart), each with
+        the paint it sets off 2-8 ms of the GUI thread's CPU (three steps held it 17-26 ms each)."""
         version = self.versions[-1]
         fit = version.fitted.fit
         text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
@@ -240,9 +242,11 @@ class ModelLab(QWidget):
                      f"{html.escape(fit.message)}</span>")
         self.model_label.setText(text)
         self.catalogue.set_checked(fit.model.effect_ids)
+        yield
         yield from self.residual_panel.setting_fit(version.fitted.curves, version.fitted.residual)
         yield
         self._show_parameters()
+        yield
         self.chart.set_points([ChartPoint(v.number, v.effects, v.how, v.fitted.fit.chi2_red_by_channel())
                                for v in self.versions])
         self._update_buttons()
@@ -358,6 +362,14 @@ class ModelLab(QWidget):
         self._add_version_in_turns(fitted, move_text(old.fitted.fit.model, fitted.fit.model))
 
     def on_diagnosis_finished(self, outcome: DiagnosisOutcome, follow: bool = False) -> None:
+        """The diagnosis shown in turns of the event loop (next_turn.in_turns): its versions and the table of
+        candidates, the candidate it would take selected, then the sites and the words. In one turn they held the
+        GUI thread 13-20 ms of CPU, and the paint they set off as much again. A new recording, or a newer
+        diagnosis, drops the steps left."""
+        steps = self._diagnosis_turns = self._showing_diagnosis(outcome, follow)
+        in_turns(self, steps, going_on=lambda: self._diagnosis_turns is steps)
+
+    def _showing_diagnosis(self, outcome: DiagnosisOutcome, follow: bool) -> Iterator[None]:
         start = self.current.number
         for step, fitted in enumerate(outcome.path, start=1):
             previous = self.current.fitted.fit.model
@@ -365,17 +377,20 @@ class ModelLab(QWidget):
             self._add_version(fitted, f"greedy path from version {start}, step {step}: "
                                       f"{move_text(previous, fitted.fit.model)}", announce=last)
         self.session.diagnosed(outcome)
-        self.candidates.set_outcome(outcome, self.current.number, self.current.effects)
+        diagnosed = self.current.number
+        yield from self.candidates.setting_outcome(outcome, diagnosed, self.current.effects)
+        yield
         self.site_panel.set_sites(outcome.sites)
+        if self.current.number != diagnosed:      # a version came while the steps ran (a checkbox)
+            self.site_panel.mark_stale(self.current.number)
         if outcome.verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED) and self.site_panel.shown_site:
             self.views.setCurrentWidget(self.site_panel)     # the misfit left: where it belongs
         if outcome.path:
-            self.status_label.setText(f"Greedy path: {len(outcome.path)} step(s), now version {self.current.number}")
+            self.status_label.setText(f"Greedy path: {len(outcome.path)} step(s), now version {diagnosed}")
         elif follow:
             self.status_label.setText("The greedy path stops at once: no candidate explains the misfit it removes")
         else:
-            self.status_label.setText(f"Diagnosed version {self.current.number}: {len(outcome.candidates)} "
-                                      f"candidates")
+            self.status_label.setText(f"Diagnosed version {diagnosed}: {len(outcome.candidates)} candidates")
         self._update_buttons()
         self.diagnosis_shown.emit(outcome)
 

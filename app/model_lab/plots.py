@@ -54,10 +54,13 @@ class ResidualPlot(StillScene, pg.PlotWidget):
             plot.setLabel("bottom", "frequency (Hz)")
         plot.setMenuEnabled(False)
         _guides(plot)
+        # No dynamic range limit (pyqtgraph clips points beyond 1e6 view heights): the y range always holds every
+        # point (set_curves), so it never clipped, but with it every new range built the point clouds again
+        # (each setYRange ran the items' update a second time: 1-2 ms of the GUI thread per refit and plot).
         self.real = pg.PlotDataItem(pen=None, symbol="o", symbolSize=4, symbolPen=None,
-                                    symbolBrush=pg.mkBrush(style.RESIDUAL_REAL))
+                                    symbolBrush=pg.mkBrush(style.RESIDUAL_REAL), dynamicRangeLimit=None)
         self.imag = pg.PlotDataItem(pen=None, symbol="t", symbolSize=5, symbolPen=None,
-                                    symbolBrush=pg.mkBrush(style.RESIDUAL_IMAG))
+                                    symbolBrush=pg.mkBrush(style.RESIDUAL_IMAG), dynamicRangeLimit=None)
         plot.addItem(self.real)
         plot.addItem(self.imag)
 
@@ -107,6 +110,7 @@ class ResidualPanel(QWidget):
         layout.addWidget(self.impedance, 1)
         layout.addWidget(self.displacement, 1)
         layout.addWidget(self.no_displacement)
+        self._has_x: bool | None = None         # the Hx plot shown (None: not decided yet)
 
     def set_fit(self, curves: ResultCurves, residual: str) -> None:
         for _ in self.setting_fit(curves, residual):
@@ -124,8 +128,11 @@ class ResidualPanel(QWidget):
             self.displacement.clear_curves()
         self.displacement.setVisible(has_x)
         self.no_displacement.setVisible(not has_x)
-        # The frequency axis is labelled on the lowest plot shown.
-        self.impedance.getPlotItem().setLabel("bottom", None if has_x else "frequency (Hz)")
+        # The frequency axis is labelled on the lowest plot shown; set when that changes (setting it again
+        # re-laid the |Z| plot out and redrew it after every refit: 2 ms of the GUI thread).
+        if has_x != self._has_x:
+            self._has_x = has_x
+            self.impedance.getPlotItem().setLabel("bottom", None if has_x else "frequency (Hz)")
 
     def clear(self) -> None:
         self.text.setText("")
@@ -215,7 +222,8 @@ class ChiSquareChart(QWidget):
         self.series: dict[str, pg.PlotDataItem] = {}
         for channel, colour in CHANNEL_COLOURS.items():
             item = pg.PlotDataItem(pen=pg.mkPen(colour, width=2), symbol="o", symbolSize=8, symbolPen=None,
-                                   symbolBrush=pg.mkBrush(colour), name=CHANNEL_SHORT[channel])
+                                   symbolBrush=pg.mkBrush(colour), name=CHANNEL_SHORT[channel],
+                                   dynamicRangeLimit=None)      # the range holds every point, as ResidualPlot's
             # Hovering a point names its model: the x axis has room for version numbers only.
             item.scatter.opts["hoverable"] = True
             item.scatter.opts["tip"] = self._tip

@@ -11,12 +11,13 @@ and in full in the tooltip.
 """
 from __future__ import annotations
 
+import functools
 import math
 from typing import Mapping
 
 import numpy as np
 
-from PySide6.QtCore import QModelIndex, Qt
+from PySide6.QtCore import QModelIndex, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QStandardItem, QStandardItemModel
 from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QHBoxLayout, QHeaderView, QLabel, QTableView,
                                QVBoxLayout, QWidget)
@@ -135,18 +136,41 @@ def shared_reason(rows) -> str:
     return reasons.pop() if unmeasured and len(reasons) == 1 else ""
 
 
+# PySide's enums are looked up and combined in Python (~1 us each): worked out once here, not for each of ~90
+# cells at every fill.
+READ_ONLY = Qt.ItemIsSelectable | Qt.ItemIsEnabled         # as a read-only table model's cells
+RIGHT = int(Qt.AlignRight | Qt.AlignVCenter)
+DISPLAY, TOOLTIP, FONT, FOREGROUND, ALIGNMENT = (Qt.DisplayRole, Qt.ToolTipRole, Qt.FontRole, Qt.ForegroundRole,
+                                                 Qt.TextAlignmentRole)
+
+
+@functools.cache
+def _bold() -> QFont:
+    """The bold font of fitted parameters and section titles (one, made when first needed: after the QApplication)."""
+    font = QFont()
+    font.setBold(True)
+    return font
+
+
 def _item(roles: dict) -> QStandardItem:
     item = QStandardItem()
-    item.setFlags(Qt.ItemIsSelectable | Qt.ItemIsEnabled)      # as a read-only table model's cells
+    item.setFlags(READ_ONLY)
     for role, value in roles.items():
         item.setData(value, role)
     return item
+
+
+def _row_shape(p) -> tuple:
+    """What of a row decides more than its numbers: its kind, font, colour, alignment and span."""
+    return (p,) if isinstance(p, str) else (p.name, p.fitted, p.value is None)
 
 
 class ParameterModel(QStandardItemModel):
     """Every role of every cell worked out once and kept by Qt: a view asks for each of them on every repaint
     (some 1,700 calls to show the table). Formatting them each time made up half of the Results page's repaint;
     answering from Python still took 5-8 ms of it, the calls themselves."""
+
+    numbers_changed = Signal()          # the same rows with new numbers (no modelReset): the widths may change
 
     def __init__(self, parent=None):
         super().__init__(0, len(COLUMNS), parent)
@@ -160,10 +184,15 @@ class ParameterModel(QStandardItemModel):
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
                        descriptions: Mapping[str, str] | None = None, sd_m2: float | None = None) -> None:
+        rows = ordered_rows(parameters, sd_m2)
+        descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
+        shape = [_row_shape(p) for p in rows]
+        same_shape = shape == [_row_shape(p) for p in self._rows] and shared_reason(rows) == self.common_reason
+        self._parameters, self._sd_m2, self._rows, self._descriptions = parameters, sd_m2, rows, descriptions
+        if same_shape and rows:
+            self._set_numbers()
+            return
         self.beginResetModel()
-        self._parameters, self._sd_m2 = parameters, sd_m2
-        self._rows = ordered_rows(parameters, sd_m2)
-        self._descriptions = {**DERIVED_DESCRIPTIONS, **(descriptions or {})}
         self.common_reason = shared_reason(self._rows)
         # Filled inside the reset, quietly: the views hear of the new table once, by modelReset.
         quiet = self.blockSignals(True)
@@ -179,29 +208,45 @@ class ParameterModel(QStandardItemModel):
         self.all_digits = on
         self.set_parameters(self._parameters, self._descriptions, self._sd_m2)
 
+    def _set_numbers(self) -> None:
+        """The same rows with new numbers (a refit of the same model, the model part arrived, Sd edited): only the
+        texts that changed are set, in the cells there are, and the views hear of it once (dataChanged). A new
+        table of items and the reset that re-laid the view out held the GUI thread 6-8 ms at every refit."""
+        quiet = self.blockSignals(True)
+        try:
+            for row, p in enumerate(self._rows):
+                if isinstance(p, str):          # a section title: the same words
+                    continue
+                tooltip = self._tooltip(p)
+                for column in range(len(COLUMNS)):
+                    item = self.item(row, column)
+                    for role, value in ((DISPLAY, self._display(p, column)), (TOOLTIP, tooltip)):
+                        if item.data(role) != value:
+                            item.setData(value, role)
+        finally:
+            self.blockSignals(quiet)
+        self.dataChanged.emit(self.index(0, 0), self.index(self.rowCount() - 1, len(COLUMNS) - 1))
+        self.numbers_changed.emit()
+
     def is_section(self, row: int) -> bool:
         return isinstance(self._rows[row], str)
 
     def _row_roles(self, p) -> list[dict]:
         if isinstance(p, str):          # a section title over the rows below it
-            font = QFont()
-            font.setBold(True)
             tip = ("What the model computes with: the Thiele-Small parameters above derive from them. "
                    "Click to fold them away or show them.")
-            return [{Qt.DisplayRole: f"▾ {p}" if col == NAME else "", Qt.FontRole: font, Qt.ToolTipRole: tip}
+            return [{DISPLAY: f"▾ {p}" if col == NAME else "", FONT: _bold(), TOOLTIP: tip}
                     for col in range(len(COLUMNS))]
         tooltip = self._tooltip(p)
         cells = []
         for col in range(len(COLUMNS)):
-            roles = {Qt.DisplayRole: self._display(p, col), Qt.ToolTipRole: tooltip}
+            roles = {DISPLAY: self._display(p, col), TOOLTIP: tooltip}
             if p.value is None:
-                roles[Qt.ForegroundRole] = QBrush(QColor(style.MISSING_TEXT))
+                roles[FOREGROUND] = QBrush(QColor(style.MISSING_TEXT))
             if col == NAME and p.fitted:
-                font = QFont()
-                font.setBold(True)      # fitted parameters stand out from the derived ones
-                roles[Qt.FontRole] = font
+                roles[FONT] = _bold()       # fitted parameters stand out from the derived ones
             if col in (VALUE, STD) and p.value is not None:
-                roles[Qt.TextAlignmentRole] = int(Qt.AlignRight | Qt.AlignVCenter)
+                roles[ALIGNMENT] = RIGHT
             cells.append(roles)
         return cells
 
@@ -272,6 +317,7 @@ class ParameterTable(QTableView):
         self.internal_folded = False
         self.parts_label: QLabel | None = None      # the line under the table that names the parts (titled_...)
         self.parameter_model.modelReset.connect(self._apply_spans)
+        self.parameter_model.numbers_changed.connect(self._fit_number_columns)
         self.clicked.connect(self._on_clicked)
 
     def set_parameters(self, parameters: Mapping[str, ParameterValue],
@@ -303,6 +349,12 @@ class ParameterTable(QTableView):
         """Measure what the names and values need (once per fill) and share the width by it."""
         fit_to_contents(self, SIZED_COLUMNS)
         self._name_width = self.columnWidth(NAME)
+        self._value_width = max(self.sizeHintForColumn(VALUE), self.horizontalHeader().sectionSizeHint(VALUE))
+        self._share_width()
+
+    def _fit_number_columns(self) -> None:
+        """_fit_columns for new numbers in the same rows: the names and units are as wide as they were."""
+        fit_to_contents(self, (STD,))
         self._value_width = max(self.sizeHintForColumn(VALUE), self.horizontalHeader().sectionSizeHint(VALUE))
         self._share_width()
 

@@ -62,6 +62,8 @@ class ResultsView(QWidget):
         super().__init__(parent)
         self.result: AnalysisResult | None = None
         self.curves = None
+        self._nominal_ohm: float | None = None
+        self._unshown = False               # the result's widgets wait for the page to be shown (_showing)
         self._filling = 0                   # counts the results begun: a fill in turns stops once a newer begins
 
         self.empty = QLabel(EMPTY_TEXT)
@@ -157,12 +159,35 @@ class ResultsView(QWidget):
         in_turns(self, self._showing(outcome), going_on=lambda: filling == self._filling, then=then)
 
     def _showing(self, outcome: AnalysisOutcome) -> Iterator[None]:
-        """The page filled in four steps, each up to a `yield`: the words and the table, |Z|, Hx, the rest."""
-        result, curves = outcome.result, outcome.curves
-        self.result, self.curves = result, curves
+        """The result taken and announced (result_changed); its widgets filled in four steps, each up to a `yield`
+        (the words and the table, |Z|, Hx, the rest), or, on a page behind another one, once it is shown."""
+        self.result, self.curves = outcome.result, outcome.curves
+        self._nominal_ohm = outcome.nominal_ohm
+        self._unshown = self._behind_another_page()
+        if not self._unshown:
+            yield from self._drawing(self.result, self.curves, outcome.nominal_ohm)
+        self.result_changed.emit(self.result)       # with Sd as edited meanwhile, if it was
+
+    def _behind_another_page(self) -> bool:
+        """The window is on screen but this page is not (another tab is in front). A version of the Model lab's,
+        adopted while the lab is in front, was drawn here at every refit: ~20 ms of the GUI thread's CPU for a page
+        nobody saw. A window not shown yet (tests, the start) fills at once."""
+        window = self.window()
+        return window is not self and window.isVisible() and not self.isVisible()
+
+    def showEvent(self, event) -> None:
+        if self._unshown and self.result is not None:
+            self._unshown = False
+            for _ in self._drawing(self.result, self.curves, self._nominal_ohm):      # before its first paint
+                pass
+        super().showEvent(event)
+
+    def _drawing(self, result: AnalysisResult, curves, nominal_ohm: float | None) -> Iterator[None]:
+        """The widgets filled with `result` in four steps, each up to a `yield`: the words and the table, |Z|, Hx,
+        the rest."""
         imported = is_imported(result)
         self.source_label.setText(source_html(result) if imported else
-                                  source_text(result) + self._re_remark(result, outcome.nominal_ohm))
+                                  source_text(result) + self._re_remark(result, nominal_ohm))
         self.validity_box.set_state(str(result.validity.overall),
                                     result.validity.imported.note if result.validity.imported else None)
         self.fit_quality.set_result(result)
@@ -176,7 +201,6 @@ class ResultsView(QWidget):
             self.displacement_stack.setCurrentWidget(self.displacement_plot)
             self.spl_panel.clear()
             self.stack.setCurrentWidget(self.content)
-            self.result_changed.emit(result)
             return
         yield
         self.impedance_stack.setCurrentWidget(self.impedance_plot)
@@ -194,7 +218,6 @@ class ResultsView(QWidget):
             draw_references(result, {"impedance": self.impedance_plot, "displacement": self.displacement_plot})
         self.spl_panel.set_data(curves.displacement, self.result.sd_m2)
         self.stack.setCurrentWidget(self.content)
-        self.result_changed.emit(self.result)       # with Sd as edited meanwhile, if it was
 
     def show_model_part(self, outcome: AnalysisOutcome) -> bool:
         """The same result with the model part of its uncertainties (AnalysisWorker.start_model_part): the table
@@ -208,8 +231,9 @@ class ResultsView(QWidget):
             from analysis.fit.model_uncertainty import with_sd
             result = with_sd(result, parameter_table(result.fit, shown.sd_m2), shown.sd_m2)
         self.result = result
-        self.fit_quality.set_result(result)
-        self._show_parameters(result)
+        if not self._unshown:           # else drawn with it when the page is shown
+            self.fit_quality.set_result(result)
+            self._show_parameters(result)
         self.result_changed.emit(result)
         return True
 
@@ -224,6 +248,7 @@ class ResultsView(QWidget):
     def clear(self) -> None:
         self._filling += 1
         self.result = self.curves = None
+        self._unshown = False
         self.impedance_plot.clear_curves()
         self.displacement_plot.clear_curves()
         self.spl_panel.clear()

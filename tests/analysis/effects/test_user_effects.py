@@ -351,3 +351,10 @@ def test_a_user_effect_is_a_user_effect():
     effect = load_effect_file(EXAMPLE)
     assert isinstance(effect, UserEffect) and registry.is_user_effect(effect)
     assert not registry.is_user_effect(get_effect("lr2"))
+
+
+def test_asking_whether_a_built_in_effect_is_a_user_effect_imports_no_user_effect_module(monkeypatch):
+    # The Model lab asks it of the candidate a first diagnosis selects, in the GUI thread: no import there.
+    monkeypatch.delitem(sys.modules, "analysis.effects.user")
+    assert not registry.is_user_effect(get_effect("lr2"))
+    assert "analysis.effects.user" not in sys.modules

@@ -275,6 +275,29 @@ def test_a_newer_result_stops_one_shown_in_turns_and_what_waits_for_it_still_run
     assert changed == [no_laser.result]
 
 
+def test_a_result_shown_behind_another_page_is_drawn_when_the_page_is_shown(qtbot, window, recordings):
+    # A version the Model lab adopts while it is in front: announced at once, drawn once the Results page is shown.
+    from app.jobs.workers import AnalysisOutcome
+    results = window.results
+    open_and_wait(qtbot, window, recordings["paper"], "model_part_shown")
+    paper = AnalysisOutcome(1, recordings["paper"], results.result, results.curves)
+    at_once, paper_re = _plotted(results), _cell(results.parameter_table, "RE", VALUE)
+    open_and_wait(qtbot, window, recordings["no_laser"], "model_part_shown")
+    no_laser, no_laser_re = _plotted(results), _cell(results.parameter_table, "RE", VALUE)
+    assert no_laser != at_once
+    window.pages.setCurrentWidget(window.model_lab)
+    qtbot.waitUntil(lambda: not results.isVisible(), timeout=wait_ms(5))
+    changed, done = [], []
+    results.result_changed.connect(changed.append)
+    results.show_outcome_in_turns(paper, lambda: done.append(True))
+    qtbot.waitUntil(lambda: bool(done), timeout=wait_ms(30))
+    assert changed == [paper.result] and results.result is paper.result
+    assert _plotted(results) == no_laser and _cell(results.parameter_table, "RE", VALUE) == no_laser_re
+    window.pages.setCurrentWidget(results)
+    assert _plotted(results) == at_once and _cell(results.parameter_table, "RE", VALUE) == paper_re
+    assert results.source_label.text().startswith(f"<b>{recordings['paper'].name}")
+
+
 def test_a_step_that_fails_still_runs_what_waits_for_the_page(qtbot, window, recordings, monkeypatch):
     from app.jobs.workers import AnalysisOutcome
     results = window.results
@@ -361,3 +384,35 @@ def test_a_broken_lead_s_not_measured_cells_are_whole(qtbot):
     text = _cell(table, "Qts", VALUE)
     assert text == "not measured"
     assert _spanned_width(table) > table.fontMetrics().horizontalAdvance(text) + 8
+
+
+def test_new_numbers_for_the_same_parameters_show_as_a_new_table_would(qtbot):
+    # A refit of the same model, its model part arrived, Sd edited: the same rows with other numbers.
+    import dataclasses
+    from app.results.parameter_table import ParameterTable
+    table = _table_of(qtbot, 300, _mixed_parameters())
+    bolder = {name: p if p.value is None else dataclasses.replace(p, value=p.value * 1234.5678, std=p.std * 3.3)
+              for name, p in _mixed_parameters().items()}
+    table.set_parameters(bolder)
+    fresh = ParameterTable()
+    qtbot.addWidget(fresh)
+    fresh.set_parameters(bolder)
+    model, expected = table.parameter_model, fresh.parameter_model
+    assert model.rowCount() == expected.rowCount()
+    for row in range(model.rowCount()):
+        for column in range(len(COLUMNS)):
+            for role in (Qt.DisplayRole, Qt.ToolTipRole, Qt.FontRole, Qt.ForegroundRole, Qt.TextAlignmentRole):
+                assert model.index(row, column).data(role) == expected.index(row, column).data(role), (row, column)
+    assert _cell(table, "Qts", VALUE) != _cell(_table_of(qtbot, 300, _mixed_parameters()), "Qts", VALUE)
+    alone = [model.row_of(name) for name in ("Qts", "Cms", "L2")]
+    for column in (VALUE, STD):         # the wider numbers fit their columns
+        widest = max(table.sizeHintForIndex(model.index(row, column)).width() for row in alone)
+        assert table.columnWidth(column) >= widest, column
+
+
+def test_a_table_of_other_parameters_replaces_the_rows(qtbot):
+    table = _table_of(qtbot, 500, _mixed_parameters())
+    fewer = {name: p for name, p in _mixed_parameters().items() if name != "L2"}
+    table.set_parameters(fewer)
+    assert _names(table) == [_cell_name for _cell_name in _names(_table_of(qtbot, 500, fewer))]
+    assert "L2" not in " ".join(_names(table))
