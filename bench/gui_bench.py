@@ -12,7 +12,12 @@ repaints per second are counted. Rows also say how many frames the
 measurement delivered, whether the audio stream dropped out while the GUI
 painted (xruns, restarts of the averaging: every repaint holds the GIL, which
 the audio callback needs), and the longest time a 1 ms Python thread waited
-to run (the GIL held by the GUI or the measurement).
+to run (the GIL held by the GUI or the measurement). That thread is the bench's,
+not the workstation's, and it takes the GIL a thousand times a second: beside
+the stall it lengthens the GUI thread's gaps (three pairs of runs with 60 frames
+offered: 26.2, 27.6, 29.2 ms without it, 34.9, 33.3, 62.5 ms with it, the GUI
+thread's CPU in the gap 22-26 ms in both). So it runs in the measurement alone
+only; the run with frames offered measures its stall without it.
 
 Then a diagnosis in the Model lab of a recording whose laser lags by 100 us
 (every candidate refitted in worker processes, the table filled at the end):
@@ -93,9 +98,9 @@ def _start_rig(folder: Path):
 
 
 class StallMeter:
-    """Gaps between the ticks of a TICK_MS QTimer, and between the wake-ups of a 1 ms Python thread."""
+    """Gaps between the ticks of a TICK_MS QTimer, and (`probe_gil`) between the wake-ups of a 1 ms Python thread."""
 
-    def __init__(self):
+    def __init__(self, probe_gil: bool = True):
         from PySide6.QtCore import QTimer
         self.timer = QTimer()
         self.timer.setTimerType(self.timer.timerType().PreciseTimer)
@@ -106,6 +111,7 @@ class StallMeter:
         self.thread_gaps: list[float] = []
         self._last = self._last_cpu = 0.0
         self._stop = threading.Event()
+        self.probe_gil = probe_gil
 
     def _tick(self) -> None:
         now, cpu = time.perf_counter(), time.thread_time()
@@ -124,14 +130,16 @@ class StallMeter:
     def __enter__(self) -> "StallMeter":
         self._last, self._last_cpu = time.perf_counter(), time.thread_time()
         self.timer.start()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+        self._thread = threading.Thread(target=self._spin, daemon=True) if self.probe_gil else None
+        if self._thread is not None:
+            self._thread.start()
         return self
 
     def __exit__(self, *exc) -> None:
         self.timer.stop()
         self._stop.set()
-        self._thread.join()
+        if self._thread is not None:
+            self._thread.join()
 
     @property
     def stall_ms(self) -> float:
@@ -206,8 +214,9 @@ def _measuring(app, window, rig) -> list[Row]:
     wizard.go_to(4)
     _wait(app, lambda: False, 0.5)          # the window's first paint is its showing's, not the measurement's
     page = wizard.measure_page
-    alone = _measure_once(app, wizard, page, template, [], 0)
-    offered = _measure_once(app, wizard, page, template, _offered_frames(template, level), OFFERED_HZ)
+    alone = _measure_once(app, wizard, page, template, [], 0, probe_gil=True)
+    offered = _measure_once(app, wizard, page, template, _offered_frames(template, level), OFFERED_HZ,
+                            probe_gil=False)        # the module doc: the probe lengthens the stalls beside it
     for run_ in (alone, offered):
         if "failed" in run_:
             return [Row(f"gui: the measurement on {where} failed: {run_['failed']}", 0.0, "", "", False)]
@@ -227,13 +236,11 @@ def _measuring(app, window, rig) -> list[Row]:
         at_most(f"gui: longest event-loop stall while averaging, {OFFERED_HZ}/s offered", offered["stall"], "ms",
                 STALL_LIMIT_MS),
         Row(CPU_ROW, offered["stall_cpu"], "ms", "", None),
-        Row(f"gui: longest wait of a 1 ms Python thread, {OFFERED_HZ}/s offered (GIL)", offered["thread"], "ms",
-            "", None),
         at_most(f"gui: xruns and restarts of the averaging, {OFFERED_HZ}/s offered", offered["xruns"], "", 0),
     ]
 
 
-def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -> dict:
+def _measure_once(app, wizard, page, template, offered: list, offered_hz: int, probe_gil: bool) -> dict:
     from PySide6.QtCore import QTimer
 
     sent = [0]
@@ -250,7 +257,7 @@ def _measure_once(app, wizard, page, template, offered: list, offered_hz: int) -
     window.measurement_shown.connect(on_shown)
     page.jobs.runner.failed.connect(on_failed)
     paints_before, frames_before = len(page.panels.paint_times), page.panels.frames_received
-    with StallMeter() as meter:
+    with StallMeter(probe_gil) as meter:
         page.start_button.click()
         started = time.monotonic()
         if offered:
