@@ -119,7 +119,7 @@ def parameter_flags(fit: FitResult, names: tuple[str, ...] | None = None, typica
             flags.append(Flag(AT_BOUND, f"{name} = {shown} ended on its {side} bound: the data push it further "
                                         "than the effect allows", name))
             continue      # a parameter held on its bound has no standard error: one flag is enough
-        if typical and spec.typical is not None and not spec.typical[0] <= value <= spec.typical[1]:
+        if typical and not spec.within_typical(value):
             flags.append(Flag(ATYPICAL, f"{name} = {shown} is outside its typical range ({spec.typical_text()})",
                               name))
         sigma = fit.stderr.get(name)

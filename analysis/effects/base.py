@@ -75,6 +75,10 @@ class ParamSpec:
         scale = max(abs(self.default), abs(value), 1e-300)
         return value - self.min <= AT_BOUND_RELATIVE * scale or self.max - value <= AT_BOUND_RELATIVE * scale
 
+    def within_typical(self, value: float) -> bool:
+        """True when `value` lies in the typical range, or no range is given."""
+        return self.typical is None or self.typical[0] <= value <= self.typical[1]
+
     def typical_text(self) -> str:
         """'0.01 to 10 mH': the typical range in display units, for the catalogue and flags."""
         if self.typical is None:

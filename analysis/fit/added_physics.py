@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 
-from analysis.effects import ParamSpec, Site, get_effect
+from analysis.effects import Site, get_effect
 from analysis.fit.least_squares import FitResult
 from analysis.model.composed import Model, ModelError
 
@@ -51,9 +51,5 @@ def asked_for(extended: FitResult, reported: FitResult) -> bool:
     if not (math.isfinite(extended.chi2) and extended.chi2 < reported.chi2):
         return False
     own = [spec for spec in extended.model.param_specs if spec.name not in reported.values]
-    return all(not spec.on_bound(extended.values[spec.name]) and _typical(spec, extended.values[spec.name])
+    return all(not spec.on_bound(extended.values[spec.name]) and spec.within_typical(extended.values[spec.name])
                for spec in own)
-
-
-def _typical(spec: ParamSpec, value: float) -> bool:
-    return spec.typical is None or spec.typical[0] <= value <= spec.typical[1]
