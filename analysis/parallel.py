@@ -31,10 +31,10 @@ def run_in_the_background() -> None:
 
 
 def pool_context() -> multiprocessing.context.BaseContext:
-    """'forkserver', its server preloaded with what every fit builds first: one server, whoever starts a pool."""
+    """'forkserver', its server preloaded with what every fit builds first (analysis.pool_preload): one server,
+    whoever starts a pool."""
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates",
-                                     "analysis.pool_preload"])
+    context.set_forkserver_preload(["analysis.pool_preload"])
     return context
 
 

@@ -1,6 +1,7 @@
 """The process pool's workers: what the fork server built once (analysis/pool_preload.py), their priority,
 and what they raise."""
 import os
+import sys
 from concurrent.futures.process import BrokenProcessPool
 
 import pytest
@@ -63,3 +64,17 @@ def test_an_exception_the_caller_cannot_rebuild_arrives_as_one_line_and_the_pool
         assert pool.submit(_niceness).result(timeout=300) == os.nice(0)       # the pool goes on
         assert pool._processes[worker].is_alive()                             # with the same workers
 
+
+def _niceness_of_the_preload() -> int | None:
+    from analysis import pool_preload
+    return pool_preload.niceness
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a nice value per thread is Linux's")
+def test_the_fork_servers_preload_runs_below_its_caller_and_the_workers_it_forks_are_not_niced_twice():
+    caller = os.nice(0)
+    with fit_executor(2) as pool:
+        assert pool.submit(_niceness_of_the_preload).result(timeout=300) == min(caller + BACKGROUND_NICENESS, 19)
+        assert pool.submit(_niceness).result(timeout=300) == caller
+    with fit_executor(2, background=True) as pool:
+        assert pool.submit(_niceness).result(timeout=300) == min(caller + BACKGROUND_NICENESS, 19)
