@@ -12,6 +12,8 @@ import os
 from concurrent.futures import Executor, ProcessPoolExecutor
 from typing import Iterator
 
+from analysis.worker_errors import call_sending_errors
+
 
 # How much lower than its caller a background pool's workers run (os.nice). The GUI diagnoses on a pool
 # as wide as the machine: at equal priority the workers took the cores from the GUI thread, which then
@@ -29,11 +31,19 @@ def run_in_the_background() -> None:
 
 
 def pool_context() -> multiprocessing.context.BaseContext:
-    """'forkserver', its server preloaded with what every fit builds first: one server, whoever starts a pool."""
+    """'forkserver', its server preloaded with what every fit builds first (analysis.pool_preload): one server,
+    whoever starts a pool."""
     context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(["analysis.fit.least_squares", "analysis.diagnosis.candidates",
-                                     "analysis.pool_preload"])
+    context.set_forkserver_preload(["analysis.pool_preload"])
     return context
+
+
+class WorkerPool(ProcessPoolExecutor):
+    """A process pool whose calls' exceptions always reach the caller (analysis.worker_errors): one that pickle
+    could not rebuild had broken the whole pool."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        return super().submit(call_sending_errors, fn, *args, **kwargs)
 
 
 @contextlib.contextmanager
@@ -44,6 +54,6 @@ def fit_executor(workers: int | None = None, *, background: bool = False) -> Ite
     if n <= 1:
         yield None
         return
-    with ProcessPoolExecutor(max_workers=n, mp_context=pool_context(),
-                             initializer=run_in_the_background if background else None) as pool:
+    with WorkerPool(max_workers=n, mp_context=pool_context(),
+                    initializer=run_in_the_background if background else None) as pool:
         yield pool

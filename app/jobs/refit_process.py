@@ -19,12 +19,12 @@ import concurrent.futures
 import itertools
 import logging
 import threading
-from concurrent.futures.process import BrokenProcessPool, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from multiprocessing.reduction import ForkingPickler
 
 from analysis.fit.least_squares import FitData, FitResult, fit_model
 from analysis.model.composed import Model
-from analysis.parallel import pool_context, run_in_the_background, worker_count
+from analysis.parallel import WorkerPool, pool_context, run_in_the_background, worker_count
 from app.jobs.background_pool import CANCEL_POLL_S, PoolCancelled
 
 log = logging.getLogger(__name__)
@@ -69,7 +69,7 @@ class RefitProcess:
 
     def __init__(self) -> None:
         self._lock = threading.Lock()       # the lab's refits run one at a time, but a shutdown may come from the GUI
-        self._pool: ProcessPoolExecutor | None = None
+        self._pool: WorkerPool | None = None
         self._cancelled_up_to = None
         self._numbers = itertools.count(1)
         self._closed = False                # shut down: no process is started again (a refit then fits here)
@@ -129,7 +129,7 @@ class RefitProcess:
                 self._cancelled_up_to.value = self.ticket()     # every refit so far
                 pool.shutdown(wait=False, cancel_futures=True)
 
-    def _running(self) -> ProcessPoolExecutor | None:
+    def _running(self) -> WorkerPool | None:
         with self._lock:
             if self._pool is None and not self._closed and worker_count() > 1:
                 context = pool_context()
@@ -137,8 +137,8 @@ class RefitProcess:
                 # an aligned 8-byte integer. A lock would be a named semaphore, gone once this side drops it:
                 # a worker still starting then failed to open it (a traceback on the terminal).
                 self._cancelled_up_to = context.Value("q", 0, lock=False)
-                self._pool = ProcessPoolExecutor(max_workers=1, mp_context=context, initializer=_start_worker,
-                                                 initargs=(self._cancelled_up_to,))
+                self._pool = WorkerPool(max_workers=1, mp_context=context, initializer=_start_worker,
+                                        initargs=(self._cancelled_up_to,))
             return self._pool
 
     def _cancel(self, number: int) -> None:
@@ -146,7 +146,7 @@ class RefitProcess:
             if self._cancelled_up_to is not None:
                 self._cancelled_up_to.value = max(self._cancelled_up_to.value, number)
 
-    def _drop(self, pool: ProcessPoolExecutor) -> None:
+    def _drop(self, pool: WorkerPool) -> None:
         with self._lock:
             if self._pool is pool:
                 self._pool = None

@@ -101,8 +101,9 @@ def every_error_class():
     return classes
 
 
-# Exceptions that are not errors for the user: cancellations and internal signals, caught where they arise.
-NOT_USER_ERRORS = {"Cancelled", "_NotJson", "SchemaError", "SpecError"}
+# Exceptions that are not errors for the user: cancellations and internal signals, caught where they arise;
+# what a worker process raised, brought back to be reported as it would have been there: a bug.
+NOT_USER_ERRORS = {"Cancelled", "_NotJson", "SchemaError", "SpecError", "analysis.worker_errors."}
 
 
 def test_every_error_a_module_defines_derives_from_linpar_error():

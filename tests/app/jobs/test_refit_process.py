@@ -11,6 +11,7 @@ import pytest
 
 import analysis
 from analysis.effects import parse_effects
+from analysis.effects.creep import CreepLog
 from analysis.fit.least_squares import FitCancelled, FitData, fit_model
 from analysis.model import Model
 from analysis.parallel import BACKGROUND_NICENESS, worker_count
@@ -138,3 +139,32 @@ def test_start_does_not_wait_for_the_process_in_the_callers_thread(refits, monke
     while refits._pool is None and time.monotonic() < deadline:
         time.sleep(0.01)
     assert refits._pool is not None and forked_in and threading.current_thread() not in forked_in
+
+
+class NeedsTwo(Exception):
+    """An exception pickle cannot rebuild: its args hold the one message, its __init__ wants two arguments."""
+
+    def __init__(self, part: str, why: str):
+        super().__init__(f"{part}: {why}")
+
+
+class FailingCreep(CreepLog):
+    """A package's effect whose code raises an exception of its own."""
+
+    def response(self, s, p):
+        raise NeedsTwo("the spider", "torn")
+
+
+def test_an_effects_exception_the_window_cannot_rebuild_is_one_line_and_the_worker_goes_on(data, refits):
+    """Before: the worker's exception could not be unpickled in the window's process; concurrent.futures marked
+    the pool broken, the refit was redone in the window's process (the window stalled) and a new worker started."""
+    creep = parse_effects("creep-log")[0]
+    failing = FailingCreep(**{f.name: getattr(creep, f.name) for f in dataclasses.fields(creep) if f.init})
+    refits.fit(refits.ticket(), data, MODEL, {}, threading.Event())
+    pool = refits._running()
+    worker = pool.submit(os.getpid).result()
+    with pytest.raises(Exception) as raised:
+        refits.fit(refits.ticket(), data, Model((*parse_effects("lr3"), failing)), {}, threading.Event())
+    assert "the effect creep-log raised NeedsTwo: the spider: torn" in str(raised.value)
+    assert refits._running() is pool and pool.submit(os.getpid).result() == worker
+    assert refits.fit(refits.ticket(), data, MODEL, {}, threading.Event()).values["Bl"] > 0
