@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Mapping
 from analysis.errors import LinparError
 from analysis.files import read_text
 from analysis.fit.error import FIT_ERROR_DEFAULTS
+from analysis.parameter_names import CODE_NAMES
 from analysis.qa_interval import FAIL, INTERVAL_K, PASS, UNCERTAIN
 from analysis.text_boundary import control_found
 
@@ -214,11 +215,17 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
     units = parameter_units()
     start = text.find('"parameters"')
     limits = []
-    for name, entry in params.items():
-        line = _line_of(text, name, max(start, 0))
-        key = f"parameters.{name}"
+    given_as: dict[str, str] = {}
+    for given, entry in params.items():
+        line = _line_of(text, given, max(start, 0))
+        key = f"parameters.{given}"
+        # The name the window and the reports show (Re, Le) is the parameter's too: a user copies it from there.
+        name = CODE_NAMES.get(given, given)
         if name not in units:
             fail(line, key, f"unknown parameter: expected one of {', '.join(units)}")
+        if name in given_as:
+            fail(line, key, f"the same parameter as {given_as[name]!r}: give its limits once")
+        given_as[name] = given
         si, customary, scale = units[name]
         if not isinstance(entry, dict):
             fail(line, key, "expected an object with nominal/tolerance or min/max, and unit")
@@ -228,7 +235,8 @@ def parse_limits(doc, text: str, path: Path) -> Limits:
         unit = entry.get("unit")
         accepted = {_unit(si): 1.0, _unit(customary): 1.0 / scale}
         if not isinstance(unit, str) or _unit(unit) not in accepted:
-            fail(line, f"{key}.unit", f"found {unit!r}, expected {si!r} (SI) or {customary!r}")
+            expected = f"{si!r}" if _unit(si) == _unit(customary) else f"{si!r} (SI) or {customary!r}"
+            fail(line, f"{key}.unit", f"found {unit!r}, expected {expected}")
         to_si = accepted[_unit(unit)]
         # The file's numbers and unit, the unit in proper notation (Ω, T·m); dimensionless: no unit in the text.
         shown_unit = "" if _unit(unit) == "1" else pretty_unit(unit)

@@ -12,6 +12,10 @@ DISPLAY_NAMES = {"RE": "Re", "LE": "Le", "SPL_2.83V_1m": "Sensitivity (2.83 V, 1
                  "SPL_1W_1m": "Sensitivity (1 W into Re, 1 m)", "eta0": "η₀ (efficiency)"}
 
 
+# The shown names that are a name too (a limits file may say Re for RE): not the sentences.
+CODE_NAMES = {shown: name for name, shown in DISPLAY_NAMES.items() if shown.isidentifier()}
+
+
 def display_name(name: str) -> str:
     return DISPLAY_NAMES.get(name, name)
 

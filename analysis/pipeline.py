@@ -12,6 +12,7 @@ call `require_fit`, which raises NotAnalysable with the reason.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import threading
 from contextlib import contextmanager
@@ -32,6 +33,7 @@ from analysis.fit.methods import DEFAULT_METHOD, fit_with
 from analysis.model.composed import Model, ModelError
 from analysis.model.lumped import resonance_frequency
 from analysis.recording.format import IN_MEMORY, Recording, RecordingError, read_recording, recording_paths
+from analysis.serial_laser import delay_start, from_serial_laser, recording_default_effects, with_delay_verdict
 from analysis.spectra import Spectra, SpectrumError, estimate_spectra
 from analysis.validity.plausibility import plausibility_findings
 from analysis.validity.assessment import Validity, assess, capture_of
@@ -122,9 +124,18 @@ def resolve_sd(recording: Recording, sd_m2: float | None) -> float | None:
 def analyze_recording(recording: Recording, sd_m2: float | None = None,
                       effects: Sequence[Effect] | None = None,
                       cancel: threading.Event | None = None, method: str = DEFAULT_METHOD) -> AnalysisResult:
+    """The judged analysis of a recording; `effects` None: the default model, with `delay-x` for a serial
+    laser's recording, whose delay is searched first (analysis/serial_laser.py)."""
     with naming_the_file(recording):
         spectra = estimate_spectra(recording)
-    return analyze_spectra(recording, spectra, sd_m2, effects, cancel, method=method)
+    if effects is None:
+        effects = recording_default_effects(recording)
+    if not from_serial_laser(recording):
+        return analyze_spectra(recording, spectra, sd_m2, effects, cancel, method=method)
+    found: list = []        # the delay search's DelaySearch
+    result = analyze_spectra(recording, spectra, sd_m2, effects, cancel, method=method,
+                             start_of=functools.partial(delay_start, found=found))
+    return with_delay_verdict(result, found[0]) if found else result
 
 
 @contextmanager

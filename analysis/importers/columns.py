@@ -75,7 +75,8 @@ def _by_name(table: Table, roles: list[str], value_name: str) -> Columns:
     def only(role: str) -> int | None:
         found = [i for i, r in enumerate(roles) if r == role]
         if len(found) > 1:
-            raise table.error(line, f"columns {', '.join(repr(names[i]) for i in found)} are all {role}: expected one")
+            raise table.error(line, f"columns {', '.join(repr(names[i]) for i in found)} are all {role}: expected one"
+                              + _uiv_hint(names))
         return found[0] if found else None
 
     frequency = only("frequency")
@@ -102,6 +103,16 @@ def _by_name(table: Table, roles: list[str], value_name: str) -> Columns:
         raise table.error(line, f"column {unused[0]!r} is not understood: expected frequency, {value_name}, "
                           "phase (or real and imaginary parts)")
     return columns
+
+
+def _uiv_hint(names: list[str]) -> str:
+    """What to do with a file of voltage, current and laser spectra given as one curve ('' for any other header):
+    its U_re, I_re and V_re are three real parts, and "expected one" alone does not say which reader it needs."""
+    signals = {name.strip().lower()[:1] for name in names}
+    if {"u", "i"} <= signals and signals & {"v", "x"}:
+        return ("; the header names voltage, current and laser spectra: read it as U/I/V spectra "
+                "(linpar analyze --uiv FILE, or the window's File > Open curves…)")
+    return ""
 
 
 @dataclass(frozen=True)

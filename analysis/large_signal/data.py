@@ -35,6 +35,7 @@ import numpy as np
 from analysis.errors import LinparError
 from analysis.recording.format import MIN_PERIODS, Recording
 from analysis.spectra import SpectrumError, excited_lines
+from analysis.serial_laser import from_serial_laser
 
 
 class LargeSignalError(LinparError, ValueError):
@@ -99,11 +100,9 @@ def recording_data(recording: Recording, label: str | None = None) -> RecordingD
     spectrum = np.fft.rfft(x, axis=1)
     spectrum[:, x_top + 1:] = 0.0         # nothing of the driver's motion is measured beyond either band
     x = np.fft.irfft(spectrum, n, axis=1)
-    measurement = recording.extra.get("measurement") if recording.extra else None
-    serial = isinstance(measurement, dict) and measurement.get("displacement_source") == "serial laser"
     lines = np.arange(1, x_top + 1)
     return RecordingData(name, float(recording.sample_rate), u, i, x, lines, lines, excited,
-                         serial or x_max_hz is not None)
+                         from_serial_laser(recording))
 
 
 def peak_to_peak(data: RecordingData, offset: float = 0.0) -> tuple[float, float]:

@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 
 from app.cli import curves, effects
-from app.cli.options import add_json_option, add_method_option, add_model_option, add_sd_option, model_effects
+from app.cli.options import (SERIAL_LASER_MODEL, add_json_option, add_method_option, add_model_option, add_sd_option,
+                             model_effects)
 from app.cli.output import print_json
 
 EXIT_QA_FAIL = 1
@@ -14,7 +15,7 @@ def register(sub) -> None:
     analyze = sub.add_parser("analyze", help="fit the parameters of a recording")
     analyze.add_argument("path", nargs="?", help="recording: NAME, NAME.wav or NAME.json (or --impedance/--uiv)")
     add_sd_option(analyze)
-    add_model_option(analyze)
+    add_model_option(analyze, why=SERIAL_LASER_MODEL)
     add_method_option(analyze)
     add_json_option(analyze)
     analyze.add_argument("--limits", metavar="FILE",
@@ -39,7 +40,8 @@ def analyze_recording(args: argparse.Namespace) -> int:
         from analysis import limits as qa
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
     # With the model part of each uncertainty (refits when the model misses the data by more than its noise).
-    result = analyze(args.path, sd_m2=args.sd, effects=model_effects(args.model), method=args.method or "joint")
+    effects = model_effects(args.model) if args.model is not None else None     # None: the recording's default
+    result = analyze(args.path, sd_m2=args.sd, effects=effects, method=args.method or "joint")
     doc = result.as_json()
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)

@@ -11,7 +11,8 @@ import sys
 from analysis.bounds import LIST_LIMIT
 from app.cli import archive_server, effects
 from app.cli.archive_server import add_archive_options, say_notes
-from app.cli.options import add_json_option, add_model_option, add_sd_option, model_effects, name_text, number
+from app.cli.options import (SERIAL_LASER_MODEL, add_json_option, add_model_option, add_sd_option, model_effects,
+                             name_text, number)
 from app.cli.output import print_json
 
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
@@ -48,7 +49,7 @@ def register(sub) -> None:
                        "(2026-05-04T09:30+02:00, or Z for UTC); default: now")
     store.add_argument("--laser-stream", metavar="FILE", help="the raw laser stream to keep with it")
     add_sd_option(store)
-    add_model_option(store)
+    add_model_option(store, why=SERIAL_LASER_MODEL)
     effects.add_effects_file_option(store)
 
     compare = verbs.add_parser("compare", help="up to 8 measurements' parameters side by side")
@@ -139,7 +140,8 @@ def _store(archive, args) -> int:
     from analysis.pipeline import analyze_path
     checked_measured_at(args.measured_at)        # before the analysis: a wrong date is said at once
     # The record's uncertainties with their model part, as `linpar analyze` prints them.
-    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model)))
+    result = model_uncertainty(analyze_path(args.path, args.sd,
+                                                   model_effects(args.model) if args.model is not None else None))
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)

@@ -17,7 +17,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from app.cli.options import CliError, add_json_option, add_model_option, add_sd_option, model_effects
+from app.cli.options import (SERIAL_LASER_MODEL, CliError, add_json_option, add_model_option, add_sd_option,
+                             model_effects)
 from app.cli.output import print_json
 
 
@@ -42,7 +43,7 @@ def register(sub) -> None:
                         help="with --simulate: drive levels in V RMS (default 0.3,1,3,6,10,14: ~0.15-8.5 mm)")
     levels.add_argument("--out", metavar="DIR", help="with --simulate: write the recordings to DIR (kept)")
     add_sd_option(levels)
-    add_model_option(levels)
+    add_model_option(levels, why=SERIAL_LASER_MODEL)
     add_json_option(levels, "print one JSON object (with the Fig. 14 data)")
     levels.set_defaults(run=run)
 

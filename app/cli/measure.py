@@ -55,8 +55,8 @@ from analysis.config_folder import data_folder
 from analysis.errors import is_user_error, user_message
 from app.cli import devices, large_signal
 from app.cli.devices import LASER_ANALOG, say
-from app.cli.options import (CliError, add_json_option, add_model_option, add_sd_option, model_effects, name_text,
-                             number)
+from app.cli.options import (SERIAL_LASER_MODEL, CliError, add_json_option, add_model_option, add_sd_option,
+                             model_effects, name_text, number)
 from app.cli.output import print_json
 from instruments.measurement.plan import TEMPLATES, MeasurementPlan
 
@@ -86,7 +86,7 @@ def register(sub) -> None:
     m.add_argument("--on-xrun", choices=("end", "restart"),
                    help="an xrun while periods are kept: end the measurement, keeping them (the default with the "
                         "serial laser), or average again")
-    add_model_option(m, why="; with the serial laser also delay-x")
+    add_model_option(m, why=SERIAL_LASER_MODEL)
     for field in ("serial", "operator", "station"):
         m.add_argument(f"--{field}", default="", metavar="TEXT", type=name_text, help=f"the {field} kept with it in the archive")
     where = m.add_mutually_exclusive_group()

@@ -81,6 +81,10 @@ def size_limit(text: str) -> tuple[str, int]:
         raise argparse.ArgumentTypeError(str(exc).removeprefix("--size-limit: ")) from None
 
 
+# What a recording's default model adds for a serial laser (analysis/serial_laser.py), said in each --model help.
+SERIAL_LASER_MODEL = "; a serial laser's recording also delay-x"
+
+
 def add_model_option(parser, default: Sequence[str] = DEFAULT_EFFECTS, why: str = "") -> None:
     """--model EFFECTS; `default` is what the command fits without it (said in the help, never typed twice)."""
     parser.add_argument("--model", metavar="EFFECTS",

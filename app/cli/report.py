@@ -16,7 +16,7 @@ from pathlib import Path
 
 from app.cli import effects
 from app.cli.archive_server import add_archive_options, open_from_args
-from app.cli.options import CliError, add_model_option, add_sd_option, model_effects
+from app.cli.options import SERIAL_LASER_MODEL, CliError, add_model_option, add_sd_option, model_effects
 
 
 def export_options() -> list[tuple[str, str]]:
@@ -29,7 +29,7 @@ def _source_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("source", metavar="ID|PATH", help="archived measurement id, or a recording to analyse")
     add_archive_options(parser)
     add_sd_option(parser, " (recordings only)")
-    add_model_option(parser, why="; recordings only")
+    add_model_option(parser, why="; recordings only" + SERIAL_LASER_MODEL)
     effects.add_effects_file_option(parser)
 
 
@@ -64,7 +64,8 @@ def load_source(args):
     """(StoredResult, header, settings, calibration) of the ID or PATH."""
     if _is_recording(args.source):
         from analysis.archive.results import stored_from_recording
-        stored, header, calibration = stored_from_recording(args.source, args.sd, model_effects(args.model))
+        effects = model_effects(args.model) if args.model is not None else None    # None: the recording's default
+        stored, header, calibration = stored_from_recording(args.source, args.sd, effects)
         return stored, header, None, calibration
     if args.sd is not None or args.model is not None:
         raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "

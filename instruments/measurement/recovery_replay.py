@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from analysis.recording.format import make_recording, write_recording
+from analysis.serial_laser import DISPLACEMENT_MAX_KEY, SERIAL_LASER
 from instruments.audio.captured import CLIP_LEVEL
 from instruments.audio.config import Calibration, ChannelMap
 from instruments.audio.periods import PeriodCollector
@@ -193,7 +194,6 @@ def _recording_of(replay: _Replay, meta: dict):
             signals = {s: v[:n * plan.period_samples] for s, v in signals.items()}
             signals["displacement"] = aligned.displacement[:n * plan.period_samples]
             capture.update(aligned.counts.capture_json())
-            from instruments.measurement.analysis_step import DISPLACEMENT_MAX_KEY
             extra[DISPLACEMENT_MAX_KEY] = aligned.max_hz
             extra["laser_alignment"] = aligned.as_json(fs, plan.laser_rate_hz)
     message = (f"the workstation stopped during the measurement (started {meta['started_at']}); {n} whole "
@@ -201,7 +201,7 @@ def _recording_of(replay: _Replay, meta: dict):
     extra = {"capture": capture, "measurement": {
         "plan": meta["plan"], "partial": True, "ended_by": "crash", "message": message, "periods": n,
         "audio": meta.get("device", ""), "recovered_at": now_utc(),
-        "displacement_source": ("serial laser" if "displacement" in signals and meta["serial_laser"] else
+        "displacement_source": (SERIAL_LASER if "displacement" in signals and meta["serial_laser"] else
                                 "sound card (laser analog)" if "displacement" in signals else "none"),
         "laser": laser_info}, **extra}
     if meta["plan"].get("calibration"):

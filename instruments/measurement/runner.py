@@ -26,8 +26,8 @@ share), "audio_capture" (every count of the capture), "measurement" (the
 plan, the devices, how it ended), and for the serial laser
 "displacement_max_hz" and "laser_alignment" (alignment.py).
 
-The analysis uses the default model, plus `delay-x` with the serial laser
-(``default_effects``); ``effects`` replaces it.
+The analysis is `linpar analyze`'s (analysis.pipeline.analyze_recording): the default model, plus `delay-x`
+with the serial laser (analysis/serial_laser.py); ``effects`` replaces it.
 """
 from __future__ import annotations
 
@@ -45,7 +45,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from analysis.pipeline import AnalysisResult
+from analysis.pipeline import AnalysisResult, analyze_recording
+from analysis.serial_laser import DISPLACEMENT_MAX_KEY, SERIAL_LASER
 from analysis.recording.format import Recording, make_recording, read_recording, write_recording
 from analysis.session import SESSION_KEY, new_session
 from instruments.audio import CapturedSignals, capture
@@ -53,7 +54,6 @@ from instruments.audio.errors import AudioError, CaptureCancelled
 from instruments.audio.interface import AudioInterface
 from instruments.laser.sensor import DisplacementSensor, LaserError
 from instruments.measurement.alignment import AlignedDisplacement, align_laser, stream_of_blocks
-from instruments.measurement.analysis_step import DISPLACEMENT_MAX_KEY, analyse_measurement
 from instruments.measurement.clocks import lower_envelope
 from instruments.measurement.laser_reader import LaserReader
 from instruments.measurement.live_periods import Listener, LivePeriods
@@ -219,19 +219,9 @@ def run_measurement(plan: MeasurementPlan, audio: AudioInterface, laser: Displac
     result = None
     if analyse:
         report("analysing", n_kept)
-        result = analyse_measurement(recording, effects=default_effects(serial) if effects is None else effects,
-                                     cancel=cancel)
+        result = analyze_recording(recording, effects=effects, cancel=cancel)
     report("done", n_kept)
     return dataclasses.replace(outcome, result=result)
-
-
-def default_effects(serial_laser: bool) -> tuple:
-    """The analysis' default model; with the serial laser also `delay-x`: the alignment leaves a delay of
-    some tens of microseconds (clocks.py), which the joint fit would otherwise spread over the driver's
-    parameters (Hx is known to ~1e-5, and 30 us is 0.2 degrees at 20 Hz, 11 degrees at 1 kHz)."""
-    from analysis.effects import DEFAULT_EFFECTS, get_effect
-    ids = DEFAULT_EFFECTS + (("delay-x",) if serial_laser else ())
-    return tuple(get_effect(i) for i in ids)
 
 
 class _Reporter:
@@ -384,7 +374,7 @@ def _recording(captured: CapturedSignals, aligned: AlignedDisplacement | None, n
         "capture": capture_info, "audio_capture": stats.as_dict(),
         "measurement": {"plan": plan.as_json(), "partial": ended_by != "complete", "ended_by": ended_by,
                         "message": message, "periods": n, "audio": audio.describe(),
-                        "displacement_source": "serial laser" if serial else (
+                        "displacement_source": SERIAL_LASER if serial else (
                             "sound card (laser analog)" if "displacement" in signals else "none"),
                         "laser": laser_info},
     }

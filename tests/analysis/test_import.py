@@ -150,6 +150,10 @@ BAD_FILES = [
     ("binary", "10 7 1\n\x00\x01", 2, "binary"),
     ("too many columns", "10 7 1 2 3\n", 1, "expected 2 or 3"),
     ("dB magnitude", "Freq(Hz) SPL(dB) Phase(deg)\n" + GOOD, 1, "dB"),
+    ("U/I/V spectra", "f_Hz,U_re,U_im,I_re,I_im,V_re,V_im\n10,1,0,0.1,0,0.01,0\n", 1,
+     "are all real: expected one; the header names voltage, current and laser spectra: read it as U/I/V spectra "
+     "(linpar analyze --uiv FILE"),
+    ("two real parts", "f,Z_re,Z_im,Y_re\n10,7,1,0.1\n", 1, "are all real: expected one"),
 ]
 
 

@@ -51,6 +51,12 @@ def test_customary_and_si_units_give_the_same_verdict(tmp_path):
     assert verdicts(tmp_path, Qts={"nominal": 0.46, "tolerance": "5%", "unit": "-"})[0] == "pass"
 
 
+def test_a_parameter_may_be_named_as_the_window_shows_it(tmp_path):
+    # The window's table and the reports say Re and Le; a user copies the name from there.
+    assert verdicts(tmp_path, Re={"nominal": 3.0, "tolerance": "1%", "unit": "ohm"}) == ("pass", {"RE": True})
+    assert verdicts(tmp_path, Le={"max": 0.13, "unit": "mH"}) == ("fail", {"LE": False})
+
+
 def test_overall_fails_when_any_fails_and_missing_parameters_fail(tmp_path):
     verdict, each = verdicts(tmp_path, RE={"nominal": 3.0, "tolerance": "5%", "unit": "ohm"},
                              Bl={"min": 5, "unit": "T*m"})
@@ -67,7 +73,10 @@ BAD = [
     (limits_doc(), r"parameters: expected an object"),
     ({"format": "other", "parameters": {}}, r"line 2: format: found 'other', expected 'linpar-limits/1'"),
     (limits_doc(XYZ={"min": 1, "unit": "ohm"}), r"line \d+: parameters.XYZ: unknown parameter"),
-    (limits_doc(RE={"min": 1}), r"parameters.RE.unit: found None, expected 'ohm'"),
+    (limits_doc(RE={"min": 1}), r"parameters.RE.unit: found None, expected 'ohm'$"),
+    (limits_doc(RE={"min": 1, "unit": "mohm"}), r"parameters.RE.unit: found 'mohm', expected 'ohm'$"),
+    (limits_doc(RE={"min": 1, "unit": "ohm"}, Re={"min": 2, "unit": "ohm"}),
+     r"parameters.Re: the same parameter as 'RE': give its limits once"),
     (limits_doc(Mms={"min": 1, "unit": "lb"}), r"parameters.Mms.unit: found 'lb', expected 'kg' \(SI\) or 'g'"),
     (limits_doc(RE={"nominal": 3, "unit": "ohm"}), r"parameters.RE.tolerance: missing"),
     (limits_doc(RE={"nominal": 3, "tolerance": "five", "unit": "ohm"}), r"parameters.RE.tolerance: found 'five'"),

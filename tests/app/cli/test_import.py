@@ -119,3 +119,27 @@ def test_stats_over_repeated_recordings(capsys, tmp_path):
     assert bl["n"] == 3 and bl["mean"] == pytest.approx(PAPER.parameters["Bl"], rel=1e-2) and bl["percent"] < 1
     code, out, _ = run(capsys, "stats", *paths)
     assert code == 0 and "3 results" in out
+
+
+def test_stats_leave_a_red_recording_out_and_say_so(capsys, tmp_path):
+    """A broken measurement (its laser mounted the wrong way round: red) is no repeat: averaged in, its numbers
+    read as a spread of tens of percent."""
+    paths = []
+    for seed, bl_sign in ((0, 1), (1, 1), (2, -1)):
+        path = tmp_path / f"rep{seed}"
+        values = {**PAPER.parameters, "Bl": bl_sign * PAPER.parameters["Bl"]}
+        write_recording(path, recording(values, noise=TYPICAL_NOISE, n_periods=4, seed=seed))
+        paths.append(str(path) + ".wav")
+    code, out, err = run(capsys, "stats", *paths, "--json")
+    assert code == 0, err
+    doc = json.loads(out)
+    assert doc["n_results"] == 2 and doc["files"] == paths[:2]
+    (left_out,) = doc["left_out"]
+    assert left_out["file"] == paths[2] and "validity red" in left_out["why"] and "laser-sign" in left_out["why"]
+    assert f"{paths[2]} left out: validity red" in err and "measure it again" in err
+    bl = doc["parameters"]["Bl"]
+    assert bl["n"] == 2 and bl["mean"] == pytest.approx(PAPER.parameters["Bl"], rel=1e-2) and bl["percent"] < 1
+    code, out, _ = run(capsys, "stats", *paths)
+    assert code == 0 and "2 results" in out and f"left out (red): 1 of 3: {paths[2]}" in out
+    code, _, err = run(capsys, "stats", paths[2])
+    assert code == 2 and "none of the 1 recordings is valid" in err

@@ -18,12 +18,13 @@ import pytest
 
 from analysis.drivers import load_driver
 from analysis.multitone import design_multitone
+from analysis.pipeline import analyze_recording
 from analysis.recording.format import make_recording
+from analysis.serial_laser import DISPLACEMENT_MAX_KEY
 from analysis.synthesis import steady_state_period
 from instruments.laser.sensor import LaserBlock
 from instruments.measurement import alignment
 from instruments.measurement.alignment import align_laser, stream_of_blocks
-from instruments.measurement.analysis_step import DISPLACEMENT_MAX_KEY, analyse_measurement
 
 PAPER = load_driver("paper")
 FS, P, RATE, PPM = 48000, 16384, 4000.0, 25.0
@@ -96,10 +97,7 @@ class Bench:
         recording = make_recording(FS, {"voltage": self.u, "current": self.i, "displacement": aligned.displacement},
                                    P, 0, tuple(int(b) for b in self.mt.excited_bins), {"sd_m2": PAPER.sd_m2},
                                    {"capture": capture, DISPLACEMENT_MAX_KEY: aligned.max_hz})
-        effects = None
-        from instruments.measurement.runner import default_effects
-        effects = default_effects(serial_laser=True)
-        return analyse_measurement(recording, effects=effects), capture
+        return analyze_recording(recording), capture      # a serial laser's: delay-x in its default model
 
 
 @pytest.fixture(scope="module")
