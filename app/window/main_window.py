@@ -188,9 +188,9 @@ class MainWindow(QMainWindow):
         self._started_at = time.monotonic()
         self.status_label.setText("")
         self.jobs.run(self.worker.start_curves(request), f"Analysing {request.name}…", self.on_finished,
-                      lambda message: self.on_failed(request.impedance, message), self.on_cancelled)
+                      lambda message: self.on_failed(request.path, message), self.on_cancelled)
         self.pages.setCurrentWidget(self.results)
-        self.analysis_started.emit(str(request.impedance))
+        self.analysis_started.emit(str(request.path))
 
     def on_finished(self, outcome: AnalysisOutcome) -> None:
         elapsed = time.monotonic() - self._started_at
