@@ -31,7 +31,7 @@ station QA3 reading high, its control chart with the alarms flagged
 (--only production: just these two).
 --only model-part: the Results page of a realistic woofer while its model part is estimated and after, and
 its report's first page, at both sizes (tools/screenshots_model_part.py).
---only curves: the Results page on a Klippel LPM export with the export's own fit overlaid, at both sizes
+--only curves: the Results page on a Klippel LPM export with the export's own fit overlaid, and the QA page on it, at both sizes
 (tools/screenshots_curves.py).
 --only verdicts: the Results page and QA's PASS, UNCERTAIN, FAIL and INVALID at both sizes
 (tools/screenshots_verdicts.py).

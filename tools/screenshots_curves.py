@@ -5,8 +5,9 @@
 
 Writes results-lpm-overlay-z-<W>x<H>.png and results-lpm-overlay-hx-<W>x<H>.png: the 6.5" mid-woofer's |Z| and
 |Hx| of tests/lpm_exports.py (a realistic driver, magnitude only, noisy), linpar's fit and the export's "Fitted"
-curve as a dashed third line, the comparison of the two fits above, once the model part is estimated; and
-open-curves-dialog.png, the dialog with the two files chosen.
+curve as a dashed third line, the comparison of the two fits above, once the model part is estimated;
+qa-imported-curves-<W>x<H>.png, the QA page on them (no signal, noise or distortion checks: judged by their fit);
+and open-curves-dialog.png, the dialog with the two files chosen.
 """
 from __future__ import annotations
 
@@ -42,4 +43,7 @@ def curves_screenshots(app: QApplication, window, folder: Path, out: Path) -> li
         tabs.setCurrentIndex(index)
         written += grab_small_and_large(app, window, out, stem)
     tabs.setCurrentIndex(0)
+    window.pages.setCurrentWidget(window.qa)
+    written += grab_small_and_large(app, window, out, "qa-imported-curves")
+    window.pages.setCurrentWidget(window.results)
     return written

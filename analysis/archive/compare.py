@@ -35,11 +35,13 @@ class ComparisonRow:
 @dataclass(frozen=True)
 class Comparison:
     ids: tuple[str, ...]
-    labels: tuple[str, ...]               # driver and serial, for column headings
+    labels: tuple[str, ...]               # driver and serial (else the id), for column headings
     rows: tuple[ComparisonRow, ...]
+    measured_at: tuple[str, ...] = ()     # ISO 8601 UTC, one per measurement
 
     def as_json(self) -> dict:
-        return {"ids": list(self.ids), "labels": list(self.labels), "rows": [r.as_json() for r in self.rows]}
+        return {"ids": list(self.ids), "labels": list(self.labels), "measured_at": list(self.measured_at),
+                "rows": [r.as_json() for r in self.rows]}
 
 
 def _finite(x: float) -> float | None:
@@ -75,4 +77,5 @@ def compare(archive, ids) -> Comparison:
                     for v in values)
         rows.append(ComparisonRow(name, ref.display_unit, tuple(values), tuple(stds), mean, spread, dev))
     labels = tuple(" ".join(x for x in (m.entry.driver, m.entry.serial) if x) or m.id for m in measurements)
-    return Comparison(tuple(m.id for m in measurements), labels, tuple(rows))
+    return Comparison(tuple(m.id for m in measurements), labels, tuple(rows),
+                      tuple(m.entry.measured_at for m in measurements))

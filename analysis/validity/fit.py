@@ -19,7 +19,8 @@ the measurement's analysis step, the GUI), in three steps:
    PASS, not a FAIL (the unit was not judged; production yield leaves it
    out), with the honest reason and what to do: measure again. One whose
    fit error (analysis.fit.error, the rms misfit in % of a curve) exceeds
-   the limits file's tolerance is NOT JUDGED, with that reason. A model-misfit
+   the limits file's tolerance is NOT JUDGED, with that reason (imported curves': what to check in the file,
+   CURVES_MISFIT_REMEDY, as they have no wiring nor channels' findings). A model-misfit
    finding (reduced chi^2 far above 1) alone does not block QA: a real driver
    measured with little noise always has one, at a fit error of a few %.
    Neither blocked case is judged against the limits parameter by parameter.
@@ -57,6 +58,11 @@ VERDICT_HEADLINES = {PASS: "PASS", FAIL: "FAIL", UNCERTAIN: "UNCERTAIN: measure 
 STORED_VERDICT = {UNCERTAIN: NOT_JUDGED}
 MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar diagnose') and fit again; if no effect "
                  "helps, check the wiring and the channels' findings")
+# Imported curves (validity.imported) have no wiring and no channels' findings, and the Model lab works on recordings
+# only: what is left to look at is the file.
+CURVES_MISFIT_REMEDY = ("find the effect the model lacks ('linpar diagnose' on the same files) and fit again with it; "
+                        "if no effect helps, check what the file holds: a band from well below fs, the phase in the "
+                        "unit it was read in, the measured (not a fitted) curve")
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,6 +156,9 @@ def qa_blocker(validity: ResultValidity, tolerance: Mapping[str, float] | None =
         if not over:
             return None
         said = "; ".join(f"the {name} by {err:.3g} % rms (tolerance {limit:g} %)" for name, err, limit in over)
+        if validity.imported is not None:
+            return NOT_JUDGED, (f"the model does not describe these curves: it misses {said}; its parameters "
+                                f"judge nothing; {CURVES_MISFIT_REMEDY}")
         return NOT_JUDGED, (f"the model does not describe this measurement: it misses {said}; its parameters "
                             f"judge nothing; {MISFIT_REMEDY}")
     for finding in validity.findings:

@@ -40,7 +40,9 @@ def _row_order(row) -> int:
 
 
 def column_label(number: int, label: str, date: str) -> str:
-    return f"{number}. {label}\n{date_text(date)[:16]}"
+    """"2. W18-PAPER 0033" over its date to the second (plain text): the number tells two measurements of one
+    driver apart, the date which was measured when, even two in one minute; the tooltip has the id."""
+    return f"{number}. {label}\n{date_text(date)}"
 
 
 class OverlayPlot(pg.GraphicsLayoutWidget):
@@ -89,7 +91,8 @@ class OverlayPlot(pg.GraphicsLayoutWidget):
                 self.plot_of(channel).addItem(item)
                 self.items[channel].append(item)
                 if not named:            # one entry per measurement, with or without its Hx
-                    self.legend.addItem(item, label)
+                    # pyqtgraph draws a legend's names as HTML: a driver named "<b>" is text, not markup.
+                    self.legend.addItem(item, html.escape(label))
                     named = True
         for channel, _ in CHANNELS:
             self.plot_of(channel).enableAutoRange()
@@ -122,7 +125,7 @@ class ComparisonTable(QTableWidget):
             item = QTableWidgetItem(text)
             if col < n:
                 item.setForeground(QBrush(QColor(PALETTE[col % len(PALETTE)])))
-                item.setToolTip(comparison.ids[col])
+                item.setToolTip(f"{comparison.ids[col]}: {comparison.labels[col]}, measured {date_text(dates[col])}")
             else:
                 item.setToolTip("The standard deviation of the values between the measurements, to set against "
                                 "each one's own ±1σ: larger means the drivers differ, not only the measurements")

@@ -15,6 +15,8 @@ from app.cli.options import (SERIAL_LASER_MODEL, add_json_option, add_model_opti
                              name_text, number)
 from app.cli.output import print_json
 
+COMPARE_HEADING_MAX = 24        # eight columns of this width and the spread fit in about 240 characters
+
 LIST_PARAMETERS = (("RE", "ohm", 1.0), ("fs", "Hz", 1.0), ("Bl", "T*m", 1.0), ("Mms", "g", 1e3), ("Qts", "", 1.0))
 
 
@@ -155,16 +157,28 @@ def _store(archive, args) -> int:
     return 0
 
 
+def _heading(text: str, width: int) -> str:
+    return text if len(text) < width else text[:width - 2] + "…"
+
+
 def _compare(archive, args) -> int:
     from analysis.archive import compare
     from analysis.report.numbers import format_number, pretty_unit
+    from analysis.text_boundary import terminal
     c = compare(archive, args.ids)
     say_notes(archive)
     if args.json:
         print_json(c.as_json())
         return 0
-    width = 14
-    print(f"{'parameter':<14}{'unit':<8}" + "".join(f"{label[:width - 1]:>{width}}" for label in c.labels)
+    # Which measurement each column is: two of one driver have the same name (and a serial measured twice
+    # the same serial), so the columns are numbered, and the numbers said first with their ids and dates.
+    labels = [terminal(label) for label in c.labels]
+    for number, (mid, when, label) in enumerate(zip(c.ids, c.measured_at, labels), 1):
+        print(f"{number}. {mid}  measured {when.replace('T', ' ').removesuffix('Z')} UTC  {label}")
+    print()
+    headings = [f"{number}. {label}" for number, label in enumerate(labels, 1)]
+    width = max(14, min(COMPARE_HEADING_MAX, max(len(h) for h in headings) + 2))
+    print(f"{'parameter':<14}{'unit':<8}" + "".join(f"{_heading(h, width):>{width}}" for h in headings)
           + f"{'spread':>{width}}")
     for row in c.rows:
         cells = "".join(f"{format_number(v, s) if v is not None else 'n/a':>{width}}" for v, s in zip(row.values, row.stds))

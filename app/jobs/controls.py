@@ -14,17 +14,21 @@ from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QProgressBar, QPushButton, QSizePolicy, QWidget
 
 from app.jobs.book import Job, JobRunner
+from app.widgets.elided_label import ElidedLabel
 from app.widgets.layout_room import keep_room_when_hidden
 
 
 TEXT_LINES = 2
+ONE_LINE_MIN_CHARS = 30
 
 
 class JobControls(QWidget):
     busy_changed = Signal(bool)
 
     def __init__(self, runner: JobRunner, parent=None, cancel_tip: str = "Stop this job; nothing it has measured so "
-                                                                          "far is kept", bar_width: int = 220):
+                                                                          "far is kept", bar_width: int = 220,
+                 one_line: bool = False):
+        """one_line: what is being done on one line, cut with "…" (the status bar's room), not on TEXT_LINES."""
         super().__init__(parent)
         self.runner = runner
         self.job: Job | None = None
@@ -33,14 +37,20 @@ class JobControls(QWidget):
         self.progress.setTextVisible(False)
         self.progress.setMaximumWidth(bar_width)
         self.progress.setMinimumWidth(40)       # it shrinks before its page sets the window's minimum width
-        self.text = QLabel()
-        self.text.setWordWrap(True)
-        # Always TEXT_LINES tall, whatever it says: a text that wrapped to one line more or less than the one
+        if one_line:
+            self.text = ElidedLabel()
+            # Its start stays readable when the row is short of room (a long path beside it in the status bar).
+            self.text.setMinimumWidth(ONE_LINE_MIN_CHARS * self.text.fontMetrics().averageCharWidth())
+        else:
+            self.text = QLabel()
+            self.text.setWordWrap(True)
+            self.text.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Fixed)
+        # Always as tall, whatever it says: a text that wrapped to one line more or less than the one
         # before changed the row's height and so resized every plot below it, and pyqtgraph laid them out
         # and redrew them all in one go (the Model lab's diagnosis: 65 ms of the GUI thread's CPU per change).
         # A longer text is cut; the whole of it is the tooltip.
-        self.text.setSizePolicy(QSizePolicy.Preferred, QSizePolicy.Fixed)
-        self.text.setFixedHeight(TEXT_LINES * self.text.fontMetrics().lineSpacing() + 2)
+        lines = 1 if one_line else TEXT_LINES
+        self.text.setFixedHeight(lines * self.text.fontMetrics().lineSpacing() + 2)
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.setToolTip(cancel_tip)
         self.cancel_button.clicked.connect(self.on_cancel)

@@ -59,5 +59,5 @@ class AnalysisWorker(JobRunner):
 
         def work(job: Job) -> AnalysisOutcome:
             result = analyse_curves(job, request)
-            return AnalysisOutcome(job.id, request.impedance, result, result_curves(result))
+            return AnalysisOutcome(job.id, request.path, result, result_curves(result))
         return self.run("analysis", work, f"analysing {request.name}")

@@ -12,7 +12,7 @@ import html
 
 from PySide6.QtCore import QEvent, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont
-from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QLabel, QPushButton, QSizePolicy,
+from PySide6.QtWidgets import (QAbstractItemView, QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
                                QSplitter, QTextBrowser, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget)
 
 from analysis.effects import Effect, categories, registry
@@ -102,7 +102,13 @@ class EffectCatalogue(QWidget):
         self.tree.setRootIsDecorated(False)
         self.tree.setItemsExpandable(False)
         self.tree.setIndentation(10)
-        self.tree.header().setStretchLastSection(True)
+        # The title takes the room the ids leave, down to a few letters, cut with "…" (its tooltip and the pane
+        # below have it whole): stretched as the last section it kept a width of 100 px, wider than the room on
+        # a 1280 px screen, and hid its end behind a horizontal scroll bar.
+        self.tree.header().setStretchLastSection(False)
+        self.tree.header().setSectionResizeMode(1, QHeaderView.Stretch)
+        self.tree.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.tree.setTextElideMode(Qt.ElideRight)
         self.tree.viewport().installEventFilter(self)
         self._bold = QFont()
         self._bold.setBold(True)

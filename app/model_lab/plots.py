@@ -209,8 +209,12 @@ class ChiSquareChart(QWidget):
         plot.setLabel("left", "reduced χ²")
         plot.setLabel("bottom", "model version")
         plot.setMenuEnabled(False)
-        plot.setTitle("Reduced χ² per channel: 1 is the noise floor", size="9pt")
-        plot.addLegend(offset=(-10, 10))
+        # The channels' colours in the title, not in a legend over the plot: wherever a legend sat, the noise
+        # floor's label met it for some range of chi^2 (at 1280x720 "Hx" lay over "noise floor" when the last
+        # versions neared 1). Short, as the residual plots' titles: a wider title would set the chart's minimum width.
+        swatches = " ".join(f"<span style='color:{CHANNEL_COLOURS[c]}'>●</span> {CHANNEL_SHORT[c]}"
+                            for c in CHANNEL_COLOURS)
+        plot.setTitle(f"Reduced χ²: {swatches}; 1 is the noise floor", size="9pt")
         # In log mode an InfiniteLine sits in view coordinates: log10(1) = 0.
         self.floor = pg.InfiniteLine(pos=0.0, angle=0, movable=False,
                                      pen=pg.mkPen(NOISE_FLOOR_COLOUR, width=2, style=Qt.DashLine),

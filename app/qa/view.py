@@ -26,6 +26,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QFileDialog, QGroupBox, QHBoxL
 
 from analysis.pipeline import AnalysisResult
 from analysis.validity.result import ResultValidity
+from app.qa import imported_words
 from app.results.fit_quality import model_words
 from app.jobs.book import Job, JobRunner
 from app.jobs.controls import JobControls
@@ -67,7 +68,8 @@ def qa_verdict(validity: ResultValidity | str) -> tuple[str, str]:
     blocker = qa_blocker(validity)
     if blocker is not None:
         return blocker
-    return "none", "no limits loaded: only the measurement's validity is judged"
+    return "none", imported_words.NO_LIMITS if imported_words.imported(validity) else \
+        "no limits loaded: only the measurement's validity is judged"
 
 
 def write_report_file(job: Job, result: AnalysisResult, path: Path, limits) -> str:
@@ -134,6 +136,8 @@ class QAView(QWidget):
         self.verdict_label.setWordWrap(True)
         self.verdict_label.setMargin(10)
         self.channels = {name: ChannelLight(name, 20) for name in CHANNELS}
+        self.no_channels = QLabel(imported_words.NO_CHANNELS)      # in their place for imported curves
+        self.no_channels.setWordWrap(True)
 
         self.load_button = QPushButton("Load limits…")
         self.limits_label = QLabel()
@@ -172,6 +176,7 @@ class QAView(QWidget):
         channel_layout = QVBoxLayout(channel_box)
         for light in self.channels.values():
             channel_layout.addWidget(light)
+        channel_layout.addWidget(self.no_channels)
         left.addWidget(channel_box)
         left.addStretch(1)
 
@@ -231,9 +236,15 @@ class QAView(QWidget):
         self.overall_light.set_status(overall)
         from app.widgets.style import VALIDITY_TEXT
         from app.widgets.traffic_light import STATE_WORDS
-        self.overall_text.setText(f"<h2>Measurement {html.escape(STATE_WORDS.get(overall, overall))}</h2>"
-                                  f"{html.escape(VALIDITY_TEXT.get(overall, ''))}")
+        curves = imported_words.imported(validity)
+        if curves and overall != "red":     # red: the curve is no driver's, said as a measurement's red
+            headline, meaning = imported_words.HEADLINE, imported_words.JUDGED_BY
+        else:
+            headline, meaning = f"Measurement {STATE_WORDS.get(overall, overall)}", VALIDITY_TEXT.get(overall, "")
+        self.overall_text.setText(f"<h2>{html.escape(headline)}</h2>{html.escape(meaning)}")
+        self.no_channels.setVisible(curves)
         for name, light in self.channels.items():
+            light.setVisible(not curves)
             entry = validity.channels.get(name)
             light.set_state(("unknown" if result is None else "absent") if entry is None else
                             str(entry.status or "unknown"), () if entry is None else entry.findings)

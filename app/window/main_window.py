@@ -5,12 +5,13 @@ import dataclasses
 import time
 from pathlib import Path
 
-from PySide6.QtCore import Qt, Signal, Slot
-from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox, QTabWidget
+from PySide6.QtCore import Signal, Slot
+from PySide6.QtWidgets import QFileDialog, QMainWindow, QMessageBox, QTabWidget
 
 from app.widgets import style
 from app.archive.page import ArchivePage
 from app.jobs.controls import JobControls
+from app.widgets.elided_label import ElidedLabel
 from app.large_signal.page import LargeSignalPage
 from app.window.menus import Menus
 from app.window.page_settle import settle_on_switch
@@ -125,12 +126,13 @@ class MainWindow(QMainWindow):
 
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
-        self.status_label = QLabel("No recording loaded")
-        self.status_label.setTextFormat(Qt.PlainText)      # it shows file names: a name is never markup
+        # One line each, cut with "…" and whole in the tooltip: the bar has room for no second line, and a
+        # long path must not widen the window.
+        self.status_label = ElidedLabel("No recording loaded")
         bar.addWidget(self.status_label, 1)
         # The analysis of an opened recording: its stage, a busy indicator and Cancel.
         self.jobs = JobControls(self.worker, cancel_tip="Stop the analysis; the results shown so far stay",
-                                bar_width=160)
+                                bar_width=160, one_line=True)
         self.jobs.busy_changed.connect(lambda busy: self.results.set_busy(self.jobs.text.text()) if busy
                                        else self.results.set_idle())
         bar.addPermanentWidget(self.jobs)
@@ -188,9 +190,9 @@ class MainWindow(QMainWindow):
         self._started_at = time.monotonic()
         self.status_label.setText("")
         self.jobs.run(self.worker.start_curves(request), f"Analysing {request.name}…", self.on_finished,
-                      lambda message: self.on_failed(request.impedance, message), self.on_cancelled)
+                      lambda message: self.on_failed(request.path, message), self.on_cancelled)
         self.pages.setCurrentWidget(self.results)
-        self.analysis_started.emit(str(request.impedance))
+        self.analysis_started.emit(str(request.path))
 
     def on_finished(self, outcome: AnalysisOutcome) -> None:
         elapsed = time.monotonic() - self._started_at

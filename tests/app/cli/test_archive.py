@@ -82,6 +82,22 @@ def test_compare(capsys, root, rec_path):
     assert code == 0 and doc["ids"] == ids and any(r["name"] == "Qts" for r in doc["rows"])
 
 
+def test_compare_heads_each_column_so_that_two_of_one_driver_are_told_apart(capsys, root, rec_path):
+    ids = [store(capsys, rec_path, "--driver", "Paper driver") for _ in range(2)]      # no serial: alike
+    code, out, err = run(capsys, "archive", "compare", *ids)
+    assert code == 0, err
+    lines = out.splitlines()
+    # The legend first: each column's number with its id and date, then the table headed by the numbers.
+    for number, mid in enumerate(ids, 1):
+        said = lines[number - 1]
+        assert said.startswith(f"{number}. {mid}  measured 20") and " UTC  Paper driver" in said
+    header = next(line for line in lines if line.startswith("parameter"))
+    assert "1. Paper driver" in header and "2. Paper driver" in header
+    code, out, _ = run(capsys, "archive", "compare", *ids, "--json")
+    doc = json.loads(out)
+    assert len(doc["measured_at"]) == 2 and all(when.endswith("Z") for when in doc["measured_at"])
+
+
 def test_report_from_path_and_id(capsys, root, rec_path, tmp_path):
     code, out, err = run(capsys, "report", rec_path, "--html", tmp_path / "a.html")
     assert code == 0, err

@@ -1,6 +1,8 @@
-"""The GUI's Open curves… job reads and fits curves as `linpar analyze --impedance` does (both through
-analysis.curves.imported.import_curves): the same lines, the same numbers."""
+"""The GUI's Open curves… job reads and fits curves as `linpar analyze --impedance` (and `--uiv`) does (both
+through analysis.curves.imported.import_curves): the same lines, the same numbers; a file given as the other kind
+is named for what it is (app.jobs.curve_kinds)."""
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -8,8 +10,11 @@ import pytest
 from analysis.effects import parse_effects
 from analysis.model.composed import Model
 from app.cli import main
+from analysis.importers import ImportFormatError
+from app.jobs.curve_kinds import CURVES_CHOICE, UIV_CHOICE, CurvesKindError
 from app.jobs.curves import CurvesRequest, analyse_curves
 from tests.builders import PAPER
+from tests.uiv_files import REAL_UIV, write_uiv_and_zma
 
 # A linearly spaced export (1 Hz steps, as many analyzers write): the CLI thins it to 100 lines per decade.
 FREQS = np.arange(5.0, 5001.0, 1.0)
@@ -52,3 +57,65 @@ def test_the_gui_job_fits_the_thinned_lines_the_cli_fits_and_finds_the_same_numb
     gui_table = {name: p.value for name, p in gui.parameters.items()}
     for name in ("RE", "Bl", "fs", "Mms", "Kms", "Qts"):
         assert gui_table[name] == pytest.approx(cli[name]["value"], rel=1e-9), name
+
+
+# -- U, I and laser spectra (File > Open curves…'s second kind, `linpar analyze --uiv`) -------------------------
+@pytest.fixture(scope="module")
+def uiv_files(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("uiv")
+    write_uiv_and_zma(folder)
+    return folder
+
+
+def _same_as_the_cli(gui, uiv: Path, capsys) -> None:
+    code = main(["analyze", "--uiv", str(uiv), "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    cli = json.loads(out)["parameters"]
+    assert gui.files == (uiv,)
+    for name in ("RE", "Bl", "fs", "Mms", "Kms", "Qts"):
+        assert gui.parameters[name].value == pytest.approx(cli[name]["value"], rel=1e-9), name
+
+
+def test_the_gui_job_fits_uiv_spectra_as_the_cli_does(uiv_files, capsys):
+    request = CurvesRequest(uiv=uiv_files / "uiv.csv")
+    assert request.path == request.uiv and request.name == "uiv.csv"
+    gui = analyse_curves(_Job(), request)
+    assert gui.data.displacement is not None          # Hx from the laser's velocity: Bl and the mechanics
+    assert gui.parameters["Bl"].value == pytest.approx(PAPER.parameters["Bl"], rel=1e-3)
+    _same_as_the_cli(gui, uiv_files / "uiv.csv", capsys)
+
+
+@pytest.mark.skipif(not REAL_UIV.exists(), reason=f"the real U/I/V spectra are kept outside the repository and "
+                                                    f"missing here: {REAL_UIV}")
+def test_the_gui_job_fits_a_real_woofers_uiv_spectra_as_the_cli_does(capsys):
+    _same_as_the_cli(analyse_curves(_Job(), CurvesRequest(uiv=REAL_UIV)), REAL_UIV, capsys)
+
+
+@pytest.mark.parametrize("role", ["impedance", "hx"])
+def test_uiv_spectra_given_as_a_curve_are_named_for_what_they_are(uiv_files, role):
+    uiv = uiv_files / "uiv.csv"
+    request = (CurvesRequest(uiv) if role == "impedance" else CurvesRequest(uiv_files / "z.zma", uiv))
+    with pytest.raises(CurvesKindError) as caught:
+        analyse_curves(_Job(), request)
+    text = str(caught.value)
+    assert text.startswith("uiv.csv holds complex U, I and laser spectra (f_Hz, U_re, U_im, I_re, I_im, V_re, V_im)")
+    assert f"not {'an impedance' if role == 'impedance' else 'an Hx'} curve" in text
+    assert f"choose “{UIV_CHOICE}”" in text and "--uiv" not in text and "\n" not in text
+
+
+def test_an_impedance_curve_given_as_uiv_spectra_is_named_for_what_it_is(uiv_files):
+    with pytest.raises(CurvesKindError) as caught:
+        analyse_curves(_Job(), CurvesRequest(uiv=uiv_files / "z.zma"))
+    text = str(caught.value)
+    assert text.startswith("z.zma holds an impedance curve, not complex U, I and laser spectra")
+    assert f"choose “{CURVES_CHOICE}” and give it as the impedance" in text and "\n" not in text
+
+
+def test_a_file_of_neither_kind_keeps_the_importers_line(tmp_path):
+    bad = tmp_path / "notes.csv"
+    bad.write_text("f_Hz,colour\n10,red\n")
+    for request in (CurvesRequest(bad), CurvesRequest(uiv=bad)):
+        with pytest.raises(ImportFormatError) as caught:
+            analyse_curves(_Job(), request)
+        assert not isinstance(caught.value, CurvesKindError) and "notes.csv" in str(caught.value)
