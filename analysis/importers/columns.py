@@ -111,7 +111,7 @@ def _uiv_hint(names: list[str]) -> str:
     signals = {name.strip().lower()[:1] for name in names}
     if {"u", "i"} <= signals and signals & {"v", "x"}:
         return ("; the header names voltage, current and laser spectra: read it as U/I/V spectra "
-                "(linpar analyze --uiv FILE, or the window's File > Open curves…)")
+                "(linpar analyze --uiv FILE; in the window, File > Open curves…, 'U, I and laser spectra')")
     return ""
 
 
