@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import os
 import sys
 from importlib import import_module
 from typing import Sequence
@@ -13,8 +14,9 @@ from analysis.text_boundary import SURROGATES, control_found, shown, terminal
 from app.cli import effects
 from app.cli.options import CliError, Parser, size_limit
 
-# 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected".
-EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED = 0, 2, 70, 130
+# 70: EX_SOFTWARE of sysexits.h, "an internal software error has been detected". 141: what a shell reports for a
+# program ended by SIGPIPE (128 + 13), as `yes | head` ends `yes`.
+EXIT_OK, EXIT_ERROR, EXIT_INTERNAL, EXIT_INTERRUPTED, EXIT_BROKEN_PIPE = 0, 2, 70, 130, 141
 
 # Each command and the module of app/cli that registers it, in the order `linpar --help` lists them. A command
 # line that names its command builds that module's parser only: building all fourteen imported what every
@@ -117,6 +119,11 @@ def _run(argv: Sequence[str] | None, ran: list[str]) -> int:
     except KeyboardInterrupt:
         print("linpar: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # The reader went away (`linpar archive list | head`): nothing is wrong, and nothing more reaches it. Not
+        # "linpar: error: Broken pipe"; and the interpreter, flushing stdout at exit, would complain once more.
+        _stdout_to_devnull()
+        return EXIT_BROKEN_PIPE
     except Exception as exc:  # noqa: BLE001 - the boundary: a user error is one line, anything else a bug
         if is_user_error(exc):
             print(f"linpar: error: {terminal(user_message(exc))}", file=sys.stderr)
@@ -124,6 +131,16 @@ def _run(argv: Sequence[str] | None, ran: list[str]) -> int:
         from app.crash_report import internal_error_line
         print(f"linpar: {internal_error_line(exc, argv=argv)}", file=sys.stderr)
         return EXIT_INTERNAL
+
+
+def _stdout_to_devnull() -> None:
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):     # a stream of the caller's (a test's capture): nothing to do
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, fd)
+    os.close(devnull)
 
 
 if __name__ == "__main__":  # pragma: no cover

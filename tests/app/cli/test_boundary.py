@@ -3,11 +3,18 @@ command groups register, and a command line that names no command plainly still 
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
 from app.cli.boundary import COMMAND_GROUPS, COMMANDS, build_parser, command_group, command_named, main
 from app.cli.options import Parser
+from tests.pace import paced
+
+REPO = Path(__file__).resolve().parents[3]
 
 
 def registered_by(module: str) -> list[str]:
@@ -75,3 +82,16 @@ def test_only_the_processs_own_command_line_freezes_its_objects_for_the_exit(mon
         monkeypatch.setattr("sys.argv", ["linpar", *shape])     # argparse's abbreviation: the window all the same
         assert main() == 0
         assert frozen == [True], shape
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly():
+    """`linpar archive list | head`: the pipe's reader leaves early. Not "linpar: error: Broken pipe", nor the
+    interpreter's complaint at exit: the command ends as a shell reports SIGPIPE (141), stderr empty."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)                        # gone before the command writes anything: every write fails
+    try:
+        done = subprocess.run([sys.executable, "-m", "app.cli", "effects"], stdout=write_end,
+                              stderr=subprocess.PIPE, text=True, timeout=paced(60), cwd=REPO)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 141 and done.stderr == ""
