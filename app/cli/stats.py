@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import argparse
 
-from app.cli.options import SERIAL_LASER_MODEL, add_json_option, add_model_option, add_sd_option, model_effects
-from app.cli.options import CliError
+from app.cli.options import (SERIAL_LASER_MODEL, CliError, add_json_option, add_model_option, add_sd_option,
+                             model_effects)
 from app.cli.output import print_json, say
 
 
