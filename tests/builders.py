@@ -65,3 +65,14 @@ def pdf_text(pdf) -> str:
     """The text of a PDF as pdftotext lays it out (poppler-utils)."""
     return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], check=True, capture_output=True,
                           text=True).stdout
+
+
+class QuietJob:
+    """What a job's work function uses of app.jobs.book.Job, for calling it outside a job: it says nothing and is
+    never cancelled."""
+
+    def say(self, text: str) -> None:
+        pass
+
+    def check(self) -> None:
+        pass

@@ -13,21 +13,11 @@ from app.cli import main
 from analysis.importers import ImportFormatError
 from app.jobs.curve_kinds import CURVES_CHOICE, UIV_CHOICE, CurvesKindError
 from app.jobs.curves import CurvesRequest, analyse_curves
-from tests.builders import PAPER
+from tests.builders import PAPER, QuietJob
 from tests.uiv_files import REAL_UIV, write_uiv_and_zma
 
 # A linearly spaced export (1 Hz steps, as many analyzers write): the CLI thins it to 100 lines per decade.
 FREQS = np.arange(5.0, 5001.0, 1.0)
-
-
-class _Job:
-    """What the job's work function uses of app.jobs.book.Job."""
-
-    def say(self, text: str) -> None:
-        pass
-
-    def check(self) -> None:
-        pass
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +34,7 @@ def linear_files(tmp_path_factory):
 
 
 def test_the_gui_job_fits_the_thinned_lines_the_cli_fits_and_finds_the_same_numbers(linear_files, capsys):
-    gui = analyse_curves(_Job(), CurvesRequest(linear_files / "z.txt", linear_files / "hx.txt", True))
+    gui = analyse_curves(QuietJob(), CurvesRequest(linear_files / "z.txt", linear_files / "hx.txt", True))
     code = main(["analyze", "--impedance", str(linear_files / "z.txt"), "--hx", str(linear_files / "hx.txt"),
                  "--mm-per-volt", "--json"])
     out, err = capsys.readouterr()
@@ -80,7 +70,7 @@ def _same_as_the_cli(gui, uiv: Path, capsys) -> None:
 def test_the_gui_job_fits_uiv_spectra_as_the_cli_does(uiv_files, capsys):
     request = CurvesRequest(uiv=uiv_files / "uiv.csv")
     assert request.path == request.uiv and request.name == "uiv.csv"
-    gui = analyse_curves(_Job(), request)
+    gui = analyse_curves(QuietJob(), request)
     assert gui.data.displacement is not None          # Hx from the laser's velocity: Bl and the mechanics
     assert gui.parameters["Bl"].value == pytest.approx(PAPER.parameters["Bl"], rel=1e-3)
     _same_as_the_cli(gui, uiv_files / "uiv.csv", capsys)
@@ -89,7 +79,7 @@ def test_the_gui_job_fits_uiv_spectra_as_the_cli_does(uiv_files, capsys):
 @pytest.mark.skipif(not REAL_UIV.exists(), reason=f"the real U/I/V spectra are kept outside the repository and "
                                                     f"missing here: {REAL_UIV}")
 def test_the_gui_job_fits_a_real_woofers_uiv_spectra_as_the_cli_does(capsys):
-    _same_as_the_cli(analyse_curves(_Job(), CurvesRequest(uiv=REAL_UIV)), REAL_UIV, capsys)
+    _same_as_the_cli(analyse_curves(QuietJob(), CurvesRequest(uiv=REAL_UIV)), REAL_UIV, capsys)
 
 
 @pytest.mark.parametrize("role", ["impedance", "hx"])
@@ -97,7 +87,7 @@ def test_uiv_spectra_given_as_a_curve_are_named_for_what_they_are(uiv_files, rol
     uiv = uiv_files / "uiv.csv"
     request = (CurvesRequest(uiv) if role == "impedance" else CurvesRequest(uiv_files / "z.zma", uiv))
     with pytest.raises(CurvesKindError) as caught:
-        analyse_curves(_Job(), request)
+        analyse_curves(QuietJob(), request)
     text = str(caught.value)
     assert text.startswith("uiv.csv holds complex U, I and laser spectra (f_Hz, U_re, U_im, I_re, I_im, V_re, V_im)")
     assert f"not {'an impedance' if role == 'impedance' else 'an Hx'} curve" in text
@@ -106,7 +96,7 @@ def test_uiv_spectra_given_as_a_curve_are_named_for_what_they_are(uiv_files, rol
 
 def test_an_impedance_curve_given_as_uiv_spectra_is_named_for_what_it_is(uiv_files):
     with pytest.raises(CurvesKindError) as caught:
-        analyse_curves(_Job(), CurvesRequest(uiv=uiv_files / "z.zma"))
+        analyse_curves(QuietJob(), CurvesRequest(uiv=uiv_files / "z.zma"))
     text = str(caught.value)
     assert text.startswith("z.zma holds an impedance curve, not complex U, I and laser spectra")
     assert f"choose “{CURVES_CHOICE}” and give it as the impedance" in text and "\n" not in text
@@ -117,5 +107,5 @@ def test_a_file_of_neither_kind_keeps_the_importers_line(tmp_path):
     bad.write_text("f_Hz,colour\n10,red\n")
     for request in (CurvesRequest(bad), CurvesRequest(uiv=bad)):
         with pytest.raises(ImportFormatError) as caught:
-            analyse_curves(_Job(), request)
+            analyse_curves(QuietJob(), request)
         assert not isinstance(caught.value, CurvesKindError) and "notes.csv" in str(caught.value)

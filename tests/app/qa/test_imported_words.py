@@ -12,7 +12,7 @@ from app.jobs.curves import CurvesRequest, analyse_curves
 from app.qa import imported_words
 from app.qa.view import QAView
 from tests.app.conftest import analysis_wait_ms
-from tests.builders import REAL_DATA
+from tests.builders import REAL_DATA, QuietJob
 from tests.uiv_files import write_uiv_and_zma
 
 SEAS = REAL_DATA / "seas_l16rnx" / "L16RNX_0g_242_27mV.zma"
@@ -20,19 +20,11 @@ RECORDING_WORDS = ("not checked yet", "have not run on this measurement", "wirin
                    "Model lab")
 
 
-class _Job:
-    def say(self, text: str) -> None:
-        pass
-
-    def check(self) -> None:
-        pass
-
-
 @pytest.fixture(scope="module")
 def curves(tmp_path_factory):
     """The paper driver's .zma, fitted as File > Open curves… fits it."""
     _, zma = write_uiv_and_zma(tmp_path_factory.mktemp("zma"))
-    return analyse_curves(_Job(), CurvesRequest(zma))
+    return analyse_curves(QuietJob(), CurvesRequest(zma))
 
 
 def _page_text(page: QAView) -> str:
