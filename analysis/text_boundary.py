@@ -8,6 +8,9 @@ that nothing stored can be refused when read back:
 
 - control characters (C0, DEL, C1: tabs, line breaks, NUL, ESC that starts
   terminal sequences), the Unicode line and paragraph separators;
+- the bidirectional controls (U+200E, U+200F, U+061C, U+202A-U+202E,
+  U+2066-U+2069): a station typed as "st2" + U+202E + "SSAP" read "st2PASS"
+  in a report, beside its verdict;
 - lone UTF-16 surrogates: Python's stand-ins for bytes that were not UTF-8
   (a Latin-1 `--operator $'M\\xfcller'`), which no file or terminal can encode.
 
@@ -32,9 +35,10 @@ from analysis.errors import LinparError
 # 0.2-0.6 ms to compile, and most starts of the command line use SURROGATES alone (its arguments' check).
 _PATTERNS = {
     # The class refused where a name enters and checked wherever a stored one is read.
-    "CONTROL": r"[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]",
+    "CONTROL": r"[\x00-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u061c\u202a-\u202e\u2066-\u2069\ud800-\udfff]",
     # The same, but a line break allowed: a multi-line description (an effect's physics).
-    "CONTROL_BUT_NEWLINE": r"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]",
+    "CONTROL_BUT_NEWLINE": r"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u061c\u202a-\u202e"
+                           r"\u2066-\u2069\ud800-\udfff]",
     # ESC [ ... final byte (CSI), ESC ] ... BEL or ESC \ (OSC), ESC and one byte: what a terminal acts on.
     "_ESCAPE_SEQUENCE": r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x9b[0-?]*[ -/]*[@-~]"
                         r"|\x9d[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?|\x1b[@-_]?",
@@ -62,9 +66,14 @@ class TextError(LinparError, ValueError):
     """A name that may not cross into the archive, a report or a terminal as given; one line."""
 
 
+_BIDI = frozenset("\u200e\u200f\u061c\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+
+
 def _what(char: str) -> str:
     if "\ud800" <= char <= "\udfff":
         return f"the byte {_visible(char)} that is not UTF-8 (set the terminal or file to UTF-8)"
+    if char in _BIDI:
+        return f"the bidirectional control {_visible(char)} (it reorders the text shown after it)"
     return f"the control character {_visible(char)}"
 
 

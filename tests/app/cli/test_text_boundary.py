@@ -21,7 +21,7 @@ from app.cli import main
 from tests.production_helpers import LIMITS, small_measurement, unit
 
 EFFECT = Path(__file__).resolve().parents[3] / "resources" / "effects" / "rms-sqrt-f.toml"
-HOSTILE = ("A\tB", "A\nB", "A\x1b]0;owned\x07B", "A\x85B", "A\u2028B", "A\x00B")
+HOSTILE = ("A\tB", "A\nB", "A\x1b]0;owned\x07B", "A\x85B", "A\u2028B", "A\x00B", "st2\u202eSSAP", "A\u2066B")
 
 
 def run(capsys, *argv):
