@@ -48,11 +48,21 @@ class Capability:
     def yield_fraction(self) -> float | None:
         return None if self.n == 0 or (self.low is None and self.high is None) else self.within / self.n
 
+    def intervals(self) -> dict[str, tuple[float, float] | None]:
+        """Each index's 95 % confidence interval from its n units (analysis.production.capability_interval)."""
+        from analysis.production.capability_interval import centred_interval, spread_interval
+        return {"cp": spread_interval(self.cp, self.n), "cpk": centred_interval(self.cpk, self.n),
+                "pp": spread_interval(self.pp, self.n), "ppk": centred_interval(self.ppk, self.n)}
+
     def as_json(self) -> dict:
+        from analysis.production.capability_interval import too_few
         return {"n": self.n, "mean": self.mean, "sigma_within": self.sigma_within, "sigma_overall": self.sigma_overall,
                 "min": self.minimum, "max": self.maximum, "lsl": self.low, "usl": self.high, "cp": self.cp,
-                "cpk": self.cpk, "pp": self.pp, "ppk": self.ppk, "yield": self.yield_fraction,
-                "within": self.within, "below": self.below, "above": self.above}
+                "cpk": self.cpk, "pp": self.pp, "ppk": self.ppk,
+                # The indices are estimates: their intervals, and why they are no verdict below the minimum count.
+                "intervals_95": {k: list(v) if v is not None else None for k, v in self.intervals().items()},
+                "too_few": too_few(self.n) or None,
+                "yield": self.yield_fraction, "within": self.within, "below": self.below, "above": self.above}
 
 
 def _indices(mean: float, sigma: float | None, low: float | None, high: float | None) -> tuple:

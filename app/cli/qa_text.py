@@ -25,6 +25,11 @@ def _index(value) -> str:
     return text
 
 
+def _index_name(key: str) -> str:
+    """'cpk' -> 'Cpk'."""
+    return key[0].upper() + key[1:]
+
+
 def _unit(unit: str) -> str:
     return "" if unit in ("-", "1") else unit
 
@@ -64,8 +69,27 @@ def stats_text(stats, location: str) -> str:
                      f"{_v(c.minimum, s):>11}{_v(c.maximum, s):>11}  {(p.limit_text or '-')[:21]:<22}"
                      f"{_index(c.cp):>8}{_index(c.cpk):>8}{_index(c.pp):>8}{_index(c.ppk):>8}{yield_text:>8}"
                      f"{alarms:>7}")
-    lines += _alarm_lines(stats) + _station_lines(stats)
+    lines += _estimate_lines(stats) + _alarm_lines(stats) + _station_lines(stats)
     return "\n".join(lines)
+
+
+def _estimate_lines(stats) -> list[str]:
+    """The indices as what they are, estimates: each one's 95 % interval, and, below the minimum count, that they
+    are no verdict (a Cpk of 9,983 from 4 units printed alone read as a capable process)."""
+    from analysis.production.capability_interval import MIN_UNITS, too_few
+    lines = []
+    for p in stats.parameters.values():
+        shown = [(name, interval) for name, interval in p.capability.intervals().items() if interval is not None]
+        if shown:
+            lines.append(f"{p.name:<13}95 % intervals: " + ", ".join(
+                f"{_index_name(name)} {_index(lo)} .. {_index(hi)}" for name, (lo, hi) in shown))
+    if not lines:
+        return []
+    n = min(p.capability.n for p in stats.parameters.values())
+    head = ["", "Cp, Cpk, Pp and Ppk are estimates from the units measured:"]
+    if n < MIN_UNITS:
+        head[1] += f" {too_few(n)}."
+    return head + lines
 
 
 def _alarm_lines(stats) -> list[str]:

@@ -55,6 +55,25 @@ def test_stats_text_and_json(capsys, line):
     assert alarm["measurements"] and all(m in ids for m in alarm["measurements"])
 
 
+def test_the_indices_are_estimates_with_their_intervals_and_no_verdict_below_25_units(capsys, line):
+    root, _, _, _ = line
+    code, out, err = run(capsys, "qa", "stats", "--root", root, "--parameter", "RE", "--until", "2024-05-01T00:30:00Z")
+    assert code == 0, err
+    assert "4 measurement(s)" in out
+    assert "only 4 units: a capability index needs at least 25" in out
+    (row,) = [line for line in out.splitlines() if line.startswith("RE ") and "95 % intervals" in line]
+    assert "Cpk " in row and " .. " in row
+    code, out, err = run(capsys, "qa", "stats", "--root", root, "--parameter", "RE", "--until", "2024-05-01T00:30:00Z",
+                         "--json")
+    (re_,) = json.loads(out)["parameters"]
+    low, high = re_["intervals_95"]["cpk"]
+    assert low < re_["cpk"] < high and high - low > 0.5 * re_["cpk"]     # 4 units say little
+    assert re_["too_few"].startswith("only 4 units")
+    code, out, err = run(capsys, "qa", "stats", "--root", root, "--parameter", "RE", "--json")
+    (re_,) = json.loads(out)["parameters"]
+    assert re_["too_few"] is None and re_["n"] == 120
+
+
 def test_limits_versions_from_golden_units_to_a_new_version(capsys, line, tmp_path):
     root, ids, _, _ = line
     code, out, err = run(capsys, "qa", "golden", "--root", root, "--add", *ids[:12], "--json")
