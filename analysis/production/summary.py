@@ -120,19 +120,22 @@ def _counts(population) -> tuple[np.ndarray, dict, dict, dict]:
 
 
 def first_tests(population) -> tuple[int, int]:
-    """(passed, judged) over each unit's first test: a unit is a driver and serial (in time order, the first
-    measurement of it); a measurement without a serial is a unit of its own. A retest neither adds a pass
-    nor hides the first test's fail."""
+    """(passed, judged) over each unit's first judged test: a unit is a driver and serial (in time order, the
+    first measurement of it that passed or failed); a measurement without a serial is a unit of its own. A
+    retest neither adds a pass nor hides the first test's fail. A test that judged nothing (invalid: a rig
+    fault; not judged) says nothing of the unit: the unit's next test is its first, else a unit measured
+    first with a broken lead and then failing was counted nowhere."""
     seen: set = set()
     passed = judged = 0
     for driver, serial, verdict in zip(population.drivers, population.serials, population.verdicts):
+        if verdict not in ("pass", "fail"):
+            continue
         if serial:
             if (driver, serial) in seen:
                 continue
             seen.add((driver, serial))
-        if verdict in ("pass", "fail"):
-            judged += 1
-            passed += verdict == "pass"
+        judged += 1
+        passed += verdict == "pass"
     return passed, judged
 
 

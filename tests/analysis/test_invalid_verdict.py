@@ -76,3 +76,17 @@ def test_production_yield_leaves_invalid_units_out_and_says_so():
     assert stats.first_pass_yield == pytest.approx(3 / 4)         # 3 pass of 4 judged; the 2 invalid not failed
     assert stats.verdicts[INVALID] == 2
     assert sum(stats.excluded.values()) == 2 and any("invalid" in reason for reason in stats.excluded)
+
+
+def test_a_unit_whose_first_test_was_invalid_is_counted_by_its_first_judged_test():
+    """SN1: broken lead (invalid), then fail; SN2: invalid, then pass; SN3: pass. The invalid tests say nothing of
+    their units: first-pass yield 2 of 3, where the first tests alone counted SN3 only (1 of 1)."""
+    verdicts = (INVALID, "fail", INVALID, "pass", "pass", "pass")
+    serials = ("SN1", "SN1", "SN2", "SN2", "SN3", "SN1")
+    validity = ("red", "green", "red", "green", "green", "green")
+    n = len(verdicts)
+    population = Population(tuple(f"20240501-{i:06d}-abcdef" for i in range(n)),
+                            tuple(f"2024-05-01T00:00:{i:02d}Z" for i in range(n)), ("QA1",) * n, ("W6",) * n,
+                            serials, ("ana",) * n, validity, verdicts, (1,) * n,
+                            {"RE": (3.0,) * n}, {"RE": (0.01,) * n})
+    assert production_stats(population).first_tests == (2, 3)    # SN1's fail, SN2's and SN3's pass; SN1's retest not
