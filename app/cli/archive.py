@@ -149,11 +149,16 @@ def _store(archive, args) -> int:
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)
     say_notes(archive)
     queued = archive.pending > 0
+    from app.cli.stored_verdict import stored_verdict
+    qa, words = (None, "") if queued else stored_verdict(archive, mid, result)
     if args.json:
-        print_json({"id": mid, "validity": str(result.validity.overall), **({"queued": True} if queued else {})})
+        print_json({"id": mid, "validity": str(result.validity.overall), **({"queued": True} if queued else {}),
+                    **({"qa": qa} if qa is not None else {})})
     else:
         print(f"{'queued' if queued else 'stored'} {mid} (validity {result.validity.overall})"
               + (": it waits in this station's queue until the server can be reached" if queued else ""))
+        if words:
+            print(words)
     return 0
 
 

@@ -27,7 +27,8 @@ The measurement is then stored in the measurement archive, a broken one too
 (analysis.archive: ``--archive`` a postgresql:// URL or a folder, or
 ``--archive-root`` a folder; default $LINPAR_ARCHIVE_URL, else $LINPAR_ARCHIVE,
 else the archive folder in the platform's data folder; ``--no-archive``: not stored) and stderr says
-its id; with --json the printed object gets "archive": {"id", "root"} ("root":
+its id; when the archive has limits, the QA verdict it recorded is printed under the result, each
+parameter's line too; with --json the printed object gets "archive": {"id", "root", "qa"} ("root":
 the folder or the server's URL without its password; "queued": true when the
 server could not be reached and the measurement waits in the station's local
 queue, which is sent with the next store or `linpar archive sync`). When
@@ -159,6 +160,7 @@ def run(args: argparse.Namespace) -> int:
     outcome = _with_model_part(outcome)
     archived = None if args.no_archive else _store(args, outcome, plan, measured_at)
     result = outcome.result
+    words = archived.pop("qa_words", "") if archived is not None else ""
     if args.json:
         doc = result.as_json()
         if archived is not None:
@@ -166,6 +168,8 @@ def run(args: argparse.Namespace) -> int:
         print_json(doc)
     else:
         print(result.report())
+        if words:                   # the verdict the archive recorded, under the numbers it judged
+            print("\n" + words)
     return EXIT_NOT_STORED if archived is not None and "error" in archived else 0
 
 
@@ -243,7 +247,9 @@ def _store(args: argparse.Namespace, outcome, plan: MeasurementPlan, measured_at
     judged = "" if outcome.result.fit is not None else f" (judged {outcome.result.validity.overall}: nothing " \
                                                        "could be fitted)"
     say(f"stored in the archive {root} as {mid}{judged}")
-    return {"id": mid, "root": str(root)}
+    from app.cli.stored_verdict import stored_verdict
+    qa, words = stored_verdict(archive, mid, outcome.result)
+    return {"id": mid, "root": str(root), **({"qa": qa, "qa_words": words} if qa is not None else {})}
 
 
 def _store_later(args: argparse.Namespace, outcome, root: str, measured_at: str) -> str:

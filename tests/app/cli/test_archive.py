@@ -57,6 +57,24 @@ def test_store_list_show_rebuild(capsys, root, rec_path):
     assert json.loads(out) == {"indexed": 1, "skipped": []}
 
 
+def test_store_says_the_verdict_the_archive_recorded_against_its_limits(capsys, root, rec_path, tmp_path):
+    """The archive judges a stored unit against its newest limits; the command that stored it says so (it said
+    only "stored ... (validity green)", and the operator never saw a FAIL the line's statistics counted)."""
+    code, out, err = run(capsys, "archive", "store", rec_path)
+    assert code == 0 and "QA:" not in out                     # no limits stored yet: nothing judged it
+    limits = tmp_path / "limits.json"
+    limits.write_text(json.dumps({"format": "linpar-limits/1", "name": "tight RE", "parameters": {
+        "RE": {"nominal": 3.3, "tolerance": "1%", "unit": "ohm"}}}))
+    code, out, err = run(capsys, "qa", "limits", "--store", limits)
+    assert code == 0, err
+    code, out, err = run(capsys, "archive", "store", rec_path, "--json")
+    assert code == 0 and json.loads(out)["qa"] == {"verdict": "fail", "limits_version": 1}
+    code, out, err = run(capsys, "archive", "store", rec_path)
+    assert code == 0 and "QA: FAIL (the archive's limits, version 1: tight RE)" in out
+    (re_line,) = [line for line in out.splitlines() if line.lstrip().startswith("RE")]
+    assert "FAIL" in re_line
+
+
 def test_root_option_overrides_the_environment(capsys, root, rec_path, tmp_path):
     other = tmp_path / "other"
     code, out, err = run(capsys, "archive", "store", rec_path, "--root", other)
