@@ -327,14 +327,17 @@ def judge_result(limits: Limits, parameters: Mapping[str, ParameterValue], valid
 
 def format_verdicts(limits: Limits, parameters: Mapping[str, ParameterValue], validity: ResultValidity | str) -> str:
     """A table for the terminal: each limit in its file's unit, the measured interval, pass, FAIL or uncertain."""
-    from analysis.qa_verdict import judge, outcome_word
+    from analysis.qa_verdict import judge, outcome_word, telling_digits
     judgement = judge(limits, parameters, validity)
     lines = [f"QA limits: {limits.name} ({limits.path}); each parameter judged by value ± {INTERVAL_K:g} σ"]
     for limit, v in zip(limits.limits, judgement.verdicts):
         unit = "" if _unit(limit.unit) == "1" else limit.unit
         shown = "n/a" if v.value is None else f"{v.value / limit.to_si:.5g} {unit}".rstrip()
         if v.interval is not None and v.interval[0] != v.interval[1]:
-            shown += f" ({v.interval[0] / limit.to_si:.4g} .. {v.interval[1] / limit.to_si:.4g})"
+            # As many digits as tell the interval's ends from each other and from the limit's bounds.
+            ends = [x / limit.to_si for x in v.interval]
+            digits = telling_digits(*ends, *(b / limit.to_si for b in (limit.low, limit.high) if b is not None))
+            shown += f" ({ends[0]:.{digits}g} .. {ends[1]:.{digits}g})"
         mark = outcome_word(v, judgement.judged)
         lines.append(f"  {limit.name:<14}{shown:>34}   limit {limit.text:<28} {mark}"
                      + (f"  ({v.note})" if v.note else ""))

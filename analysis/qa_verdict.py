@@ -10,6 +10,8 @@ units.
 """
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from typing import Mapping
 
@@ -58,7 +60,20 @@ def outcome_word(verdict, judged: bool = True) -> str:
 def _straddle_text(verdict) -> str:
     lo, hi = verdict.interval
     scale, unit = verdict.limit.to_si, _unit(verdict)
-    return f"{verdict.limit.name} {lo / scale:.4g} .. {hi / scale:.4g} {unit}".rstrip() + f" across {verdict.limit.text}"
+    bounds = [b / scale for b in (verdict.limit.low, verdict.limit.high) if b is not None]
+    digits = telling_digits(lo / scale, hi / scale, *bounds)
+    return (f"{verdict.limit.name} {lo / scale:.{digits}g} .. {hi / scale:.{digits}g} {unit}".rstrip()
+            + f" across {verdict.limit.text}")
+
+
+def telling_digits(*values: float, least: int = 4, most: int = 12) -> int:
+    """The fewest significant digits (from `least`) that write every two different `values` differently: an
+    interval across a limit was "3.02 .. 3.02 Ω across ≤ 3.02 Ω", the three numbers that decide it the same."""
+    distinct = {v for v in values if math.isfinite(v)}
+    for digits in range(least, most + 1):
+        if len({f"{v:.{digits}g}" for v in distinct}) == len(distinct):
+            return digits
+    return most
 
 
 def judge(limits, parameters: Mapping, validity: ResultValidity | str) -> QAJudgement:
