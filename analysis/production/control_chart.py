@@ -72,6 +72,11 @@ class ControlChart:
     alarms: Sequence[Alarm]         # an AlarmList: each Alarm made when it is read
 
     @property
+    def judges(self) -> bool:
+        """Whether its baseline is long enough to raise alarms (MIN_BASELINE units)."""
+        return self.baseline >= MIN_BASELINE
+
+    @property
     def ucl(self) -> float:
         return self.centre + 3 * self.sigma
 
@@ -89,7 +94,7 @@ class ControlChart:
 
     def as_json(self, ids=None) -> dict:
         return {"baseline": self.baseline, "centre": self.centre, "sigma": self.sigma, "ucl": self.ucl,
-                "lcl": self.lcl, "mr_centre": self.mr_centre, "mr_ucl": self.mr_ucl,
+                "lcl": self.lcl, "mr_centre": self.mr_centre, "mr_ucl": self.mr_ucl, "judges": self.judges,
                 "alarms": [a.as_json(ids) for a in self.alarms]}
 
 
@@ -106,7 +111,10 @@ def control_chart(values, baseline: int = DEFAULT_BASELINE) -> ControlChart | No
         return None
     centre = float(np.mean(x[:b]))
     z = (x - centre) / sigma
-    runs = [r for rule in _ZONE_RULES for r in _zone_alarms(z, rule)] + _jump_alarms(mr, D4_PAIRS * mr_centre)
+    # Limits from fewer than MIN_BASELINE units are too unsure to raise alarms on (8 units gave 6 alarms, each
+    # said to come "about once in 92 units of a stable process"): the points are drawn, no alarm is raised.
+    runs = [] if b < MIN_BASELINE else \
+        [r for rule in _ZONE_RULES for r in _zone_alarms(z, rule)] + _jump_alarms(mr, D4_PAIRS * mr_centre)
     return ControlChart(x, b, centre, sigma, mr, mr_centre, AlarmList(runs))
 
 

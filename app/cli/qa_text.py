@@ -93,6 +93,11 @@ def _estimate_lines(stats) -> list[str]:
 
 
 def _alarm_lines(stats) -> list[str]:
+    short = [p.chart.baseline for p in stats.parameters.values() if p.chart is not None and not p.chart.judges]
+    if short:
+        from analysis.production.control_chart import MIN_BASELINE
+        return ["", f"Control chart: no alarms judged: its centre and sigma would come from {max(short)} units; at "
+                    f"least {MIN_BASELINE} set them"]
     charts = [(p, p.chart) for p in stats.parameters.values() if p.chart is not None and p.chart.alarms]
     if not charts:
         return []

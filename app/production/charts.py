@@ -178,8 +178,8 @@ class ControlChartView(pg.GraphicsLayoutWidget):
                              symbolBrush=ALARM, symbolPen=None)
         # A short title: pyqtgraph makes a title's width the chart's minimum width, and at 1280 px a long one ran
         # the chart, with its limits' labels, past the window's edge.
-        self.individuals.setTitle(f"{display_name(p.name)}: {len(chart.alarms)} alarm(s); centre, σ of units "
-                                  f"1–{chart.baseline}")
+        said = f"{len(chart.alarms)} alarm(s)" if chart.judges else "no alarms below 10 units"
+        self.individuals.setTitle(f"{display_name(p.name)}: {said}; centre, σ of units 1–{chart.baseline}")
 
 
 class HistogramView(pg.PlotWidget):

@@ -103,6 +103,15 @@ def drifted(seed, kind, n=300, start=150, sigma=0.8, centre=70.0):
     return x
 
 
+def test_a_baseline_of_fewer_than_10_units_draws_the_points_and_raises_no_alarm():
+    """8 units: centre and sigma from 8 points are too unsure to judge by (the CLI raised 6 alarms, each one
+    said to come about once in 92 units of a stable process)."""
+    x = [70.0, 70.1, 69.9, 70.0, 73.0, 70.05, 69.95, 70.0]
+    chart = control_chart(x)
+    assert chart is not None and chart.baseline == 8 and not chart.judges and len(chart.alarms) == 0
+    assert control_chart(x + [70.0, 70.02], baseline=10).judges       # from 10 units it judges
+
+
 @pytest.mark.parametrize("kind", ["step", "ramp"])
 def test_a_drift_injected_at_unit_150_is_flagged_within_10_units(kind):
     for seed in range(20):
