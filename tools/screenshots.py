@@ -547,6 +547,9 @@ ONLY = {"archive": archive_screenshots, "model-lab": model_lab_only, "new-effect
 
 
 def main(argv: list[str]) -> int:
+    if any(a in ("-h", "--help") for a in argv[1:]):      # not an output folder named "--help"
+        print(__doc__)
+        return 0
     only = None
     if "--only" in argv:
         at = argv.index("--only")
