@@ -11,6 +11,17 @@ def _v(value, scale: float = 1.0) -> str:
     return "-" if value is None else f"{value * scale:.4g}"
 
 
+def _extreme(value, capability, scale: float) -> str:
+    """The smallest or largest unit's value with as many digits as tell it from the limits (max 3.02 against
+    "≤ 3.02 Ω" with 11 % of the units outside read as if every unit sat on the limit)."""
+    if value is None:
+        return "-"
+    from analysis.qa_verdict import telling_digits
+    bounds = [b * scale for b in (capability.low, capability.high) if b is not None]
+    digits = telling_digits(value * scale, *bounds, most=7)      # 11 characters at most: the column keeps
+    return f"{value * scale:.{digits}g}"
+
+
 INDEX_WIDTH = 7       # a capability index in at most 7 characters, each column one wider: never glued
 
 
@@ -58,15 +69,19 @@ def stats_text(stats, location: str) -> str:
     if not stats.parameters:
         lines.append("No measurement in this selection.")
         return "\n".join(lines)
-    head = (f"{'parameter':<13}{'unit':<6}{'n':>7}{'mean':>11}{'sigma':>10}{'min':>11}{'max':>11}  {'limit':<22}"
-            f"{'Cp':>8}{'Cpk':>8}{'Pp':>8}{'Ppk':>8}{'yield':>8}{'alarms':>7}")
+    # The limit as its file says it, whole (cut to 21 characters, "0.000421234 .. 0.000438765 m/N" lost its upper
+    # bound and its unit).
+    limit_width = max([22, *(len(p.limit_text or "-") + 1 for p in stats.parameters.values())])
+    head = (f"{'parameter':<13}{'unit':<6}{'n':>7}{'mean':>11}{'sigma':>10}{'min':>11}{'max':>11}  "
+            f"{'limit':<{limit_width}}{'Cp':>8}{'Cpk':>8}{'Pp':>8}{'Ppk':>8}{'yield':>8}{'alarms':>7}")
     lines += ["", head]
     for p in stats.parameters.values():
         c, s = p.capability, p.display_scale
         yield_text = "-" if c.yield_fraction is None else f"{100 * c.yield_fraction:.1f}%"
         alarms = "-" if p.chart is None else str(len(p.chart.alarms))
         lines.append(f"{p.name:<13}{_unit(p.display_unit):<6}{c.n:>7}{_v(c.mean, s):>11}{_v(c.sigma_overall, s):>10}"
-                     f"{_v(c.minimum, s):>11}{_v(c.maximum, s):>11}  {(p.limit_text or '-')[:21]:<22}"
+                     f"{_extreme(c.minimum, c, s):>11}{_extreme(c.maximum, c, s):>11}  "
+                     f"{(p.limit_text or '-'):<{limit_width}}"
                      f"{_index(c.cp):>8}{_index(c.cpk):>8}{_index(c.pp):>8}{_index(c.ppk):>8}{yield_text:>8}"
                      f"{alarms:>7}")
     lines += _estimate_lines(stats) + _alarm_lines(stats) + _station_lines(stats)

@@ -57,3 +57,21 @@ def test_stats_columns_fit_six_digit_capability_indices(capsys, tmp_path, measur
     code, out, err = run(capsys, "qa", "stats", "--root", archive.root, "--parameter", "RE", "--json")
     (re_stats,) = json.loads(out)["parameters"]
     assert re_stats["cp"] > 1e5
+
+
+def test_the_limit_is_whole_and_the_extremes_tell_themselves_from_it(capsys, tmp_path, measured):
+    """A limit in m/N was cut to 21 characters ("0.000421234 .. 0.0004": its upper bound and unit lost), and a
+    max of 3.0201 against "≤ 3.02 Ω" read "3.02"."""
+    path, doc = measured
+    archive = Archive(tmp_path / "archive")
+    archive.store_limits({"format": "linpar-limits/1", "name": "edge", "parameters": {
+        "RE": {"max": 3.02, "unit": "ohm"}, "Cms": {"min": 0.000421234, "max": 0.000438765, "unit": "m/N"}}})
+    for i, re_ in enumerate((3.0100000, 3.0150000, 3.0201000)):          # the last fails by 0.1 mohm (2 sigma: 0.07)
+        archive.store(path, unit(doc, RE=re_), {"serial": f"SN{i}", "driver": "W6",
+                                                "measured_at": f"2024-05-01T{i:02d}:00:00Z"})
+    code, out, err = run(capsys, "qa", "stats", "--root", archive.root, "--parameter", "RE", "--parameter", "Cms")
+    assert code == 0, err
+    re_row = next(line for line in out.splitlines() if line.startswith("RE "))
+    cms_row = next(line for line in out.splitlines() if line.startswith("Cms "))
+    assert " 3.0201 " in re_row and " 3.01 " in re_row
+    assert "0.000421234 .. 0.000438765 m/N" in cms_row
