@@ -73,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
     verb = args.archive_command
     if verb in archive_server.SERVER_VERBS:
         return archive_server.run_verb(args)
-    archive = archive_server.open_from_args(args)
+    archive = archive_server.open_from_args(args, creates=verb == "store")
     if verb == "list":
         from analysis.archive import Filter
         entries = archive.list(Filter(args.driver, args.serial, args.operator, args.station, args.validity,

@@ -41,9 +41,17 @@ def spec_of(args) -> str:
     return archive_spec(explicit)
 
 
-def open_from_args(args):
+def open_from_args(args, creates: bool = False):
+    """The archive the options name. A folder named on the command line that does not exist is refused unless
+    the command `creates` (stores the first measurement or limits): a mistyped path answered "0 measurement(s)",
+    exit 0, as if the line had measured nothing (a store says where it stored)."""
     from analysis.archive.backends import open_archive
-    return open_archive(spec_of(args))
+    spec = spec_of(args)
+    named = getattr(args, "archive", None) or getattr(args, "root", None)
+    if named and not creates and "://" not in spec and not Path(spec).exists():
+        raise CliError(f"{spec}: no archive there: check the path (a first 'linpar archive store' or 'linpar qa "
+                       "limits --store' makes one)")
+    return open_archive(spec)
 
 
 def say_notes(archive) -> None:

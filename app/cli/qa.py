@@ -97,7 +97,7 @@ def _stats(archive, args, with_stds: bool = True):
 
 
 def run(args: argparse.Namespace) -> int:
-    archive = open_from_args(args)
+    archive = open_from_args(args, creates=args.qa_command == "limits" and bool(getattr(args, "store", None)))
     try:
         return {"stats": _run_stats, "limits": _run_limits, "golden": _run_golden,
                 "export": _run_export}[args.qa_command](archive, args)

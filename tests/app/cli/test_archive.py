@@ -220,3 +220,17 @@ def test_an_sqlite_error_is_one_line_not_a_traceback(capsys, root, rec_path, mon
     code, out, err = run(capsys, "archive", "show", mid)
     assert code == 2 and err.count("\n") == 1
     assert "disk I/O error" in err and "linpar archive rebuild" in err
+
+
+def test_a_mistyped_archive_folder_is_refused_not_read_as_empty(capsys, root, rec_path, tmp_path):
+    """`qa stats --archive /archiv_typo` answered "0 measurement(s)", exit 0, as if the line had measured nothing."""
+    typo = tmp_path / "archiv_typo"
+    for argv in (("archive", "list", "--root", typo), ("qa", "stats", "--archive", typo),
+                 ("archive", "show", "20240501-000000-abcdef", "--root", typo)):
+        code, out, err = run(capsys, *argv)
+        assert code == 2 and err.count("\n") == 1 and f"{typo}: no archive there: check the path" in err, argv
+        assert not typo.exists()
+    code, out, err = run(capsys, "archive", "store", rec_path, "--root", typo)     # a first store makes one
+    assert code == 0, err
+    code, out, err = run(capsys, "archive", "list", "--root", typo)
+    assert code == 0 and "1 measurement(s)" in out

@@ -37,6 +37,7 @@ def test_every_bad_effect_file_is_named_and_the_good_ones_load(capsys, folder):
 
 def test_commands_that_build_no_model_do_not_read_the_effects_folder(capsys, folder, tmp_path):
     root = tmp_path / "archive"
+    root.mkdir()                        # an empty archive: a folder named that does not exist is refused
     code, out, err = run(capsys, "archive", "list", "--root", root)
     assert code == 0 and "0 measurement(s)" in out, err
     code, out, err = run(capsys, "archive", "rebuild", "--root", root)
