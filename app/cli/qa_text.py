@@ -92,15 +92,16 @@ def _estimate_lines(stats) -> list[str]:
     """The indices as what they are, estimates: each one's 95 % interval, and, below the minimum count, that they
     are no verdict (a Cpk of 9,983 from 4 units printed alone read as a capable process)."""
     from analysis.production.capability_interval import MIN_UNITS, too_few
-    lines = []
+    lines, counts = [], []
     for p in stats.parameters.values():
         shown = [(name, interval) for name, interval in p.capability.intervals().items() if interval is not None]
         if shown:
+            counts.append(p.capability.n)
             lines.append(f"{p.name:<13}95 % intervals: " + ", ".join(
                 f"{_index_name(name)} {_index(lo)} .. {_index(hi)}" for name, (lo, hi) in shown))
     if not lines:
         return []
-    n = min(p.capability.n for p in stats.parameters.values())
+    n = min(counts)
     head = ["", "Cp, Cpk, Pp and Ppk are estimates from the units measured:"]
     if n < MIN_UNITS:
         head[1] += f" {too_few(n)}."
@@ -108,14 +109,14 @@ def _estimate_lines(stats) -> list[str]:
 
 
 def _alarm_lines(stats) -> list[str]:
-    short = [p.chart.baseline for p in stats.parameters.values() if p.chart is not None and not p.chart.judges]
-    if short:
+    charts = [(p, p.chart) for p in stats.parameters.values() if p.chart is not None and p.chart.alarms]
+    if not charts:
+        short = [p.chart.baseline for p in stats.parameters.values() if p.chart is not None and not p.chart.judges]
+        if not short:
+            return []
         from analysis.production.control_chart import MIN_BASELINE
         return ["", f"Control chart: no alarms judged: its centre and sigma would come from {max(short)} units; at "
                     f"least {MIN_BASELINE} set them"]
-    charts = [(p, p.chart) for p in stats.parameters.values() if p.chart is not None and p.chart.alarms]
-    if not charts:
-        return []
     baseline = charts[0][1].baseline
     lines = ["", f"Control-chart alarms (individuals; centre and sigma from the first {baseline} units; an alarm is a "
                  "reason to look, about one in 92 units of a stable process raises one):"]
