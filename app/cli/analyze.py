@@ -40,8 +40,7 @@ def analyze_recording(args: argparse.Namespace) -> int:
         from analysis import limits as qa
     limits = qa.load_limits(args.limits) if args.limits else None    # a bad limits file fails before the analysis
     # With the model part of each uncertainty (refits when the model misses the data by more than its noise).
-    effects = model_effects(args.model) if args.model is not None else None     # None: the recording's default
-    result = analyze(args.path, sd_m2=args.sd, effects=effects, method=args.method or "joint")
+    result = analyze(args.path, sd_m2=args.sd, effects=model_effects(args.model), method=args.method or "joint")
     doc = result.as_json()
     if limits is not None:
         doc["limits"] = qa.judge_result(limits, result.parameters, result.validity)

@@ -142,8 +142,7 @@ def _store(archive, args) -> int:
     from analysis.pipeline import analyze_path
     checked_measured_at(args.measured_at)        # before the analysis: a wrong date is said at once
     # The record's uncertainties with their model part, as `linpar analyze` prints them.
-    chosen = model_effects(args.model) if args.model is not None else None     # None: the recording's default
-    result = model_uncertainty(analyze_path(args.path, args.sd, chosen))
+    result = model_uncertainty(analyze_path(args.path, args.sd, model_effects(args.model)))
     mid = archive.store(args.path, result, {"driver": args.driver, "serial": args.serial, "operator": args.operator,
                                             "station": args.station, "notes": args.notes,
                                             "measured_at": args.measured_at}, laser_stream=args.laser_stream)

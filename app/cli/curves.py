@@ -78,7 +78,7 @@ def analyze_curves(args: argparse.Namespace) -> int:
     from analysis.fit.model_uncertainty import model_uncertainty
     curves = load_curves(args)
     # No --model, no --method: fit_curves chooses (magnitude-only curves have their own defaults).
-    effects = None if args.model is None else model_effects(args.model)
+    effects = model_effects(args.model)
     fitted = fit_curves(curves.impedance, curves.displacement, effects, args.sd, curves.fit_range, curves.notes,
                         method=getattr(args, "method", None))
     result = model_uncertainty(fitted)        # the model part of each uncertainty (analysis.fit.model_uncertainty)

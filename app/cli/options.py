@@ -110,7 +110,11 @@ def add_json_option(parser, what: str = "print one JSON object") -> None:
 
 
 def model_effects(text: str | None, option: str = "--model"):
-    """The effects an option names (the default model for None); ModelError that names the option."""
+    """The effects an option names; None when it was not given: the command's default, which the analysis
+    chooses (a recording's depends on it: a serial laser's has delay-x; magnitude-only curves have their own).
+    ModelError that names the option."""
+    if text is None:
+        return None
     from analysis.effects import UnknownEffectError, parse_effects
     from analysis.model.composed import ModelError
     try:

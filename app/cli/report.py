@@ -64,8 +64,7 @@ def load_source(args):
     """(StoredResult, header, settings, calibration) of the ID or PATH."""
     if _is_recording(args.source):
         from analysis.archive.results import stored_from_recording
-        effects = model_effects(args.model) if args.model is not None else None    # None: the recording's default
-        stored, header, calibration = stored_from_recording(args.source, args.sd, effects)
+        stored, header, calibration = stored_from_recording(args.source, args.sd, model_effects(args.model))
         return stored, header, None, calibration
     if args.sd is not None or args.model is not None:
         raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "
