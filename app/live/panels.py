@@ -111,18 +111,21 @@ class LiveChannelPanel(QWidget):
         # Drawn in this order: the dense noise + distortion dots, the noise floor over them, the lines on top.
         # The points are short thick segments of one path, not pyqtgraph symbols: a scatter item keeps Python
         # objects per point and costs ~2 ms a panel per repaint; a path of segments a tenth of that.
-        self.distortion = pg.PlotDataItem(pen=pg.mkPen(DISTORTION_COLOUR, width=3), connect="pairs",
-                                          antialias=False, name="noise + distortion")
+        # Curves, not PlotDataItems: a PlotDataItem maps the log axis, finds its bounds and updates its own curve
+        # at each setData, three times a channel per repaint; the curves are given log10(f) already.
+        self.distortion = pg.PlotCurveItem(pen=pg.mkPen(DISTORTION_COLOUR, width=3), connect="pairs",
+                                           antialias=False, skipFiniteCheck=True)
         # Width 1: an antialiased line any wider costs twice as much to draw, with the GIL held throughout.
-        self.noise = pg.PlotDataItem(pen=pg.mkPen(NOISE_COLOUR, width=1), name="noise floor", connect="finite")
-        self.lines = pg.PlotDataItem(pen=pg.mkPen(SIGNAL_COLOUR, width=4), connect="pairs", antialias=False,
-                                     name="signal lines")
-        self.y_grid = pg.PlotDataItem(pen=pg.mkPen(GRID_COLOUR, width=1), connect="pairs", antialias=False)
+        self.noise = pg.PlotCurveItem(pen=pg.mkPen(NOISE_COLOUR, width=1), connect="finite")
+        self.lines = pg.PlotCurveItem(pen=pg.mkPen(SIGNAL_COLOUR, width=4), connect="pairs", antialias=False,
+                                      skipFiniteCheck=True)
+        self.y_grid = pg.PlotCurveItem(pen=pg.mkPen(GRID_COLOUR, width=1), connect="pairs", antialias=False,
+                                       skipFiniteCheck=True)
         self.y_grid.setZValue(-10)
         for item in (self.y_grid, self.distortion, self.noise, self.lines):
             plot.addItem(item)
         self._freqs_key: tuple | None = None
-        self._x_span = (1.0, 10.0)
+        self._x_span = (0.0, 1.0)          # log10(f) of the grid lines' ends
         self._y_range: tuple[float, float] | None = None
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -151,14 +154,14 @@ class LiveChannelPanel(QWidget):
         self._set_y_range(line_db, other_db, noise)
         self._dots(self.lines, frame.line_freqs, line_db, DOT_HEIGHT)
         self._dots(self.distortion, frame.other_freqs, other_db, DOT_HEIGHT * 0.5)
-        self.noise.setData(frame.noise_freqs, noise)
+        self.noise.setData(np.log10(frame.noise_freqs), noise)
 
-    def _dots(self, item: pg.PlotDataItem, freqs: np.ndarray, db: np.ndarray, height: float) -> None:
+    def _dots(self, item: pg.PlotCurveItem, freqs: np.ndarray, db: np.ndarray, height: float) -> None:
         """Each point a vertical segment `height` of the y range tall (with the pen's width: a dot)."""
         shown = np.isfinite(db)
         half = 0.5 * height * (self._y_range[1] - self._y_range[0]) if self._y_range else 0.5
         y = db[shown]
-        item.setData(np.repeat(freqs[shown], 2), np.column_stack([y - half, y + half]).ravel())
+        item.setData(np.repeat(np.log10(freqs[shown]), 2), np.column_stack([y - half, y + half]).ravel())
 
     def _set_frequencies(self, frame: LiveFrame) -> None:
         """The frequency axis spans the band, first to last excited line; set when the lines change."""
@@ -169,7 +172,7 @@ class LiveChannelPanel(QWidget):
         self._freqs_key = key
         lo, hi = np.log10(frame.line_freqs[0]), np.log10(frame.line_freqs[-1])
         self.plot.setXRange(lo, hi, padding=0.02)
-        self._x_span = (10 ** (lo - 0.05), 10 ** (hi + 0.05))
+        self._x_span = (lo - 0.05, hi + 0.05)
         self._y_range = None               # new lines: the grid is redrawn with the next range
 
     def _set_y_range(self, *arrays: np.ndarray) -> None:

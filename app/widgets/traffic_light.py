@@ -28,6 +28,7 @@ class TrafficLight(QWidget):
         super().__init__(parent)
         self.diameter = diameter
         self.status = "unknown"
+        self.shown: str | None = None          # the status last set, as given
         self.setSizePolicy(QSizePolicy.Fixed, QSizePolicy.Fixed)
         self.set_status("unknown")
 
@@ -38,6 +39,9 @@ class TrafficLight(QWidget):
         return self.sizeHint()
 
     def set_status(self, status: str) -> None:
+        if status == self.shown:       # the live panels set it with every frame: a repaint only when it changes
+            return
+        self.shown = status
         self.status = status if status in LAMP_COLOURS else "unknown"
         words = STATE_WORDS.get(self.status, status)
         self.setToolTip(f"{status}: {words}")

@@ -104,7 +104,7 @@ def test_a_measurement_without_displacement_shows_that_channel_absent(qtbot, pan
     with qtbot.waitSignal(panels.repainted, timeout=wait_ms(10)):
         panels.set_frame(frames[-1])
     assert panels.panels["displacement"].light.light.status == "absent"
-    assert len(panels.panels["displacement"].lines.getData()[0] or []) == 0
+    assert panels.panels["displacement"].lines.getData()[0].size == 0
 
 
 def test_clear_calls_back_after_the_last_channel_is_emptied_and_not_when_a_newer_clear_took_over(qtbot, panels,
@@ -116,7 +116,7 @@ def test_clear_calls_back_after_the_last_channel_is_emptied_and_not_when_a_newer
     called, superseded = [], []
     panels.clear(band_hz=(10.0, 1000.0), then=lambda: superseded.append(1))
     panels.clear(band_hz=(10.0, 1000.0),
-                 then=lambda: called.append([len(p.lines.getData()[0] or []) for p in panels.panels.values()]))
+                 then=lambda: called.append([p.lines.getData()[0].size for p in panels.panels.values()]))
     assert not called                                  # later turns, not the clear's own
     qtbot.waitUntil(lambda: bool(called), timeout=wait_ms(10))
     assert called == [[0, 0, 0]]                       # every channel empty by then
