@@ -208,11 +208,13 @@ def displacement_noise_factor(recording: Recording) -> float:
     return 1.0 if factor is None else max(float(factor), 1.0)
 
 
-def _displacement_max_hz(recording: Recording) -> float | None:
+def displacement_max_hz(recording: Recording, error: type[LinparError] = SpectrumError) -> float | None:
+    """The top of a serial laser's band (the sidecar's displacement_max_hz), None when the laser has no band of
+    its own; `error` (one line) when the key holds no frequency. The spectra and the large-signal data read it."""
     value = recording.extra.get("displacement_max_hz") if recording.extra else None
     if value is None:
         return None
-    return FREQUENCY.check(value, "sidecar key displacement_max_hz (the top of the laser's band)", SpectrumError)
+    return FREQUENCY.check(value, "sidecar key displacement_max_hz (the top of the laser's band)", error)
 
 
 def estimate_spectra(recording: Recording) -> Spectra:
@@ -243,7 +245,7 @@ def estimate_spectra(recording: Recording) -> Spectra:
     if "displacement" in per_period:
         # A serial laser samples slower than the sound card: the sidecar's
         # displacement_max_hz marks where its band ends; lines above carry no displacement.
-        max_hz = _displacement_max_hz(recording)
+        max_hz = displacement_max_hz(recording)
         x_lines = excited if max_hz is None else excited[excited * bin_width <= max_hz]
         in_band = np.isin(excited, x_lines)
         displacement = transfer_from_periods("displacement", "m/V", per_period["displacement"][:, x_lines],

@@ -34,7 +34,7 @@ import numpy as np
 
 from analysis.errors import LinparError
 from analysis.recording.format import MIN_PERIODS, Recording
-from analysis.spectra import SpectrumError, excited_lines
+from analysis.spectra import SpectrumError, displacement_max_hz, excited_lines
 from analysis.serial_laser import from_serial_laser
 
 
@@ -93,7 +93,7 @@ def recording_data(recording: Recording, label: str | None = None) -> RecordingD
         raise LargeSignalError(f"{name}: {exc}") from None
     top = int(excited[-1])
     bin_width = recording.sample_rate / n
-    x_max_hz = _displacement_max_hz(recording)
+    x_max_hz = displacement_max_hz(recording, LargeSignalError)
     x_top = top if x_max_hz is None else min(top, int(math.floor(x_max_hz / bin_width)))
     if x_top < 4:
         raise LargeSignalError(f"{name}: the displacement's band ({x_max_hz} Hz) holds no line of the excitation")
@@ -109,12 +109,3 @@ def peak_to_peak(data: RecordingData, offset: float = 0.0) -> tuple[float, float
     """(min, max) of the coherent mean period's x + offset, m: the range the curves rest on."""
     x = data.mean("x") + offset
     return float(x.min()), float(x.max())
-
-
-def _displacement_max_hz(recording: Recording) -> float | None:
-    value = recording.extra.get("displacement_max_hz") if recording.extra else None
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0:
-        raise LargeSignalError(f"sidecar key displacement_max_hz: found {value!r}, expected a positive number in Hz")
-    return float(value)

@@ -141,6 +141,15 @@ def serial_laser_recording(delay_s: float):
     return driver, block, laser
 
 
+@pytest.mark.parametrize("band", ["fast", -1760.0, 5e6])
+def test_a_laser_band_that_is_no_frequency_is_one_line_as_the_spectra_say_it(band):
+    """The large-signal data read the sidecar's displacement_max_hz with the spectra's rule (analysis.spectra)."""
+    _driver, _block, laser = serial_laser_recording(0.0)
+    laser = dataclasses.replace(laser, extra={**laser.extra, "displacement_max_hz": band})
+    with pytest.raises(LargeSignalError, match="displacement_max_hz .*: found .*, expected a frequency"):
+        recording_data(laser, "r1")
+
+
 def test_an_unknown_rest_position_and_a_late_laser_are_found():
     """The serial laser 80 us late, its mean removed: both found, and the result trusted."""
     driver, block, laser = serial_laser_recording(80e-6)
