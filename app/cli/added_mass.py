@@ -43,7 +43,7 @@ def _mass_curves(args):
 def run(args: argparse.Namespace) -> int:
     from analysis import added_mass as am
     curves, notes = _mass_curves(args)
-    effects = model_effects(args.model or am.DEFAULT_EFFECTS)
+    effects = model_effects(am.DEFAULT_EFFECTS if args.model is None else args.model)
     f_range = fit_range(args)
     primary = am.joint_added_mass(curves, effects, args.sd, f_range)
     checks = []

@@ -58,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         used = [name for name, value in (("--levels", args.levels), ("--out", args.out)) if value]
         if used:
             raise CliError(f"{', '.join(used)}: only with --simulate")
-    effects = model_effects(args.model) if args.model else None     # a bad --model fails before the simulation
+    effects = model_effects(args.model)         # a bad --model fails before the simulation
     items = _simulate(args) if args.simulate else list(args.paths)
     series = level_series(items, args.sd, effects)
     if args.json:

@@ -111,7 +111,7 @@ def run(args: argparse.Namespace) -> int:
     from instruments.measurement.runner import MeasurementCancelled
 
     large_signal.plan_options_checked(args)     # a large-signal limit given to this single measurement is refused
-    effects = model_effects(args.model) if args.model else None
+    effects = model_effects(args.model)
     if not args.no_archive:     # a mistyped archive is said now, not after the measurement (nothing connects yet)
         from analysis.archive.backends import archive_spec, check_spec
         if args.archive is not None and not args.archive.strip():

@@ -20,7 +20,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     from analysis.pipeline import analyze_path, require_fit
     from analysis.repeatability import format_spread, repeatability
-    effects = model_effects(args.model) if args.model else None
+    effects = model_effects(args.model)
     tables, left_out = [], []
     for path in args.paths:
         result = analyze_path(path, args.sd, effects)

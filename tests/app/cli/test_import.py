@@ -121,6 +121,25 @@ def test_stats_over_repeated_recordings(capsys, tmp_path):
     assert code == 0 and "3 results" in out
 
 
+def test_an_empty_model_option_is_the_textbook_model_as_in_analyze(capsys, tmp_path):
+    """`--model ""` named the default model in stats (and levels, measure, addedmass) and none in analyze."""
+    paths = []
+    for seed in range(2):
+        path = tmp_path / f"rep{seed}"
+        write_recording(path, recording(noise=TYPICAL_NOISE, n_periods=4, seed=seed))
+        paths.append(str(path) + ".wav")
+    fitted = {}
+    for model in ("", "none", None):
+        code, out, err = run(capsys, "stats", *paths, "--json", *(() if model is None else ("--model", model)))
+        assert code == 0, err
+        fitted[model] = set(json.loads(out)["parameters"])
+    assert fitted[""] == fitted["none"] and "lambda" not in fitted[""]
+    assert "lambda" in fitted[None]                  # the default model's creep
+    code, out, err = run(capsys, "analyze", paths[0], "--json", "--model", "")
+    assert code == 0, err
+    assert "lambda" not in json.loads(out)["parameters"]
+
+
 def test_stats_leave_a_red_recording_out_and_say_so(capsys, tmp_path):
     """A broken measurement (its laser mounted the wrong way round: red) is no repeat: averaged in, its numbers
     read as a spread of tens of percent."""
