@@ -32,16 +32,16 @@ from functools import cache
 from analysis.errors import LinparError
 
 # The bidirectional controls (LRM, RLM, ALM, the embeddings and overrides, the isolates), as a character class's
-# inside: the patterns below and _what's words share it.
-_BIDI = r"\u200e\u200f\u061c\u202a-\u202e\u2066-\u2069"
+# inside: the patterns below, _what's words and the server's CHECK (analysis.archive.pg.audit) share it.
+BIDI_CLASS = r"\u200e\u200f\u061c\u202a-\u202e\u2066-\u2069"
 # The patterns, compiled on first use (PEP 562 below): a class holding the surrogates' 2048 characters takes
 # 0.2-0.6 ms to compile, and most starts of the command line use SURROGATES alone (its arguments' check).
 _PATTERNS = {
     # The class refused where a name enters and checked wherever a stored one is read.
-    "CONTROL": rf"[\x00-\x1f\x7f-\x9f\u2028\u2029{_BIDI}\ud800-\udfff]",
+    "CONTROL": rf"[\x00-\x1f\x7f-\x9f\u2028\u2029{BIDI_CLASS}\ud800-\udfff]",
     # The same, but a line break allowed: a multi-line description (an effect's physics).
-    "CONTROL_BUT_NEWLINE": rf"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029{_BIDI}\ud800-\udfff]",
-    "_BIDI": f"[{_BIDI}]",
+    "CONTROL_BUT_NEWLINE": rf"[\x00-\x09\x0b-\x1f\x7f-\x9f\u2028\u2029{BIDI_CLASS}\ud800-\udfff]",
+    "_BIDI": f"[{BIDI_CLASS}]",
     # ESC [ ... final byte (CSI), ESC ] ... BEL or ESC \ (OSC), ESC and one byte: what a terminal acts on.
     "_ESCAPE_SEQUENCE": r"\x1b\[[0-?]*[ -/]*[@-~]|\x1b\][^\x07\x1b]*(?:\x07|\x1b\\)?|\x9b[0-?]*[ -/]*[@-~]"
                         r"|\x9d[^\x07\x1b\x9c]*(?:\x07|\x1b\\|\x9c)?|\x1b[@-_]?",

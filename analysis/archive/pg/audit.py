@@ -1,4 +1,4 @@
-"""The audit trail the server enforces (schema version 3): who stored what and when is the server's word.
+"""The audit trail the server enforces (schema versions 3 and 4): who stored what and when is the server's word.
 
 Version 1 gave each role INSERT on whole tables, with `stored_by`,
 `received_at`, `created_by` as column defaults a client could override: an
@@ -14,8 +14,14 @@ cannot read stopped `qa stats` for everyone. Here, whatever program connects:
   a CHECK), its name one line of text; the measurements' names too (the
   class analysis.text_boundary refuses). The CHECKs are NOT VALID: rows stored
   before stay readable (a reader flags what breaks the rule), new ones are checked.
+
+Version 4 adds the bidirectional controls to the class the server refuses in
+those names, as analysis.text_boundary does: "st2" + U+202E + "SSAP" read
+"st2PASS" beside a verdict, and a program other than linpar could store it.
 """
 from __future__ import annotations
+
+from analysis.text_boundary import BIDI_CLASS
 
 # The characters analysis.text_boundary.CONTROL refuses, as a PostgreSQL regular expression (ARE escapes).
 _CONTROL_RE = r"'[\x01-\x1f\x7f-\x9f\u2028\u2029]'"
@@ -92,6 +98,17 @@ ALTER TABLE linpar.limits_versions ADD CONSTRAINT limits_document_checked
 ALTER TABLE linpar.measurements ADD CONSTRAINT names_one_line
     CHECK (driver !~ {_CONTROL_RE} AND serial !~ {_CONTROL_RE} AND operator !~ {_CONTROL_RE}
            AND station !~ {_CONTROL_RE}) NOT VALID;
+"""
+
+# The bidirectional controls, as a PostgreSQL regular expression (ARE escapes, as _CONTROL_RE).
+_BIDI_RE = f"'[{BIDI_CLASS}]'"
+
+V4_BIDI = f"""
+ALTER TABLE linpar.measurements ADD CONSTRAINT names_without_bidi_controls
+    CHECK (driver !~ {_BIDI_RE} AND serial !~ {_BIDI_RE} AND operator !~ {_BIDI_RE}
+           AND station !~ {_BIDI_RE}) NOT VALID;
+ALTER TABLE linpar.limits_versions ADD CONSTRAINT name_without_bidi_controls
+    CHECK (name !~ {_BIDI_RE}) NOT VALID;
 """
 
 # Set by `linpar archive setup` on the database (ALTER DATABASE ... SET), for every session: a station whose

@@ -155,7 +155,12 @@ def _v3() -> str:
     return V3_AUDIT
 
 
-MIGRATIONS: tuple[str, ...] = (_V1, _v2(), _v3())
+def _v4() -> str:
+    from analysis.archive.pg.audit import V4_BIDI
+    return V4_BIDI
+
+
+MIGRATIONS: tuple[str, ...] = (_V1, _v2(), _v3(), _v4())
 CURRENT_VERSION = len(MIGRATIONS)
 _LOCK_KEY = 0x6C696E706172      # "linpar": the advisory lock that serialises migrations
 

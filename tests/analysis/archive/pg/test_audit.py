@@ -73,7 +73,8 @@ def test_a_limits_version_is_stamped_and_checked_by_the_server(pg_database):
                                ("W6", {"format": "linpar-limits/1", "parameters": {"fs": {"min": 9, "max": 1,
                                                                                           "unit": "Hz"}}}),
                                ("W6", ["not", "an", "object"]),
-                               ("W6\x1b]0;owned\x07", LIMITS)):
+                               ("W6\x1b]0;owned\x07", LIMITS),
+                               ("W6\u202eSSAP", LIMITS)):
             with pytest.raises(psycopg.errors.CheckViolation):
                 conn.execute("INSERT INTO linpar.limits_versions (name, document) VALUES (%s, %s)",
                              (name, json.dumps(document)))
@@ -86,13 +87,15 @@ def test_a_limits_version_is_stamped_and_checked_by_the_server(pg_database):
     assert open_archive(pg_database.url("audrey")).limits().created_by == "eva"
 
 
-def test_names_with_control_characters_are_refused_by_the_server(pg_database, measured):
+def test_names_with_control_or_bidirectional_characters_are_refused_by_the_server(pg_database, measured):
     path, doc = measured
     mid = open_archive(pg_database.url("station_a")).store(path, doc, {"serial": "SN1"})
     row = list(_row_of(pg_database, mid))
-    row[4] = "W6\x1b[2J"
-    with _as(pg_database, "station_a") as conn, pytest.raises(psycopg.errors.CheckViolation):
-        _insert_measurement(conn, row, mid[:-2] + ("00" if not mid.endswith("00") else "01"))
+    for column, name in ((4, "W6\x1b[2J"), (7, "st2\u202eSSAP"), (5, "SN\u20661"), (6, "\u200fanna")):
+        forged = list(row)
+        forged[column] = name
+        with _as(pg_database, "station_a") as conn, pytest.raises(psycopg.errors.CheckViolation):
+            _insert_measurement(conn, forged, mid[:-2] + ("00" if not mid.endswith("00") else "01"))
 
 
 def test_every_station_session_is_bounded_and_setup_bounds_the_server_side(pg_database):
@@ -122,7 +125,7 @@ def test_setup_migrates_an_existing_line_to_the_audited_schema(pg_server, measur
         conn.execute("INSERT INTO linpar.limits_versions (name, document, created_by, created_at) VALUES "
                      "('old\tname', %s, 'someone', '2001-01-01')", (json.dumps({**LIMITS, "name": "old\tname"}),))
     report = setup(pg_server.url(ADMIN, name), {"station_a": "operator", "audrey": "auditor"})
-    assert (report.schema_from, report.schema_to) == (2, CURRENT_VERSION) == (2, 3)
+    assert (report.schema_from, report.schema_to) == (2, CURRENT_VERSION) == (2, 4)
     old = open_archive(pg_server.url("audrey", name)).limits()
     assert old.created_by == "someone" and old.name == "old\\tname"        # kept as stored, shown escaped
     path, doc = measured
