@@ -57,16 +57,22 @@ def _round(value: float, down: bool) -> float:
     return (math.floor if down else math.ceil)(value / step) * step
 
 
-def propose_limits(population, k: float, ids=(), name: str = "") -> tuple[dict, list[ProposedLimit], list[str]]:
-    """(linpar-limits/1 document, the limits with their numbers, notes) from the golden units' population."""
-    from analysis.limits import parameter_units
-    if len(population) < MIN_GOLDEN:
-        raise ArchiveError(f"limits from golden units need at least {MIN_GOLDEN} of them; {len(population)} found")
+def check_golden(population) -> None:
+    """ArchiveError (one line) when a unit of `population` cannot be a golden unit: a broken measurement (red), or
+    one its limits could not judge. Checked where units are marked golden and where limits are proposed."""
     bad = [f"{i} ({v})" for i, v, d in zip(population.ids, population.validity, population.verdicts)
            if v == "red" or d in ("invalid", "not judged")]
     if bad:
         raise ArchiveError(f"a golden unit must be a valid measurement the model describes: {', '.join(bad[:5])} "
                            "is not: measure it again or leave it out")
+
+
+def propose_limits(population, k: float, ids=(), name: str = "") -> tuple[dict, list[ProposedLimit], list[str]]:
+    """(linpar-limits/1 document, the limits with their numbers, notes) from the golden units' population."""
+    from analysis.limits import parameter_units
+    if len(population) < MIN_GOLDEN:
+        raise ArchiveError(f"limits from golden units need at least {MIN_GOLDEN} of them; {len(population)} found")
+    check_golden(population)
     units = parameter_units()
     notes, proposed = [], []
     if len(population) < FEW_GOLDEN:

@@ -165,6 +165,9 @@ def _run_limits(archive, args) -> int:
 def _run_golden(archive, args) -> int:
     ids = archive.golden()
     if args.add:
+        from analysis.archive.population import Selection
+        from analysis.production.golden import check_golden
+        check_golden(archive.population(Selection(ids=tuple(archive.resolve(i)[0] for i in args.add)).checked()))
         ids = archive.set_golden(args.add, golden=True)
     if args.remove:
         ids = archive.set_golden(args.remove, golden=False)

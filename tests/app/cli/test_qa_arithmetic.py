@@ -1,5 +1,6 @@
 """QA arithmetic (issue 31, class 3): first-pass yield counts each unit's first test; `qa stats` columns fit
 their numbers and keep their signs."""
+import copy
 import json
 
 import pytest
@@ -75,3 +76,19 @@ def test_the_limit_is_whole_and_the_extremes_tell_themselves_from_it(capsys, tmp
     cms_row = next(line for line in out.splitlines() if line.startswith("Cms "))
     assert " 3.0201 " in re_row and " 3.01 " in re_row
     assert "0.000421234 .. 0.000438765 m/N" in cms_row
+
+
+def test_a_broken_measurement_is_refused_as_a_golden_unit_where_it_is_marked(capsys, tmp_path, measured):
+    """A red unit marked golden was taken, and only `qa limits --from-golden` refused it, later and elsewhere."""
+    path, doc = measured
+    archive = Archive(tmp_path / "archive")
+    broken = copy.deepcopy(doc)
+    broken["validity"]["overall"] = "red"
+    good = archive.store(path, doc, {"serial": "SN1", "driver": "W6"})
+    bad = archive.store(path, broken, {"serial": "SN2", "driver": "W6"})
+    code, _, err = run(capsys, "qa", "golden", "--root", archive.root, "--add", good, bad)
+    assert code == 2 and f"{bad} (red)" in err and "measure it again or leave it out" in err
+    assert archive.golden() == []                         # nothing marked: neither of the two
+    code, out, err = run(capsys, "qa", "golden", "--root", archive.root, "--add", good, "--json")
+    assert code == 0, err
+    assert json.loads(out)["golden"] == [good]
