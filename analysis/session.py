@@ -16,7 +16,7 @@ from datetime import datetime, timezone
 from importlib import metadata
 from typing import Any, Mapping
 
-from analysis.text_boundary import cleaned
+from analysis.text_boundary import cleaned, spreadsheet_comment
 
 SESSION_KEY = "session"
 SESSION_FIELDS = ("operator", "station", "template", "measured_at", "software")
@@ -85,5 +85,7 @@ def trace_line(header: Mapping) -> str:
 
 
 def comment_lines(title: str, header: Mapping, marker: str = "#") -> list[str]:
-    """Comment lines above a table (CSV exports): what it is, the header one item a line, the exporting software."""
-    return [f"{marker} {line}" for line in (title, *trace_items(header), f"exported by {software()}")]
+    """Comment lines above a table (CSV exports): what it is, the header one item a line, the exporting software;
+    the names in them never a spreadsheet's formula (analysis.text_boundary.spreadsheet_comment)."""
+    return [spreadsheet_comment(f"{marker} {line}")
+            for line in (title, *trace_items(header), f"exported by {software()}")]

@@ -124,3 +124,17 @@ def spreadsheet_cell(text: str) -> str:
     """A text cell no spreadsheet runs as a formula (OWASP: prefix = + - @ tab CR with a quote)."""
     text = str(text)
     return "'" + text if text.startswith(_FORMULA_START) else text
+
+
+def spreadsheet_comment(line: str, delimiter: str = ",") -> str:
+    """A comment line of a CSV file ('# driver ...') that no spreadsheet runs as a formula.
+
+    A spreadsheet knows no comments: it splits the line at the delimiter as any row, so a name holding a comma
+    puts what follows in a cell of its own ('# driver ACME,=1+2' has the cell '=1+2'). Each part after the
+    first that would start a formula is quoted as spreadsheet_cell does, also behind spaces or an opening quote
+    ('"=1+2"' is the cell =1+2).
+    The line still starts with '#' for the readers that skip such lines (pandas' comment='#', csv readers).
+    """
+    first, *rest = str(line).split(delimiter)
+    return delimiter.join([first, *("'" + part if part.lstrip(' "').startswith(_FORMULA_START) else part
+                                    for part in rest)])

@@ -11,7 +11,8 @@ parameter, columns
 note says why it is missing; std is the total standard uncertainty, std_noise and
 std_model its two parts in SI, empty where the analysis did not estimate them:
 analysis.fit.model_uncertainty). Decimal point '.', comma-separated, UTF-8,
-RFC 4180 quoting. A reader skips the '#' lines (pandas: comment="#").
+RFC 4180 quoting; in the comment lines a part after a comma that would start a spreadsheet formula is quoted
+(analysis.text_boundary.spreadsheet_comment). A reader skips the '#' lines (pandas: comment="#").
 
 JSON ("linpar-parameters/1"): the driver header, the parameters keyed by
 name ({value, std, unit, display_unit, display_scale, reason; std_noise and std_model where estimated}), the model

@@ -142,3 +142,19 @@ def test_an_argument_that_is_not_utf8_is_one_line_and_no_crash(capsys, tmp_path)
     report = write_crash_report(RuntimeError("x"), argv=["archive", "list", "--operator", latin1])
     assert "M\\udcfcller" in report.read_text(encoding="utf-8") and "RuntimeError" in report.read_text()
     report.unlink()
+
+
+def test_a_name_with_commas_puts_no_formula_in_a_cell_of_the_exports_comment_lines(capsys, tmp_path, measured):
+    """A spreadsheet has no comment lines: it splits '# driver ACME,=1+2' at the comma, and '=1+2' is a cell."""
+    path, doc = measured
+    archive = Archive(tmp_path / "archive")
+    names = {"driver": "ACME,=1+2,+3+4, -5+6,@SUM(1)", "serial": 'SN,"=HYPERLINK(""http://x"")"'}
+    mid = archive.store(path, unit(doc, fs=70.0), names)
+    out_csv = tmp_path / "parameters.csv"
+    code, out, err = run(capsys, "export", mid, "--root", archive.root, "--csv", out_csv)
+    assert code == 0, err
+    text = out_csv.read_text()
+    comments = [line for line in text.splitlines() if line.startswith("#")]
+    cells = [cell.lstrip(" ") for row in csv.reader(comments) for cell in row]     # as a spreadsheet splits them
+    assert len(cells) > len(comments) and not [c for c in cells if c.startswith(("=", "+", "-", "@"))]
+    assert "# driver ACME,'=1+2,'+3+4,' -5+6,'@SUM(1)" in text.splitlines()       # still one line that says it
