@@ -44,6 +44,8 @@ import numpy as np
 
 from analysis.curves.noise import describe_noise, with_estimated_noise
 from analysis.curves.passivity import judged_not_a_driver, passivity_findings
+from analysis.curves.misfit import judged_misfit
+from analysis.curves.plausible_numbers import judged_plausible
 from analysis.derived import ParameterValue, parameter_table
 from analysis.effects import Effect, parse_effects
 from analysis.effects.base import ParamSpec
@@ -71,7 +73,8 @@ MAGNITUDE_ONLY_EFFECTS = "lr2,creep-log-causal-fs"
 # this many lines per decade, each decade counts alike, as in a log-spaced
 # .zma (35 per octave is about 116 per decade).
 LINES_PER_DECADE = 100
-VALIDITY_NOTE = "imported curves: no per-line noise of their own, no validity checks"
+VALIDITY_NOTE = ("imported curves: no per-line noise of their own, no validity checks of the signals (judged only: "
+                 "whether the curve and its numbers can be a driver's)")
 UNCERTAINTY_NOTE = ("imported curves carry no noise estimate of their own: each line's noise is estimated from the "
                     "curve's local scatter (a quadratic over 7 neighbouring lines, pooled over 15), and the "
                     "uncertainties are scaled by sqrt(reduced chi^2) where the model misses by more than that noise; "
@@ -219,6 +222,8 @@ def fit_curves(impedance: TransferFunction, hx: TransferFunction | None = None,
     found = passivity_findings(impedance)       # a curve no driver can give: red, its parameters withheld
     if found:
         validity, parameters = judged_not_a_driver(validity, parameters, found)
+    else:                                       # numbers no driver has: judged as a recording's
+        validity = judged_misfit(judged_plausible(validity, parameters, sd_m2))
     return CurveAnalysis(fit=fit, parameters=parameters, sd_m2=sd_m2, ranges=ranges,
                          validity=validity, notes=tuple(notes), data=data,
                          model_part_always=magnitude_only(impedance, hx), other_bands=other_bands)

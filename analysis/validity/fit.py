@@ -145,6 +145,9 @@ def qa_blocker(validity: ResultValidity, tolerance: Mapping[str, float] | None =
     tolerance: channel -> the largest fit error in % at which the model is taken to describe the measurement
     (analysis.fit.error.FIT_ERROR_DEFAULTS when None). A result stored before the fit error was computed (no
     "fit_error_percent") is judged by its model-misfit finding, as it was then."""
+    if validity.overall == Severity.RED and validity.imported is not None:       # a file: mend how it was read
+        return INVALID, (f"the curves as read are no driver's: {red_findings_text(validity)}; the unit itself "
+                         "was not judged")
     if validity.overall == Severity.RED:
         return INVALID, (f"measurement invalid: {red_findings_text(validity)}, and measure again; the unit "
                          "itself was not judged")

@@ -68,17 +68,20 @@ def _red(channel: str, code: str, message: str, remedy: str, value: float) -> Fi
     return Finding(channel, code, Severity.RED, message, remedy, value)
 
 
-def _mass_cause(mms: float | None, per_area: float | None) -> str:
-    """The likely cause of an impossible mass or efficiency: the laser's scale, else Sd."""
+def _mass_cause(mms: float | None, per_area: float | None, x_scale: str = _X_SCALE) -> str:
+    """The likely cause of an impossible mass or efficiency: the displacement's scale (`x_scale` says how to mend
+    it), else Sd."""
     if mms is not None and mms < MMS_LIGHTEST:
-        return _X_SCALE
+        return x_scale
     if per_area is not None and per_area < MASS_PER_AREA_RED[0] * 1e-2:
-        return _X_SCALE
+        return x_scale
     return _SD_SCALE
 
 
-def mechanical_findings(parameters: Mapping, sd_m2: float | None, peak_m: float | None) -> list[Finding]:
-    """Efficiency, mass per area and excursion (module doc), on the displacement channel."""
+def mechanical_findings(parameters: Mapping, sd_m2: float | None, peak_m: float | None,
+                        x_scale: str = _X_SCALE) -> list[Finding]:
+    """Efficiency, mass per area and excursion (module doc), on the displacement channel; `x_scale`: the remedy
+    when the displacement's scale is the likely cause (a recording's sidecar; an imported Hx curve's unit)."""
     found: list[Finding] = []
     mms, eta0 = _value(parameters, "Mms"), _value(parameters, "eta0")
     per_area = mms / sd_m2 if mms is not None and sd_m2 else None
@@ -86,22 +89,22 @@ def mechanical_findings(parameters: Mapping, sd_m2: float | None, peak_m: float 
         found.append(_red("displacement", EXCURSION,
                           f"peak excursion {peak_m * 1e3:.4g} mm: {peak_m / DEFAULT_X_LIMIT_M:.3g} times the "
                           f"small-signal limit {DEFAULT_X_LIMIT_M * 1e3:g} mm; no driver moves so far at a "
-                          "measuring level", _X_SCALE, peak_m))
+                          "measuring level", x_scale, peak_m))
     if per_area is not None and not MASS_PER_AREA_RED[0] <= per_area <= MASS_PER_AREA_RED[1]:
         found.append(_red("displacement", MASS_PER_AREA,
                           f"moving mass per area Mms/Sd {per_area:.3g} kg/m^2 (Mms {mms * 1e3:.3g} g, Sd "
                           f"{sd_m2:.4g} m^2); real drivers have {MASS_PER_AREA_REAL[0]:g} to "
-                          f"{MASS_PER_AREA_REAL[1]:g} kg/m^2", _mass_cause(mms, per_area), per_area))
+                          f"{MASS_PER_AREA_REAL[1]:g} kg/m^2", _mass_cause(mms, per_area, x_scale), per_area))
     elif mms is not None and mms < MMS_LIGHTEST:
         found.append(_red("displacement", MASS_PER_AREA, f"moving mass Mms {mms * 1e6:.3g} mg: below any "
-                          f"loudspeaker's ({MMS_LIGHTEST * 1e6:g} mg)", _X_SCALE, mms))
+                          f"loudspeaker's ({MMS_LIGHTEST * 1e6:g} mg)", x_scale, mms))
     if eta0 is not None and (eta0 < 0 or eta0 > ETA0_YELLOW):
         severity = Severity.RED if eta0 < 0 or eta0 > ETA0_RED else Severity.YELLOW
         why = ("no driver's efficiency is negative" if eta0 < 0 else
                f"direct-radiating drivers stay below {ETA0_YELLOW * 100:g} %" + (
                    "; only a few professional woofers come near it" if severity is Severity.YELLOW else ""))
         found.append(Finding("displacement", EFFICIENCY, severity, f"reference efficiency eta0 {eta0 * 100:.4g} %: "
-                             f"{why}", _mass_cause(mms, per_area), eta0))
+                             f"{why}", _mass_cause(mms, per_area, x_scale), eta0))
     return found
 
 

@@ -45,6 +45,15 @@ class ValidityBox(QLabel):
         self.setText(f"<b>Validity: {html.escape(state)}</b> — {html.escape(meaning)}")
 
 
+def imported_meaning(validity) -> str | None:
+    """What the validity of imported curves means: what was found in them (their numbers no driver's, a curve the
+    model misses), each with its remedy, else that nothing was checked; None for a recording."""
+    if validity.imported is None:
+        return None
+    found = validity.findings
+    return "; ".join(f"{f.message}: {f.remedy}" for f in found) if found else validity.imported.note
+
+
 def source_text(result: AnalysisResult) -> str:
     s = result.spectra
     name = result.source.name if result.source else "recording"
@@ -188,8 +197,7 @@ class ResultsView(QWidget):
         imported = is_imported(result)
         self.source_label.setText(source_html(result) if imported else
                                   source_text(result) + self._re_remark(result, nominal_ohm))
-        self.validity_box.set_state(str(result.validity.overall),
-                                    result.validity.imported.note if result.validity.imported else None)
+        self.validity_box.set_state(str(result.validity.overall), imported_meaning(result.validity))
         self.fit_quality.set_result(result)
         self._show_parameters(result)
         if curves is None:          # a broken measurement: judged (validity, reasons), nothing fitted

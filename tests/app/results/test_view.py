@@ -416,3 +416,25 @@ def test_a_table_of_other_parameters_replaces_the_rows(qtbot):
     table.set_parameters(fewer)
     assert _names(table) == [_cell_name for _cell_name in _names(_table_of(qtbot, 500, fewer))]
     assert "L2" not in " ".join(_names(table))
+
+
+def test_imported_curves_whose_numbers_are_no_drivers_say_what_was_found_and_the_remedy_on_the_page(qtbot):
+    """The page said "Validity: red — imported curves: ... no validity checks" and nothing of why."""
+    import dataclasses
+
+    from analysis.curves.fitting import fit_curves
+    from analysis.validity.fit import INVALID, qa_blocker
+    from app.results.view import ValidityBox, imported_meaning
+    from tests.analysis.curves.test_fitting import curve
+    from tests.builders import DRIVERS
+    z, hx = (curve(DRIVERS["paper"], name, noise=0.003, seed=seed) for seed, name in enumerate(("impedance",
+                                                                                                "displacement")))
+    in_mm = fit_curves(z, dataclasses.replace(hx, value=hx.value * 1e3), sd_m2=0.0133).validity
+    box = ValidityBox()
+    qtbot.addWidget(box)
+    box.set_state(str(in_mm.overall), imported_meaning(in_mm))
+    assert "Validity: red" in box.text() and "--mm-per-volt" in box.text() and "no validity checks" not in box.text()
+    verdict, why = qa_blocker(in_mm)
+    assert verdict == INVALID and why.startswith("the curves as read are no driver's") and "measure" not in why
+    right = fit_curves(z, hx, sd_m2=0.0133).validity
+    assert imported_meaning(right) == right.imported.note and "no validity checks" in right.imported.note
