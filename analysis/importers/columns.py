@@ -23,6 +23,9 @@ _FREQ = re.compile(r"freq|^f$|^f[\s_(\[]*hz[)\]]*$|^hz$")
 _PHASE = re.compile(r"phase|^arg|^ang|(?<![a-z])(?:rad|deg)")
 HX_UNITS = {"m/V": 1.0, "mm/V": 1e-3, "um/V": 1e-6}
 _HX_UNIT = re.compile(r"(?<![a-z])(mm|um|µm|m)\s*/\s*v(?![a-z])")
+# An impedance column's unit in its header: ohm with an SI prefix (case matters: m is milli, M mega).
+_Z_UNIT = re.compile(r"(?<![A-Za-z])([mkKM]?)\s?(?:[oO][hH][mM][sS]?|Ω)(?![A-Za-z])")
+_Z_PREFIX = {"": ("ohm", 1.0), "m": ("mOhm", 1e-3), "k": ("kOhm", 1e3), "K": ("kOhm", 1e3), "M": ("MOhm", 1e6)}
 
 
 def column_role(name: str) -> str:
@@ -164,3 +167,18 @@ def hx_unit(table: Table, columns: Columns, option: str | None) -> tuple[str, st
             unit = {"mm": "mm/V", "um": "um/V", "µm": "um/V", "m": "m/V"}[m.group(1)]
             return unit, f"from the file: {text!r}"
     return "m/V", "assumed: the file does not say (SI); give mm/V explicitly if it is in mm/V"
+
+
+def impedance_scale(table: Table, columns: Columns) -> tuple[float, str | None]:
+    """The factor to ohm of an impedance magnitude whose column header names another unit (Z[mOhm]), and the note
+    that says so; (1, None) for ohm or a header that names none. Only the column's own header is read: a comment
+    line may quote another value in milliohm."""
+    column = columns.magnitude if columns.magnitude is not None else columns.real
+    if not table.header or column is None:
+        return 1.0, None
+    text = table.header[column]
+    m = _Z_UNIT.search(text)
+    if not m or not m.group(1):
+        return 1.0, None
+    unit, factor = _Z_PREFIX[m.group(1)]
+    return factor, f"magnitude in {unit} (from the file: {text!r}), converted to ohm"

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from analysis.bounds import FREQUENCY, HX, IMPEDANCE, Bound
-from analysis.importers.columns import HX_UNITS, assign_columns, hx_unit, phase_unit
+from analysis.importers.columns import HX_UNITS, assign_columns, hx_unit, impedance_scale, phase_unit
 from analysis.importers import lpm
 from analysis.importers.errors import ImportFormatError
 from analysis.importers.table import Table, parse_table, read_text
@@ -128,6 +128,10 @@ def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: st
         chosen, why = hx_unit(table, columns, unit)
         value = value * HX_UNITS[chosen]
         notes.append(f"magnitude in {chosen} ({why})")
+    else:
+        factor, said = impedance_scale(table, columns)
+        value = value * factor
+        notes += [said] if said else []
     check_bound(table, np.abs(value), HX if kind == "displacement" else IMPEDANCE, value_name.split(" in ")[0])
     has_phase = columns.is_complex or columns.phase is not None
     n = len(freqs)

@@ -102,6 +102,21 @@ def test_hx_in_mm_per_volt_by_option_or_header(tmp_path):
     assert np.abs(read_hx(write(tmp_path, body, "si.txt")).value)[0] == pytest.approx(0.3)   # m/V by default
 
 
+@pytest.mark.parametrize("header, scale", [("Freq[Hz] Z[mOhm] Phase[deg]", 1e3), ("f |Z|(kΩ) phase(deg)", 1e-3),
+                                           ("Freq[Hz] Z[Ohm] Phase[deg]", 1.0), ("f Impedance(ohms) deg", 1.0)])
+def test_an_impedance_column_in_milliohm_or_kiloohm_is_converted_as_its_header_says(tmp_path, header, scale):
+    """Z[mOhm] was read as ohm: RE 995 ohm, and the fit's fs and Q moved with it, with no word said."""
+    body = "\n".join(f"{f} {m * scale} {p}" for f, m, p in zip(F, MAG, DEG))
+    curve = read_curve(write(tmp_path, f"{header}\n{body}\n"), "impedance")
+    assert_curve(curve.transfer)
+    assert any("converted to ohm" in n for n in curve.notes) == (scale != 1.0)
+
+
+def test_a_comment_that_quotes_milliohm_leaves_the_column_in_ohm(tmp_path):
+    curve = read_curve(write(tmp_path, "# Rdc 5600 mOhm\nf Z phase\n" + rows()), "impedance")
+    assert_curve(curve.transfer)
+
+
 def test_hx_phase_may_be_unwrapped(tmp_path):
     body = "\n".join(f"{f} 1e-4 {p}" for f, p in zip(F, [-10, -90, -200, -400, -700]))
     assert read_hx(write(tmp_path, body)).has_phase
