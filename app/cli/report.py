@@ -60,12 +60,31 @@ def _is_recording(text: str) -> bool:
     return wav.is_file() and sidecar.is_file()
 
 
+def _not_a_file(source: str) -> None:
+    """CliError when SOURCE names a file that is no recording: half of one, or a curve of another tool (which
+    the archive's "not a measurement id" would have answered)."""
+    from pathlib import Path
+
+    from analysis.recording.format import recording_paths
+    if not Path(source).is_file():
+        return
+    wav, sidecar = recording_paths(source)
+    if Path(source) in (wav, sidecar):
+        missing = sidecar if Path(source) == wav else wav
+        raise CliError(f"{source}: a recording is NAME.wav with its sidecar NAME.json, and {missing} is not there: "
+                       "keep the two files together")
+    raise CliError(f"{source}: a file, not a recording (NAME.wav and NAME.json) or a measurement id: curves of "
+                   "another tool are fitted with 'linpar analyze --impedance FILE' (or --uiv FILE); their report "
+                   "and exports come from the window: File > Open curves..., then File > Export report...")
+
+
 def load_source(args):
     """(StoredResult, header, settings, calibration) of the ID or PATH."""
     if _is_recording(args.source):
         from analysis.archive.results import stored_from_recording
         stored, header, calibration = stored_from_recording(args.source, args.sd, model_effects(args.model))
         return stored, header, None, calibration
+    _not_a_file(args.source)
     if args.sd is not None or args.model is not None:
         raise CliError(f"{args.source}: --sd and --model apply to recordings; an archived measurement keeps "
                        "its own")
