@@ -54,11 +54,17 @@ def run(args: argparse.Namespace) -> int:
     for c in loaded:
         checks.append(am.single_added_mass(curves[0].impedance, c.impedance, c.added_mass_kg, effects, args.sd,
                                            f_range))
+    from analysis.added_mass_agreement import disagreements
+    apart = disagreements(primary, checks)
     if args.json:
-        print_json(am.added_mass_document(primary, checks, notes))
+        print_json({**am.added_mass_document(primary, checks, notes), "disagreements": apart})
         return 0
     for result in [primary, *checks]:
         print(result.report())
+        print()
+    if apart:
+        print("The methods disagree:")
+        print("\n".join(f"  {line}" for line in apart))
         print()
     for note in notes:
         print(f"  {note}")

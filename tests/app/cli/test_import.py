@@ -100,9 +100,11 @@ def test_addedmass_on_the_seas_set(capsys):
     assert doc["parameters"]["Mms"]["value"] == pytest.approx(15.05e-3, rel=0.01)
     methods = [c["method"] for c in doc["cross_checks"]]
     assert methods[0].startswith("model-free") and methods.count("single added mass (classical)") == 2
+    assert any(line.startswith("Rms ") and "model-free" in line for line in doc["disagreements"])
     code, out, _ = run(capsys, "addedmass", SEAS / "L16RNX_0g_242_27mV.zma",
                        "--mass", "8.017", SEAS / "L16RNX_8_017g_242_27mV.zma")
     assert code == 0 and "joint fit of 2 curves" in out and "Mms" in out
+    assert out.count("The methods disagree:") <= 1
 
 
 def test_stats_over_repeated_recordings(capsys, tmp_path):
