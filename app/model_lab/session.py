@@ -10,6 +10,8 @@ from __future__ import annotations
 import dataclasses
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from analysis.derived import parameter_table
 from analysis.fit.least_squares import FitData
 from app.model_lab.versions import LabVersion
@@ -66,7 +68,14 @@ class LabSession:
         return dataclasses.replace(fitted, result=result)
 
     def add(self, fitted: LabFit, how: str) -> LabVersion:
-        """The next version, numbered from 1, with the lab's Sd; `how` says how it came about."""
+        """The next version, numbered from 1, with the lab's Sd; `how` says how it came about.
+
+        A fit made in a worker process (a diagnosis's candidates, the greedy path's steps) comes back with a copy
+        of the recording's spectra: the version takes the base's own, so that the Results page's echo of it
+        (is_same_recording) is this recording's and not a new one's that would restart the lab and drop it."""
+        if self.base is not None and fitted.result.spectra is not self.base.spectra \
+                and same_lines(fitted.result.spectra, self.base.spectra):
+            fitted = dataclasses.replace(fitted, result=dataclasses.replace(fitted.result, spectra=self.base.spectra))
         version = LabVersion(len(self.versions) + 1, self.with_sd(fitted), how)
         self.versions.append(version)
         return version
@@ -80,3 +89,9 @@ class LabSession:
         """True when the diagnosis's candidates are one move from the current version."""
         return (self.diagnosis is not None and self.current is not None
                 and self.diagnosis_version == self.current.number)
+
+
+def same_lines(a, b) -> bool:
+    """True when two analysis.spectra.Spectra hold the same recording's lines (a copy that crossed a process)."""
+    return (a.sample_rate == b.sample_rate and a.period_samples == b.period_samples and a.n_periods == b.n_periods
+            and np.array_equal(a.excited_bins, b.excited_bins) and np.array_equal(a.impedance.value, b.impedance.value))

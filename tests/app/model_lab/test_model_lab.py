@@ -229,7 +229,7 @@ def test_a_newer_version_drops_the_steps_left_of_one_shown_in_turns(qtbot, lab, 
     qtbot.wait(100)
     assert [o.job for o in adopted] == [3]                  # the version added at once; not the one in turns
     assert lab.model_label.text().startswith("<b>Version 3</b>")
-    assert lab.current.fitted is fitted
+    assert lab.current.fitted.fit is fitted.fit          # (its spectra the lab's own: LabSession.add)
 
 
 def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):

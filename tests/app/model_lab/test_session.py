@@ -42,6 +42,20 @@ def test_versions_are_numbered_and_the_last_is_current(base):
     assert second.effects == "textbook" and second.how == "removed both effects"
 
 
+def test_a_version_fitted_in_a_worker_process_is_of_the_same_recording(base):
+    """A diagnosis's candidate comes back pickled, its spectra a copy: adopted, the Results page echoed it as a
+    new recording, and the lab restarted, dropping the version and the diagnosis (Apply, Follow the greedy path)."""
+    import pickle
+    session = LabSession()
+    session.restart(base)
+    session.add(first_version(base), "as fitted")
+    textbook = fit_model(session.data, Model(parse_effects("none")))
+    from_worker = pickle.loads(pickle.dumps(lab_fit(base, textbook)))
+    assert from_worker.result.spectra is not base.spectra
+    version = session.add(from_worker, "applied")
+    assert session.is_same_recording(version.fitted.result) and session.current is version
+
+
 def test_sd_follows_the_results_page_on_the_current_version(base):
     session = LabSession()
     session.restart(base)
