@@ -28,6 +28,7 @@ from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
 from analysis.limits import INTERVAL_K
 from analysis.report.qa import VERDICT_COLOURS, QASection
+from analysis.report.text_fit import shorten, width_in, wrap
 
 # fontTools says every font it subsets at INFO, some 250 lines an export: noise on the user's terminal
 # (`linpar gui` logs at INFO). Their warnings still show.
@@ -36,7 +37,7 @@ for _chatty in ("fontTools", "matplotlib"):
 
 A4 = (8.27, 11.69)
 MARGIN = 0.7             # inches
-BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT = 8.5, 11.5, 15, 16
+BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT, FOOTER_PT = 8.5, 11.5, 15, 16, 7
 GAP = 1.3            # line height / font size
 EM = 0.56            # DejaVu Sans averages ~0.55 em per character
 # Characters per line of body text across the page.
@@ -102,8 +103,10 @@ class _Pages:
         self.page_no += 1
         self.y = MARGIN
         of = f" of {self.total}" if self.total else ""
-        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], f"{self.footer}   page {self.page_no}{of}", fontsize=7,
-                      color="#666666")
+        page = f"   page {self.page_no}{of}"
+        # The page number is what a footer is for: a long title gives way to it.
+        footer = shorten(self.footer, A4[0] - 2 * MARGIN - width_in(page, FOOTER_PT), FOOTER_PT)
+        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], footer + page, fontsize=FOOTER_PT, color="#666666")
 
     def close(self) -> None:
         if self.fig is not None:
@@ -146,7 +149,7 @@ class _Pages:
                                    linewidth=0.5))
 
     def wrapped(self, s: str, x: float = 0.0, **kw) -> None:
-        for part in textwrap.wrap(s, _chars(A4[0] - 2 * MARGIN - x)) or [""]:
+        for part in wrap(s, A4[0] - 2 * MARGIN - x, BODY_PT, kw.get("weight") == "bold") or [""]:
             self.line(part, x=x, **kw)
 
     def section(self, title: str, rows, key_width: float = 2.0) -> None:
@@ -158,7 +161,7 @@ class _Pages:
 
     @staticmethod
     def _wrap_value(value: str, key_width: float) -> list[str]:
-        return textwrap.wrap(value, _chars(A4[0] - 2 * MARGIN - key_width)) or [""]
+        return wrap(value, A4[0] - 2 * MARGIN - key_width, BODY_PT) or [""]
 
     @staticmethod
     def _own_line(key: str, key_width: float) -> int:
@@ -183,8 +186,8 @@ class _Pages:
         headline = f"QA: {qa.headline}"
         width_pt = TextPath((0, 0), headline, size=VERDICT_PT, prop=FontProperties(weight="bold")).get_extents().width
         left = 0.12 + width_pt / 72 + 0.3
-        width = _chars(A4[0] - 2 * MARGIN - left - 0.1)
-        lines = textwrap.wrap(qa.why, width) + textwrap.wrap(f"limits: {qa.name} ({qa.file})", width)
+        width = A4[0] - 2 * MARGIN - left - 0.1
+        lines = wrap(qa.why, width, BODY_PT) + wrap(f"limits: {qa.name} ({qa.file})", width, BODY_PT)
         height = max(0.5, LINE * len(lines) + 0.2)
         self._room(height + 0.15)
         self.y += 0.05
@@ -326,7 +329,7 @@ def _parameters(pages: _Pages, rows, title: str = "Parameters") -> None:
 def _flow(pages: _Pages, c: ReportContent) -> None:
     """The customer's pages (parameters, model, validity, plots, calibration), then the appendix on a page
     of its own (fit statistics, correlations, the model's internal quantities, residuals, raw settings)."""
-    for part in textwrap.wrap(c.title, int((A4[0] - 2 * MARGIN) * 72 / (TITLE_PT * 0.62))):
+    for part in wrap(c.title, A4[0] - 2 * MARGIN, TITLE_PT, bold=True):
         pages.line(part, TITLE_PT, gap=1.6, weight="bold")
     if c.qa is not None:
         pages.banner(c.qa)

@@ -1,0 +1,50 @@
+"""The PDF report's layout (analysis.report.pdf): names of any length stay inside the page, and every page keeps
+its number."""
+import re
+import subprocess
+
+import pytest
+
+from analysis.archive.results import StoredResult, results_document
+from analysis.pipeline import analyze_recording
+from analysis.report import build_report, write_report
+from tests.builders import TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
+
+A4_WIDTH_PT = 8.27 * 72
+EDGE_PT = 0.3 * 72          # the margins are wider: a word reaching into this strip ran over the margin
+
+
+@pytest.fixture(scope="module")
+def stored():
+    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=9)
+    return StoredResult.from_json(results_document(analyze_recording(rec), rec))
+
+
+def _word_boxes(pdf) -> list[tuple[str, float, float]]:
+    """(word, xMin, xMax) in points of every word pdftotext finds."""
+    text = subprocess.run(["pdftotext", "-bbox", str(pdf), "-"], check=True, capture_output=True, text=True).stdout
+    return [(w, float(x0), float(x1))
+            for x0, x1, w in re.findall(r'<word xMin="([\d.]+)" yMin="[\d.]+" xMax="([\d.]+)" yMax="[\d.]+">([^<]*)'
+                                        r"</word>", text)]
+
+
+# A maker's name with spaces (191 characters) and one of wide capitals without a space to break at (420): the
+# first cut the footer and its page number off the page, the second ran the title and the Driver row past the
+# A4 edge (a line's width was guessed from its number of characters).
+SPACED = " ".join(["Loudspeaker-Fabrik Müller & Söhne GmbH Prototyp"] * 4)
+LONG = "Very long driver name " + "X" * 398
+
+
+@needs_pdftotext
+@pytest.mark.parametrize("driver", [SPACED, LONG], ids=["spaced", "long"])
+def test_a_long_name_stays_inside_the_page_and_every_page_keeps_its_number(stored, tmp_path, driver):
+    pdf = tmp_path / "r.pdf"
+    write_report(build_report(stored, {"driver": driver, "serial": "SN-1"}), pdf=pdf)
+    pages = pdf_text(pdf).split("\f")[:-1]
+    for n, page in enumerate(pages, 1):
+        assert f"page {n} of {len(pages)}" in page
+    outside = [(w, x0, x1) for w, x0, x1 in _word_boxes(pdf) if x0 < EDGE_PT or x1 > A4_WIDTH_PT - EDGE_PT]
+    assert outside == []
+    # The whole name is still there, wrapped, in the title and the Driver row: only the footer shortens it.
+    head = "".join(pages[0].split("Serial number")[0].split()).replace("Driver", "", 1)
+    assert head.count("".join(driver.split())) == 2
