@@ -24,6 +24,7 @@ from matplotlib.patches import Circle, Rectangle
 from matplotlib.textpath import TextPath
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
+from analysis.report.fonts import STAND_IN, drawable, families
 from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
 from analysis.limits import INTERVAL_K
@@ -34,6 +35,9 @@ from analysis.report.text_fit import shorten, width_in, wrap
 # (`linpar gui` logs at INFO). Their warnings still show.
 for _chatty in ("fontTools", "matplotlib"):
     logging.getLogger(_chatty).setLevel(logging.WARNING)
+# The fallback font has no bold: matplotlib warns "Failed to find font weight bold" for each bold line it looks
+# at, and draws its regular weight, which is what the report wants.
+logging.getLogger("matplotlib.font_manager").setLevel(logging.ERROR)
 
 A4 = (8.27, 11.69)
 MARGIN = 0.7             # inches
@@ -43,6 +47,9 @@ EM = 0.56            # DejaVu Sans averages ~0.55 em per character
 # Characters per line of body text across the page.
 WRAP = int((A4[0] - 2 * MARGIN) * 72 / (BODY_PT * EM))
 LINE = BODY_PT * GAP / 72
+# Said once, under the header, when a name holds a character no font of the report's draws (analysis.report.fonts).
+STAND_IN_NOTE = (f"{STAND_IN} stands for a character the fonts of this PDF cannot draw: the HTML report and the "
+                 "data export write the names in full.")
 KEEP_TOGETHER = 2.5      # inches: a shorter section is not split across pages
 PLOT_LEFT = 0.6 * MARGIN        # axis labels sit in the left margin's outer part: plots use the width
 PLOT_SHRINK = 0.8
@@ -89,6 +96,7 @@ class _Pages:
         """pdf None: a dry run that only counts pages (nothing is plotted or saved)."""
         self.pdf, self.footer, self.content, self.page_no = pdf, footer, content, 0
         self.plot_scale, self.total = plot_scale, total
+        self.stood_in = False           # a character was written as STAND_IN
         self.fig: Figure | _DryPage | None = None
         self.y = 0.0
         self.plots: list[tuple[str, float, float]] = []      # (what, top, height) on the current page
@@ -106,7 +114,7 @@ class _Pages:
         page = f"   page {self.page_no}{of}"
         # The page number is what a footer is for: a long title gives way to it.
         footer = shorten(self.footer, A4[0] - 2 * MARGIN - width_in(page, FOOTER_PT), FOOTER_PT)
-        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], footer + page, fontsize=FOOTER_PT, color="#666666")
+        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], drawable(footer + page), fontsize=FOOTER_PT, color="#666666")
 
     def close(self) -> None:
         if self.fig is not None:
@@ -124,7 +132,9 @@ class _Pages:
 
     def text(self, x: float, s: str, size: float = BODY_PT, **kw) -> None:
         """Draw at the current line, x inches from the left margin (the line does not advance)."""
-        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], s, fontsize=size, va="top", **kw)
+        shown = drawable(s)
+        self.stood_in |= shown != s
+        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], shown, fontsize=size, va="top", **kw)
 
     def line(self, s: str = "", size: float = BODY_PT, gap: float = GAP, x: float = 0.0, **kw) -> None:
         height = size * gap / 72
@@ -334,6 +344,8 @@ def _flow(pages: _Pages, c: ReportContent) -> None:
     if c.qa is not None:
         pages.banner(c.qa)
     pages.pairs(c.header, 1.5)
+    if pages.stood_in:
+        pages.wrapped(STAND_IN_NOTE, color="#555555")
     if c.qa is not None:
         _qa_table(pages, c.qa)
     _parameters(pages, c.parameters)
@@ -385,7 +397,7 @@ def _layout(content: ReportContent) -> tuple[float, int]:
 
 def render_pdf(content: ReportContent) -> bytes:
     buf = io.BytesIO()
-    with matplotlib.rc_context(STYLE):
+    with matplotlib.rc_context({**STYLE, "font.family": list(families())}):
         scale, total = _layout(content)
         # No creation date: the same measurement gives the same file.
         with PdfPages(buf, metadata={"Title": content.title, "Creator": "linpar", "CreationDate": None}) as pdf:

@@ -48,3 +48,23 @@ def test_a_long_name_stays_inside_the_page_and_every_page_keeps_its_number(store
     # The whole name is still there, wrapped, in the title and the Driver row: only the footer shortens it.
     head = "".join(pages[0].split("Serial number")[0].split()).replace("Driver", "", 1)
     assert head.count("".join(driver.split())) == 2
+
+
+@needs_pdftotext
+def test_a_name_the_fonts_cannot_draw_gives_no_warning_and_says_once_where_it_is_whole(stored, tmp_path):
+    """A name ending in 日本語 printed matplotlib's "Glyph 26085 missing from font(s) DejaVu Sans" three times on
+    the terminal and drew empty boxes."""
+    import warnings
+    from analysis.report import render_html
+    driver = "Lautsprecher — 日本語 \N{EGYPTIAN HIEROGLYPH A001}"
+    content = build_report(stored, {"driver": driver})
+    pdf = tmp_path / "r.pdf"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        write_report(content, pdf=pdf)
+    from analysis.report.fonts import FALLBACK_FAMILIES, STAND_IN, families
+    text = pdf_text(pdf)
+    cjk = "日本語" if set(families()) & set(FALLBACK_FAMILIES) else STAND_IN * 3
+    assert f"Lautsprecher — {cjk} {STAND_IN}" in text
+    assert text.count("stands for a character the fonts of this PDF cannot draw") == 1
+    assert driver in render_html(content)           # where the note says the name is whole
