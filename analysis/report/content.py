@@ -18,7 +18,7 @@ from analysis.fit.report import fit_report_rows
 from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.customer import (calibration_rows, file_name, model_title, parameter_row_cells,
                                       split_parameters)
-from analysis.report.numbers import format_number, format_std, pretty_unit, readable_number
+from analysis.report.numbers import determined, format_number, format_std, pretty_unit, readable_number
 from analysis.report.qa import LimitRow, QASection, qa_section
 from analysis.validity.result import ResultValidity
 
@@ -64,6 +64,7 @@ class ParameterRow:
     relative: str
     note: str            # why a value is missing
     fitted: bool
+    determined: bool = True     # False: the value reads NOT_DETERMINED (analysis.report.numbers.determined)
 
 
 @dataclass(frozen=True)
@@ -223,7 +224,8 @@ def _rows(parameters) -> tuple[ParameterRow, ...]:
     rows = []
     for p in parameters:
         name, value, std, unit, rel = parameter_row_cells(p)
-        rows.append(ParameterRow(name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted))
+        rows.append(ParameterRow(name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted,
+                                 determined(p)))
     return tuple(rows)
 
 

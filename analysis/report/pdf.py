@@ -28,6 +28,7 @@ from analysis.report.fonts import STAND_IN, drawable, families
 from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
 from analysis.limits import INTERVAL_K
+from analysis.report.numbers import NOT_DETERMINED_NOTE
 from analysis.report.qa import VERDICT_COLOURS, QASection
 from analysis.report.text_fit import shorten, width_in, wrap
 
@@ -334,6 +335,8 @@ def _parameters(pages: _Pages, rows, title: str = "Parameters") -> None:
         pages.text(cols[4], p.relative)
         for part in note_lines or [""]:
             pages.line(part, x=x_note, color="#555555")
+    if not all(p.determined for p in rows):
+        pages.wrapped(NOT_DETERMINED_NOTE, color="#555555")
 
 
 def _flow(pages: _Pages, c: ReportContent) -> None:

@@ -5,19 +5,11 @@ import subprocess
 
 import pytest
 
-from analysis.archive.results import StoredResult, results_document
-from analysis.pipeline import analyze_recording
 from analysis.report import build_report, write_report
-from tests.builders import TYPICAL_NOISE, needs_pdftotext, pdf_text, recording
+from tests.builders import needs_pdftotext, pdf_text
 
 A4_WIDTH_PT = 8.27 * 72
 EDGE_PT = 0.3 * 72          # the margins are wider: a word reaching into this strip ran over the margin
-
-
-@pytest.fixture(scope="module")
-def stored():
-    rec = recording(noise=TYPICAL_NOISE, n_periods=3, seed=9)
-    return StoredResult.from_json(results_document(analyze_recording(rec), rec))
 
 
 def _word_boxes(pdf) -> list[tuple[str, float, float]]:
@@ -68,3 +60,19 @@ def test_a_name_the_fonts_cannot_draw_gives_no_warning_and_says_once_where_it_is
     assert f"Lautsprecher — {cjk} {STAND_IN}" in text
     assert text.count("stands for a character the fonts of this PDF cannot draw") == 1
     assert driver in render_html(content)           # where the note says the name is whole
+
+
+@needs_pdftotext
+def test_a_parameter_the_data_do_not_determine_reads_so_with_one_line_under_the_table(stored, undetermined_qms,
+                                                                                     tmp_path):
+    pdf = tmp_path / "r.pdf"
+    write_report(build_report(undetermined_qms, {}), pdf=pdf)
+    customer = pdf_text(pdf).split("Appendix")[0]
+    assert re.search(r"^\s*Qms\s+not determined\s+[\d.]+\s+400 %", customer, re.M)
+    from analysis.report.numbers import NOT_DETERMINED_NOTE
+    table = customer.split("Parameters")[1].split("Model")[0]
+    assert table.count("not determined") == 2 and " ".join(NOT_DETERMINED_NOTE.split()) in " ".join(table.split())
+    assert re.search(r"^\s*Qts\s+\d", customer, re.M)          # the others are numbers, and no note for them
+    plain = tmp_path / "plain.pdf"
+    write_report(build_report(stored, {}), pdf=plain)
+    assert "not determined" not in pdf_text(plain)
