@@ -51,10 +51,11 @@ def band_text(validity, channel: str) -> str:
     """" (14.6-915 Hz)": the band a channel's fit error was measured over, from a result's validity
     (analysis.validity.result.ResultValidity; None: no band), or ""."""
     band = ((validity.fit_band_hz if validity is not None else None) or {}).get(channel)
-    return f" ({_hz(band[0])}-{_hz(band[1])} Hz)" if band else ""
+    return f" ({hz_text(band[0])}-{hz_text(band[1])} Hz)" if band else ""
 
 
-def _hz(f: float) -> str:
+def hz_text(f: float) -> str:
+    """A frequency in Hz without its unit: "14.6", "915", "20000" (never "2e+04")."""
     return f"{f:.3g}" if f < 1000 else f"{f:.0f}"
 
 

@@ -13,12 +13,12 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from analysis.archive.results import StoredResult
-from analysis.fit.error import band_text
+from analysis.fit.error import band_text, hz_text
 from analysis.fit.report import fit_report_rows
 from analysis.fit.methods import DEFAULT_METHOD, METHODS
 from analysis.report.customer import (calibration_rows, file_name, model_title, parameter_row_cells,
                                       split_parameters)
-from analysis.report.numbers import format_number, format_std, pretty_unit, readable_number
+from analysis.report.numbers import determined, format_number, format_std, pretty_unit, readable_number
 from analysis.report.qa import LimitRow, QASection, qa_section
 from analysis.validity.result import ResultValidity
 
@@ -64,6 +64,7 @@ class ParameterRow:
     relative: str
     note: str            # why a value is missing
     fitted: bool
+    determined: bool = True     # False: the value reads NOT_DETERMINED (analysis.report.numbers.determined)
 
 
 @dataclass(frozen=True)
@@ -128,10 +129,16 @@ def uncertainty_parts(p) -> str:
                      for std, what in ((p.std_noise, "noise"), (p.std_model, "model")) if std is not None)
 
 
-def _method_text(name) -> str:
-    """The identification method's name and what it does (results stored before methods had a name: joint)."""
-    name = name or DEFAULT_METHOD
-    return f"{name}: {METHODS[name]}" if name in METHODS else str(name)
+def _method_text(result: StoredResult) -> str:
+    """The identification method's name and what it did (results stored before methods had a name: joint). The
+    joint fit's words say what it had: Z alone when there was no Hx, and for imported curves each line's noise
+    estimated from its curve's scatter (analysis.curves.noise), where a recording's is measured."""
+    name = result.model_info.get("method") or DEFAULT_METHOD
+    if name != "joint" or name not in METHODS:
+        return f"{name}: {METHODS[name]}" if name in METHODS else str(name)
+    fitted = "Z and Hx fitted together" if result.with_displacement else "Z fitted alone"
+    noise = "its noise" if result.validity.imported is None else "the noise estimated from its curve's scatter"
+    return f"{name}: {fitted}, each line weighted by {noise}"
 
 
 def _chi2_text(info: Mapping) -> str:
@@ -172,7 +179,7 @@ def _fit_rows(result: StoredResult) -> tuple[tuple[str, str], ...]:
         return ()
     info = result.model_info
     effects = ", ".join(_effect_title(e, result) for e in result.effects) or "none (the textbook lumped model)"
-    rows = [("Effects", effects), ("Method", _method_text(info.get("method")))] + _user_effect_rows(result)
+    rows = [("Effects", effects), ("Method", _method_text(result))] + _user_effect_rows(result)
     for channel, value in (info.get("chi2_red") or {}).items():
         rows.append((f"Reduced χ² ({channel})", format_number(value) if value is not None else "n/a"))
     for key, label in (("aic", "AIC"), ("bic", "BIC")):
@@ -207,7 +214,7 @@ def _settings_rows(settings: Mapping) -> tuple[tuple[str, str], ...]:
             text = ", ".join(value)
         elif (key.endswith("_band_hz") and isinstance(value, list) and len(value) == 2
               and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)):
-            text = " – ".join(f"{v:.4g}" for v in value)
+            text = " – ".join(hz_text(v) for v in value)
         elif isinstance(value, (Mapping, list)):
             flat: list[tuple[str, str]] = []
             _flatten(key, value, flat)
@@ -223,7 +230,8 @@ def _rows(parameters) -> tuple[ParameterRow, ...]:
     rows = []
     for p in parameters:
         name, value, std, unit, rel = parameter_row_cells(p)
-        rows.append(ParameterRow(name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted))
+        rows.append(ParameterRow(name, value, std, unit, rel, p.reason or uncertainty_parts(p), p.fitted,
+                                 determined(p)))
     return tuple(rows)
 
 
@@ -260,7 +268,8 @@ def build_report(result: StoredResult, header: Mapping[str, Any], settings: Mapp
         header=head, overall=result.overall, lights=_lights(result.validity), peak_displacement=peak_text,
         parameters=_rows(customer), model=_model_rows(result),
         settings=_settings_rows({**dict(result.settings), **dict(settings or {})}),
-        calibration=calibration_rows(calibration), result=result, notes=tuple(notes),
+        calibration=calibration_rows(calibration, imported=result.validity.imported is not None),
+        result=result, notes=tuple(notes),
         qa=None if limits is None else qa_section(limits, result.parameters, result.validity),
         internal=_rows(internal), fit=_fit_rows(result), calibration_detail=tuple(cal))
 

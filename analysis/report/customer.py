@@ -69,9 +69,14 @@ def _g(x: float) -> str:
     return f"{x:.4g}"
 
 
-def calibration_rows(calibration: Mapping | None) -> tuple[tuple[str, str], ...]:
+IMPORTED_CALIBRATION = "imported curves, read from a file: calibrated by whoever measured them, not by this workstation"
+
+
+def calibration_rows(calibration: Mapping | None, imported: bool = False) -> tuple[tuple[str, str], ...]:
     """A short table in words: what full scale means on each channel, with how it was got (the raw keys are
-    in the appendix)."""
+    in the appendix). Imported curves have no calibration of ours to say: someone else's instrument measured them."""
+    if imported:
+        return (("Calibration", IMPORTED_CALIBRATION),)
     n: dict[str, float] = {}
     _calibration_numbers(dict(calibration or {}), n)
     rows = []

@@ -8,6 +8,7 @@ from __future__ import annotations
 from html import escape
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
+from analysis.report.numbers import NOT_DETERMINED_NOTE
 from analysis.report.plots import figures, svg_of
 from analysis.limits import INTERVAL_K
 from analysis.report.qa import VERDICT_COLOURS, QASection
@@ -78,6 +79,8 @@ def _parameter_table(title: str, rows) -> str:
                      f"<td class='num'>{escape(p.std)}</td><td>{escape(p.unit)}</td>"
                      f"<td class='num'>{escape(p.relative)}</td><td>{escape(p.note)}</td></tr>")
     parts.append("</table>")
+    if not all(p.determined for p in rows):
+        parts.append(f"<p class='note'>{escape(NOT_DETERMINED_NOTE)}</p>")
     return "".join(parts)
 
 

@@ -77,13 +77,34 @@ def format_std(std: float | None) -> str:
     return f"{rounded:.{max(0, decimals)}f}"
 
 
+def percent_text(percent: float) -> str:
+    """A relative uncertainty written as its sigma is: two significant digits, a trailing zero kept ("3.0 %" in
+    the column of "2.8 %", not "3 %"), a power of ten below 1e-4 %."""
+    return f"{format_std(percent) if percent >= 1e-4 else readable_number(percent)} %"
+
+
+NOT_DETERMINED = "not determined"
+NOT_DETERMINED_NOTE = ("not determined: the 1σ is at least the value itself (100 % or more): the data do not fix "
+                       "this parameter.")
+
+
+def determined(p: ParameterValue) -> bool:
+    """False when the parameter's 1-sigma is at least its value: "6 ± 25" is as much 0 or 30 as 6, and a number
+    printed alone would be read as a measured one. A level in dB has no relative uncertainty to judge by."""
+    if p.value is None or p.std is None or math.isnan(p.std) or p.display_unit.startswith("dB"):
+        return True
+    return p.std < abs(p.value)
+
+
 def parameter_cells(p: ParameterValue) -> tuple[str, str, str, str]:
-    """(value, 1-sigma, unit, relative uncertainty) in customary units."""
+    """(value, 1-sigma, unit, relative uncertainty) in customary units; the value NOT_DETERMINED when the data do
+    not determine it (determined)."""
     if p.value is None:
         return "n/a", "", pretty_unit(p.display_unit), ""
     v = p.value * p.display_scale
     s = None if p.std is None else p.std * abs(p.display_scale)
     # A relative uncertainty of a level in dB means nothing: its std in dB already is one.
     relative_ok = s is not None and v != 0 and math.isfinite(s) and not p.display_unit.startswith("dB")
-    rel = f"{readable_number(100 * s / abs(v))} %" if relative_ok else ""
-    return format_number(v, s), format_std(s), pretty_unit(p.display_unit), rel
+    rel = percent_text(100 * s / abs(v)) if relative_ok else ""
+    value = format_number(v, s) if determined(p) else NOT_DETERMINED
+    return value, format_std(s), pretty_unit(p.display_unit), rel

@@ -24,24 +24,33 @@ from matplotlib.patches import Circle, Rectangle
 from matplotlib.textpath import TextPath
 
 from analysis.report.content import CHANNEL_TITLES, ReportContent
+from analysis.report.fonts import STAND_IN, drawable, families
 from analysis.report.html import LIGHT_COLOURS
 from analysis.report.plots import STYLE, draw_hx, draw_impedance, draw_residuals, draw_spl
 from analysis.limits import INTERVAL_K
+from analysis.report.numbers import NOT_DETERMINED_NOTE
 from analysis.report.qa import VERDICT_COLOURS, QASection
+from analysis.report.text_fit import shorten, width_in, wrap
 
 # fontTools says every font it subsets at INFO, some 250 lines an export: noise on the user's terminal
 # (`linpar gui` logs at INFO). Their warnings still show.
 for _chatty in ("fontTools", "matplotlib"):
     logging.getLogger(_chatty).setLevel(logging.WARNING)
+# The fallback font has no bold: matplotlib warns "Failed to find font weight bold" for each bold line it looks
+# at, and draws its regular weight, which is what the report wants.
+logging.getLogger("matplotlib.font_manager").setLevel(logging.ERROR)
 
 A4 = (8.27, 11.69)
 MARGIN = 0.7             # inches
-BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT = 8.5, 11.5, 15, 16
+BODY_PT, HEAD_PT, TITLE_PT, VERDICT_PT, FOOTER_PT = 8.5, 11.5, 15, 16, 7
 GAP = 1.3            # line height / font size
 EM = 0.56            # DejaVu Sans averages ~0.55 em per character
 # Characters per line of body text across the page.
 WRAP = int((A4[0] - 2 * MARGIN) * 72 / (BODY_PT * EM))
 LINE = BODY_PT * GAP / 72
+# Said once, under the header, when a name holds a character no font of the report's draws (analysis.report.fonts).
+STAND_IN_NOTE = (f"{STAND_IN} stands for a character the fonts of this PDF cannot draw: the HTML report and the "
+                 "data export write the names in full.")
 KEEP_TOGETHER = 2.5      # inches: a shorter section is not split across pages
 PLOT_LEFT = 0.6 * MARGIN        # axis labels sit in the left margin's outer part: plots use the width
 PLOT_SHRINK = 0.8
@@ -88,6 +97,7 @@ class _Pages:
         """pdf None: a dry run that only counts pages (nothing is plotted or saved)."""
         self.pdf, self.footer, self.content, self.page_no = pdf, footer, content, 0
         self.plot_scale, self.total = plot_scale, total
+        self.stood_in = False           # a character was written as STAND_IN
         self.fig: Figure | _DryPage | None = None
         self.y = 0.0
         self.plots: list[tuple[str, float, float]] = []      # (what, top, height) on the current page
@@ -102,8 +112,10 @@ class _Pages:
         self.page_no += 1
         self.y = MARGIN
         of = f" of {self.total}" if self.total else ""
-        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], f"{self.footer}   page {self.page_no}{of}", fontsize=7,
-                      color="#666666")
+        page = f"   page {self.page_no}{of}"
+        # The page number is what a footer is for: a long title gives way to it.
+        footer = shorten(self.footer, A4[0] - 2 * MARGIN - width_in(page, FOOTER_PT), FOOTER_PT)
+        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], drawable(footer + page), fontsize=FOOTER_PT, color="#666666")
 
     def close(self) -> None:
         if self.fig is not None:
@@ -121,7 +133,9 @@ class _Pages:
 
     def text(self, x: float, s: str, size: float = BODY_PT, **kw) -> None:
         """Draw at the current line, x inches from the left margin (the line does not advance)."""
-        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], s, fontsize=size, va="top", **kw)
+        shown = drawable(s)
+        self.stood_in |= shown != s
+        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], shown, fontsize=size, va="top", **kw)
 
     def line(self, s: str = "", size: float = BODY_PT, gap: float = GAP, x: float = 0.0, **kw) -> None:
         height = size * gap / 72
@@ -146,7 +160,7 @@ class _Pages:
                                    linewidth=0.5))
 
     def wrapped(self, s: str, x: float = 0.0, **kw) -> None:
-        for part in textwrap.wrap(s, _chars(A4[0] - 2 * MARGIN - x)) or [""]:
+        for part in wrap(s, A4[0] - 2 * MARGIN - x, BODY_PT, kw.get("weight") == "bold") or [""]:
             self.line(part, x=x, **kw)
 
     def section(self, title: str, rows, key_width: float = 2.0) -> None:
@@ -158,7 +172,7 @@ class _Pages:
 
     @staticmethod
     def _wrap_value(value: str, key_width: float) -> list[str]:
-        return textwrap.wrap(value, _chars(A4[0] - 2 * MARGIN - key_width)) or [""]
+        return wrap(value, A4[0] - 2 * MARGIN - key_width, BODY_PT) or [""]
 
     @staticmethod
     def _own_line(key: str, key_width: float) -> int:
@@ -183,8 +197,8 @@ class _Pages:
         headline = f"QA: {qa.headline}"
         width_pt = TextPath((0, 0), headline, size=VERDICT_PT, prop=FontProperties(weight="bold")).get_extents().width
         left = 0.12 + width_pt / 72 + 0.3
-        width = _chars(A4[0] - 2 * MARGIN - left - 0.1)
-        lines = textwrap.wrap(qa.why, width) + textwrap.wrap(f"limits: {qa.name} ({qa.file})", width)
+        width = A4[0] - 2 * MARGIN - left - 0.1
+        lines = wrap(qa.why, width, BODY_PT) + wrap(f"limits: {qa.name} ({qa.file})", width, BODY_PT)
         height = max(0.5, LINE * len(lines) + 0.2)
         self._room(height + 0.15)
         self.y += 0.05
@@ -321,16 +335,20 @@ def _parameters(pages: _Pages, rows, title: str = "Parameters") -> None:
         pages.text(cols[4], p.relative)
         for part in note_lines or [""]:
             pages.line(part, x=x_note, color="#555555")
+    if not all(p.determined for p in rows):
+        pages.wrapped(NOT_DETERMINED_NOTE, color="#555555")
 
 
 def _flow(pages: _Pages, c: ReportContent) -> None:
     """The customer's pages (parameters, model, validity, plots, calibration), then the appendix on a page
     of its own (fit statistics, correlations, the model's internal quantities, residuals, raw settings)."""
-    for part in textwrap.wrap(c.title, int((A4[0] - 2 * MARGIN) * 72 / (TITLE_PT * 0.62))):
+    for part in wrap(c.title, A4[0] - 2 * MARGIN, TITLE_PT, bold=True):
         pages.line(part, TITLE_PT, gap=1.6, weight="bold")
     if c.qa is not None:
         pages.banner(c.qa)
     pages.pairs(c.header, 1.5)
+    if pages.stood_in:
+        pages.wrapped(STAND_IN_NOTE, color="#555555")
     if c.qa is not None:
         _qa_table(pages, c.qa)
     _parameters(pages, c.parameters)
@@ -382,7 +400,7 @@ def _layout(content: ReportContent) -> tuple[float, int]:
 
 def render_pdf(content: ReportContent) -> bytes:
     buf = io.BytesIO()
-    with matplotlib.rc_context(STYLE):
+    with matplotlib.rc_context({**STYLE, "font.family": list(families())}):
         scale, total = _layout(content)
         # No creation date: the same measurement gives the same file.
         with PdfPages(buf, metadata={"Title": content.title, "Creator": "linpar", "CreationDate": None}) as pdf:

@@ -46,7 +46,7 @@ def test_the_report_overlays_the_exports_fit_and_says_how_far_apart_the_fits_are
     back, header, _ = stored
     content = build_report(back, header)
     rows = dict(content.model)
-    assert dict(content.settings)["Impedance fitted"] == "2 – 225.5 Hz"
+    assert dict(content.settings)["Impedance fitted"] == "2 – 225 Hz"       # as the Model rows write a band
     for name in ("impedance", "displacement"):
         row = rows[f"The export's fit ({name})"]
         assert "fit error" in row and "rms from linpar's fitted curve" in row
