@@ -115,7 +115,8 @@ class _Pages:
         page = f"   page {self.page_no}{of}"
         # The page number is what a footer is for: a long title gives way to it.
         footer = shorten(self.footer, A4[0] - 2 * MARGIN - width_in(page, FOOTER_PT), FOOTER_PT)
-        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], drawable(footer + page), fontsize=FOOTER_PT, color="#666666")
+        self.fig.text(MARGIN / A4[0], 0.4 / A4[1], drawable(footer + page), fontsize=FOOTER_PT, color="#666666",
+                      parse_math=False)
 
     def close(self) -> None:
         if self.fig is not None:
@@ -135,7 +136,9 @@ class _Pages:
         """Draw at the current line, x inches from the left margin (the line does not advance)."""
         shown = drawable(s)
         self.stood_in |= shown != s
-        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], shown, fontsize=size, va="top", **kw)
+        # parse_math=False: a name holding two "$" is text, not a formula for matplotlib to typeset.
+        self.fig.text((MARGIN + x) / A4[0], 1 - self.y / A4[1], shown, fontsize=size, va="top", parse_math=False,
+                      **kw)
 
     def line(self, s: str = "", size: float = BODY_PT, gap: float = GAP, x: float = 0.0, **kw) -> None:
         height = size * gap / 72

@@ -76,3 +76,12 @@ def test_a_parameter_the_data_do_not_determine_reads_so_with_one_line_under_the_
     plain = tmp_path / "plain.pdf"
     write_report(build_report(stored, {}), pdf=plain)
     assert "not determined" not in pdf_text(plain)
+
+
+@needs_pdftotext
+def test_a_name_with_dollar_signs_is_printed_as_typed_not_typeset_as_a_formula(stored, tmp_path):
+    """matplotlib reads text between two "$" as mathtext: "W$x^2$" would be drawn as W and x squared."""
+    pdf = tmp_path / "r.pdf"
+    write_report(build_report(stored, {"driver": "W$x^2$ $5 woofer", "serial": "SN$1$"}), pdf=pdf)
+    text = pdf_text(pdf)
+    assert "W$x^2$ $5 woofer" in text and "SN$1$" in text
