@@ -93,12 +93,21 @@ class Recording:
         return self.n_samples / self.sample_rate
 
 
+def not_a_folder(path: str | Path) -> None:
+    """RecordingError when `path` is a folder: read as a stem, FOLDER.wav and FOLDER.json were said missing."""
+    if Path(path).is_dir():
+        held = len(list(Path(path).glob("*.wav")))
+        raise RecordingError(f"{path}: a folder, not a recording: give one recording in it (NAME, NAME.wav or "
+                             f"NAME.json){'; it holds ' + str(held) + ' WAV file(s)' if held else ''}")
+
+
 def read_recording(path: str | Path) -> Recording:
     """Read NAME.wav + NAME.json; `path` is the stem, NAME.wav or NAME.json.
 
     Every rule of the format is checked; a file that breaks one raises
     RecordingError and nothing is returned.
     """
+    not_a_folder(path)
     wav_path, json_path = recording_paths(path)
     # A FIFO, folder or device is named as what it is; a file beyond its size limit is refused unread.
     regular_file(json_path, "sidecar", f"the sidecar of the recording next to {wav_path.name}", RecordingError)

@@ -59,7 +59,7 @@ def load_curves(args: argparse.Namespace):
         used = [f"--{n.replace('_', '-')}" for n in CURVE_ONLY if getattr(args, n)]
         raise CliError(f"{', '.join(used)}: for imported curves only (--impedance/--uiv), not for a recording")
     if not (args.impedance or args.uiv or args.hx):
-        raise CliError("analyze needs a recording path (NAME, NAME.wav or NAME.json) or curves: "
+        raise CliError(f"{args.command} needs a recording path (NAME, NAME.wav or NAME.json) or curves: "
                        "--impedance FILE [--hx FILE] or --uiv FILE")
     if args.path:
         raise CliError("give either a recording PATH or imported curves (--impedance/--uiv), not both")

@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"  {e.id:<22} {e.title} ({_parameters_text(e)})")
             print(f"  {'':<22} cures: {e.signature}")
     print(f"[effects of your own] (folder: {registry.user_folder()})")
-    if not users:
+    if not users and not getattr(args, "effect_problems", []):     # a file that could not be read: said below
         print("  none: write a TOML file there, or give --effects-file FILE (docs/effects.md)")
     for e in users:
         formula = getattr(e, "formula", None)

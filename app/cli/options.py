@@ -115,8 +115,11 @@ def model_effects(text: str | None, option: str = "--model"):
     ModelError that names the option."""
     if text is None:
         return None
-    from analysis.effects import UnknownEffectError, parse_effects
     from analysis.model.composed import ModelError
+    if not text.replace(",", "").strip():      # an unset shell variable ($MODEL) must not fit the textbook model
+        raise ModelError(f"{option}: empty: give effect ids separated by commas ('linpar effects' lists them), or "
+                         "'none' for the textbook model")
+    from analysis.effects import UnknownEffectError, parse_effects
     try:
         return parse_effects(text)
     except UnknownEffectError as exc:

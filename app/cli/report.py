@@ -61,11 +61,12 @@ def _is_recording(text: str) -> bool:
 
 
 def _not_a_file(source: str) -> None:
-    """CliError when SOURCE names a file that is no recording: half of one, or a curve of another tool (which
-    the archive's "not a measurement id" would have answered)."""
+    """CliError when SOURCE names a file that is no recording: half of one, or a curve of another tool; a folder
+    (RecordingError): the archive's "not a measurement id" would have answered each."""
     from pathlib import Path
 
-    from analysis.recording.format import recording_paths
+    from analysis.recording.format import not_a_folder, recording_paths
+    not_a_folder(source)
     if not Path(source).is_file():
         return
     wav, sidecar = recording_paths(source)

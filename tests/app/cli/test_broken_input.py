@@ -180,3 +180,18 @@ def test_frequencies_near_1e308_in_an_imported_curve_are_refused(capsys, tmp_pat
     assert code == 2 and out == ""
     assert "huge.zma: line 3: frequency 1e+300: expected a frequency: a number from 0.01 to 1e+06 Hz" in \
         one_line(err)
+
+
+@pytest.mark.parametrize("command", ["analyze", "report", "diagnose", "stats"])
+def test_a_folder_of_recordings_is_named_a_folder_with_what_it_holds(capsys, tmp_path, command):
+    """`analyze FOLDER` read it as the stem of FOLDER.wav and said 'FOLDER.json: missing ... next to FOLDER.wav'."""
+    write_recording(tmp_path / "rec", recording(noise=TYPICAL_NOISE, n_periods=3, seed=2))
+    extra = ("--pdf", tmp_path / "r.pdf") if command == "report" else ()
+    code, out, err = run(capsys, command, tmp_path, *extra)
+    line = one_line(err)
+    assert code == 2 and f"{tmp_path}: a folder, not a recording" in line and "it holds 1 WAV file(s)" in line
+
+
+def test_diagnose_without_a_path_names_itself_not_analyze(capsys):
+    code, out, err = run(capsys, "diagnose")
+    assert code == 2 and one_line(err).startswith("linpar: error: diagnose needs a recording path")

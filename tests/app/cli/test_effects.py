@@ -87,6 +87,7 @@ def test_each_bad_file_exits_2_with_one_line(capsys, tmp_path, rms_recording, co
     assert err.startswith(f"linpar: error: {bad}: ") and err.count("\n") == 1, err
     assert words in err
     assert "Traceback" not in err and not (tmp_path / "r.html").exists()
+    assert "none: write a TOML file there" not in out         # the file is there: the error says what is wrong
 
 
 def test_a_bad_file_in_the_user_folder_is_named_too(capsys, tmp_path, monkeypatch):
