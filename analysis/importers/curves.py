@@ -6,6 +6,8 @@ uncertainties from the scatter of the residual.
 """
 from __future__ import annotations
 
+import dataclasses
+
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -103,8 +105,12 @@ def curve_from_table(table: Table, kind: str, phase: str | None = None, unit: st
     si_unit, value_name = KINDS[kind]
     columns = assign_columns(table, value_name)
     freqs = table.values[:, columns.frequency]
-    check_frequencies(table, freqs)
     notes: list[str] = []
+    if freqs.size > 1 and np.all(np.diff(freqs) < 0):       # written from the top of the band down: read it turned
+        table = dataclasses.replace(table, values=table.values[::-1], lines=table.lines[::-1])
+        freqs = freqs[::-1]
+        notes.append("frequencies descending in the file: read from its last line up")
+    check_frequencies(table, freqs)
     if columns.is_complex:
         value = table.values[:, columns.real] + 1j * table.values[:, columns.imag]
         _check_positive(table, np.abs(value), f"|{value_name.split()[0].strip('|')}|")
@@ -167,7 +173,8 @@ def check_frequencies(table: Table, freqs: np.ndarray) -> None:
     if steps.size:
         i = steps[0] + 1
         raise table.error(int(table.lines[i]), f"frequency {freqs[i]:g} Hz is not above the previous line's "
-                          f"{freqs[i - 1]:g} Hz: expected strictly increasing frequencies")
+                          f"{freqs[i - 1]:g} Hz: expected strictly increasing frequencies (sort the file by "
+                          "frequency and remove repeated lines)")
 
 
 def _check_positive(table: Table, values: np.ndarray, what: str) -> None:

@@ -117,6 +117,15 @@ def test_a_comment_that_quotes_milliohm_leaves_the_column_in_ohm(tmp_path):
     assert_curve(curve.transfer)
 
 
+def test_a_table_written_from_the_top_of_the_band_down_is_read_turned_with_a_note(tmp_path):
+    descending = "\n".join(rows().strip().splitlines()[::-1]) + "\n"
+    curve = read_curve(write(tmp_path, descending), "impedance")
+    assert_curve(curve.transfer)
+    assert any("descending" in n for n in curve.notes)
+    with pytest.raises(ImportFormatError, match="sort the file by frequency"):
+        read_curve(write(tmp_path, rows() + "20 7.0 1\n", "dup.txt"), "impedance")
+
+
 def test_hx_phase_may_be_unwrapped(tmp_path):
     body = "\n".join(f"{f} 1e-4 {p}" for f, p in zip(F, [-10, -90, -200, -400, -700]))
     assert read_hx(write(tmp_path, body)).has_phase
