@@ -61,8 +61,9 @@ MISFIT_REMEDY = ("find the effect the model lacks (the Model lab, or 'linpar dia
 # Imported curves (validity.imported) have no wiring and no channels' findings, and the Model lab works on recordings
 # only: what is left to look at is the file.
 CURVES_MISFIT_REMEDY = ("find the effect the model lacks ('linpar diagnose' on the same files) and fit again with it; "
-                        "if no effect helps, check what the file holds: a band from well below fs, the phase in the "
-                        "unit it was read in, the measured (not a fitted) curve")
+                        "or fit the band the model holds in (--fmax, e.g. 10 x fs: a voice coil far above fs needs "
+                        "more than the catalogue's inductance); if neither helps, check what the file holds: a band "
+                        "from well below fs, the phase in the unit it was read in, the measured (not a fitted) curve")
 
 
 @dataclass(frozen=True, slots=True)
