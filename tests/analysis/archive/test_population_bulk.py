@@ -130,12 +130,14 @@ def _back_to_the_schema_without_columns(archive_and_connection, request) -> None
         return
     with request.getfixturevalue("pg_database").admin() as conn:
         conn.execute(f"ALTER TABLE linpar.measurements {', '.join(drops)}")
-        conn.execute(WITHOUT_THE_AUDIT_TRAIL)          # version 3's, which setup then adds again
+        conn.execute(WITHOUT_THE_AUDIT_TRAIL)          # versions 3 and 4's, which setup then adds again
         conn.execute("UPDATE linpar.schema_version SET version = 1")
 
 
-# What the audit migration (analysis/archive/pg/audit.py, schema version 3) adds, taken away again.
+# What the audit migrations (analysis/archive/pg/audit.py, schema versions 3 and 4) add, taken away again.
 WITHOUT_THE_AUDIT_TRAIL = """
+ALTER TABLE linpar.measurements DROP CONSTRAINT names_without_bidi_controls;
+ALTER TABLE linpar.limits_versions DROP CONSTRAINT name_without_bidi_controls;
 DROP TRIGGER stamp ON linpar.measurements; DROP TRIGGER stamp ON linpar.limits_versions;
 DROP TRIGGER stamp ON linpar.golden_units; DROP TRIGGER own ON linpar.parameters;
 DROP FUNCTION linpar.stamp_measurement(), linpar.stamp_limits_version(), linpar.stamp_golden_unit(),
