@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Callable
 
-from analysis.diagnosis import acceptance, jobs, noise_floor, pairs, residuals
+from analysis.diagnosis import acceptance, determined, jobs, noise_floor, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.diagnosis.sites import SiteResult, first_among_tied, fit_site, localise, usable_sites
 from analysis.diagnosis.starts import best_starts, residual_context, same_compliance_at_fs, screen_calls
@@ -219,7 +219,7 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
             outcomes[index] = (fit, error)
         calls_left[index] -= 1
         if calls_left[index] == 0:
-            judged[index] = _judged(current, moves[index], *outcomes[index])
+            judged[index] = _judged(data, current, moves[index], *outcomes[index])
             if passing is not None and judged[index].accepted:
                 passing(judged[index].effect.site)
     candidates = [judged[index] for index in range(len(moves))]
@@ -227,13 +227,16 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
 
 
-def _judged(current: FitResult, move, fit: FitResult | None, error: str | None) -> Candidate:
-    """A single candidate, flagged and assessed by rules 1 and 2."""
+def _judged(data: FitData, current: FitResult, move, fit: FitResult | None, error: str | None) -> Candidate:
+    """A single candidate, flagged and assessed by rules 1 and 2 (its own parameters judged determined or not
+    with those of the others the data do not fix held: analysis.diagnosis.determined)."""
     action, effect, replaces, _ = move
+    fit = determined.with_undetermined_held(data, fit, effect.param_names)
     flags = acceptance.candidate_flags(current, fit, effect)
     return Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
                      delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
-                     flags=flags, assessment=acceptance.assess(current, fit, effect, flags))
+                     flags=flags, assessment=acceptance.assess(
+                         current, fit, effect, flags, simplifying=acceptance.simplifies(current, fit, replaces)))
 
 
 class _SiteFits:
@@ -274,7 +277,8 @@ def choose(current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
     for c in ranked:
         if c.accepted:
             site = sites.done[c.effect.site]
-            c = dataclasses.replace(c, assessment=acceptance.assess(current, c.fit, c.judged, c.flags, site))
+            c = dataclasses.replace(c, assessment=acceptance.assess(
+                current, c.fit, c.judged, c.flags, site, simplifying=acceptance.simplifies(current, c.fit, c.replaces)))
         judged.append(c)
     chosen = next((c for c in judged if c.accepted), None)
     return tuple(judged), chosen
@@ -313,7 +317,7 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     diagnosis then ends at the candidate the path would take (Diagnosis.final), nothing is
     adopted. locate=False skips the site localisation of the final model.
     """
-    current = start_fit or fit_model(data, start_model, cancel=cancel)
+    current = determined.with_undetermined_held(data, start_fit or fit_model(data, start_model, cancel=cancel))
     steps: list[Step] = []
     capped = False
     while True:

@@ -3,7 +3,7 @@
 Every candidate's refit (about 40 of them) is most of a diagnosis's time,
 and on a model that already explains the measurement down to its noise it
 only confirms that no effect pays for itself. The path ends there, without
-them, when both hold:
+them, when all three hold:
 
 1. every channel's chi^2 is within chance of its noise: chi^2_c <= m_c +
    3 sqrt(2 m_c) for the m_c values of channel c (chi^2 with m_c degrees of
@@ -11,7 +11,13 @@ them, when both hold:
 2. no site's smooth correction (analysis.diagnosis.sites) removes more than
    its own flexibility takes from noise alone: fitting pure noise with edf
    effective parameters lowers chi^2 by about edf, standard deviation
-   sqrt(2 edf), so a drop above edf + 3 sqrt(2 edf) is structure.
+   sqrt(2 edf), so a drop above edf + 3 sqrt(2 edf) is structure;
+3. no parameter of the model is undetermined or on a bound. Such a
+   parameter says an effect of the model has become superfluous (LR-3's
+   second stage once a creep law explains what it had bent towards), which
+   the path mends by swapping it for a simpler one of its category (LR-3
+   for LR-2): at the noise floor that swap pays by the parameters it saves,
+   so the path must rank the candidates once more to take it.
 
 The sites' corrections are the ones the diagnosis reports at its end, so
 the check costs nothing a diagnosis did not already compute. What it gives
@@ -23,6 +29,7 @@ for on a model already at its noise floor, and the words say so.
 """
 from __future__ import annotations
 
+from analysis.diagnosis import acceptance
 from analysis.diagnosis.chance import CHANCE_SIGMAS, within_chance  # noqa: F401 (the tests use them here)
 from analysis.diagnosis.sites import SiteResult
 from analysis.fit.least_squares import FitResult
@@ -39,9 +46,16 @@ def channels_at_noise(fit: FitResult) -> bool:
 
 
 def nothing_to_find(fit: FitResult, sites: dict) -> bool:
-    """Rules 1 and 2: the model meets the noise, and no site's correction (`sites`, by site: all the usable
-    sites' results for `fit`) removes more than noise would."""
-    return channels_at_noise(fit) and all(_noise_only(fit, s) for s in sites.values())
+    """Rules 1 to 3: the model meets the noise, no site's correction (`sites`, by site: all the usable sites'
+    results for `fit`) removes more than noise would, and no effect of the model looks superfluous."""
+    return channels_at_noise(fit) and all(_noise_only(fit, s) for s in sites.values()) \
+        and not superfluous_parameters(fit)
+
+
+def superfluous_parameters(fit: FitResult) -> list[str]:
+    """Rule 3: the parameters undetermined or on a bound (their effect may have nothing left to do)."""
+    return [f.parameter for f in acceptance.parameter_flags(fit, typical=False)
+            if f.code in (acceptance.UNDETERMINED, acceptance.AT_BOUND)]
 
 
 def _noise_only(fit: FitResult, site: SiteResult) -> bool:
