@@ -36,8 +36,12 @@ from analysis.fit.least_squares import FitResult
 
 
 SKIPPED_WORDS = ("No candidate was refitted: the model meets the noise on every channel and no site's smooth "
-                 "correction removes more than noise would, so no effect of the catalogue has anything to "
-                 "explain (one whose whole effect is within the noise is not looked for).")
+                 "correction removes more than noise would, so no effect, of the catalogue or of your own, has "
+                 "anything to explain (one whose whole effect is within the noise is not looked for).")
+# The same, said of a path that took steps before it met the noise: what it took did the explaining.
+ENDED_WORDS = ("The path ended there without refitting the candidates again: the model meets the noise on every "
+               "channel and no site's smooth correction removes more than noise would, so nothing is left to "
+               "explain (an effect whose whole effect is within the noise is not looked for).")
 
 
 def channels_at_noise(fit: FitResult) -> bool:

@@ -64,6 +64,9 @@ def test_diagnose_ranks_the_users_effect_first_and_explains_the_recording(capsys
     assert doc["verdict"] == "explained"
     assert doc["final"]["effects"] == ["lr2", "creep-log", "rms-sqrt-f"]
     assert all(v <= 2 for v in doc["final"]["chi2_red"].values())
+    # The verdict credits the user's effect, not "no effect of the catalogue has anything to explain".
+    assert "rms-sqrt-f is an effect of your own" in doc["verdict_text"]
+    assert "of the catalogue" not in doc["verdict_text"]
 
 
 def test_without_the_file_the_effect_is_unknown_and_the_message_says_how(capsys, rms_recording):
