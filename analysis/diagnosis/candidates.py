@@ -166,7 +166,8 @@ def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
 
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
                     cancel: threading.Event | None = None, costs: dict[str, float] | None = None,
-                    passing: Callable[[Site], None] | None = None) -> tuple[Candidate, ...]:
+                    passing: Callable[[Site], None] | None = None,
+                    effects: tuple[Effect, ...] | None = None) -> tuple[Candidate, ...]:
     """Every candidate refitted, warm-started from `current`, flagged and ranked by delta BIC (best first).
 
     Their assessment applies rules 1 and 2 of the acceptance rule; rule 3
@@ -174,8 +175,9 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     `costs`: what each effect's refit cost before (by effect id), to hand the costliest to the pool first.
     `passing`: told the site of each single candidate that passes rules 1 and 2 as soon as it does (on the
     pool, while other refits still run), so that rule 3's site fit can start behind them.
+    `effects`: what may be tried (default: candidate_models's).
     """
-    moves = candidate_models(current.model)
+    moves = candidate_models(current.model, effects)
     ctx = residual_context(data, current)
     screens, screen_owners = screen_calls(data, current, moves, ctx)
     screen_handles = jobs.submit(screens, executor, cancel)
@@ -322,15 +324,21 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     capped = False
     while True:
         sites = _SiteFits(data, current, executor)
+        tried = None        # every effect
         if noise_floor.channels_at_noise(current):
             sites.need(usable_sites(current.model))
-            if noise_floor.nothing_to_find(current, sites.done):
-                steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current), chosen=None,
-                                  flags=_model_flags(current), at_noise_floor=True))
-                break
+            if noise_floor.meets_noise(current, sites.done):
+                idle = {e.category for e in noise_floor.idle_effects(current)}
+                if not idle:
+                    steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current),
+                                      chosen=None, flags=_model_flags(current), at_noise_floor=True))
+                    break
+                # At the noise floor only a simpler form of an idle effect is looked for (noise_floor rule 3).
+                tried = tuple(e for e in available_effects() if e.category in idle)
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
-        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps), passing=sites.start)
+        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps), passing=sites.start,
+                                 effects=tried)
         ranked, best = choose(current, ranked, sites)
         if best is None:    # the candidates rule 3 refused, tried with what acts on the channel they left
             refused = pairs.rank_pairs(data, current, ranked, _refit, jobs.run, executor, cancel, Candidate,

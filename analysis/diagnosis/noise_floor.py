@@ -12,12 +12,13 @@ them, when all three hold:
    its own flexibility takes from noise alone: fitting pure noise with edf
    effective parameters lowers chi^2 by about edf, standard deviation
    sqrt(2 edf), so a drop above edf + 3 sqrt(2 edf) is structure;
-3. no parameter of the model is undetermined or on a bound. Such a
-   parameter says an effect of the model has become superfluous (LR-3's
-   second stage once a creep law explains what it had bent towards), which
-   the path mends by swapping it for a simpler one of its category (LR-3
-   for LR-2): at the noise floor that swap pays by the parameters it saves,
-   so the path must rank the candidates once more to take it.
+3. no effect of the model has a parameter undetermined or on a bound. Such
+   a parameter says the effect has become superfluous (LR-3's second stage
+   once a creep law explains what it had bent towards), which the path
+   mends by swapping it for a simpler one of its category (LR-3 for LR-2):
+   at the noise floor that swap pays by the parameters it saves. Rules 1
+   and 2 holding, the path then ranks those swaps only (an addition is not
+   looked for at the noise floor, as above): 3 refits, not 40.
 
 The sites' corrections are the ones the diagnosis reports at its end, so
 the check costs nothing a diagnosis did not already compute. What it gives
@@ -32,6 +33,7 @@ from __future__ import annotations
 from analysis.diagnosis import acceptance
 from analysis.diagnosis.chance import CHANCE_SIGMAS, within_chance  # noqa: F401 (the tests use them here)
 from analysis.diagnosis.sites import SiteResult
+from analysis.effects.base import Effect
 from analysis.fit.least_squares import FitResult
 
 
@@ -50,16 +52,27 @@ def channels_at_noise(fit: FitResult) -> bool:
 
 
 def nothing_to_find(fit: FitResult, sites: dict) -> bool:
-    """Rules 1 to 3: the model meets the noise, no site's correction (`sites`, by site: all the usable sites'
-    results for `fit`) removes more than noise would, and no effect of the model looks superfluous."""
-    return channels_at_noise(fit) and all(_noise_only(fit, s) for s in sites.values()) \
-        and not superfluous_parameters(fit)
+    """Rules 1 to 3: the model meets the noise, no site's correction removes more than noise would, and no
+    effect of the model looks superfluous."""
+    return meets_noise(fit, sites) and not idle_effects(fit)
+
+
+def meets_noise(fit: FitResult, sites: dict) -> bool:
+    """Rules 1 and 2: the model meets the noise, and no site's correction (`sites`, by site: all the usable
+    sites' results for `fit`) removes more than noise would."""
+    return channels_at_noise(fit) and all(_noise_only(fit, s) for s in sites.values())
 
 
 def superfluous_parameters(fit: FitResult) -> list[str]:
-    """Rule 3: the parameters undetermined or on a bound (their effect may have nothing left to do)."""
+    """The parameters undetermined or on a bound (their effect may have nothing left to do)."""
     return [f.parameter for f in acceptance.parameter_flags(fit, typical=False)
             if f.code in (acceptance.UNDETERMINED, acceptance.AT_BOUND)]
+
+
+def idle_effects(fit: FitResult) -> tuple[Effect, ...]:
+    """Rule 3: the model's effects with a superfluous parameter (a lumped parameter's has no simpler form)."""
+    idle = set(superfluous_parameters(fit))
+    return tuple(e for e in fit.model.effects if idle & set(e.param_names))
 
 
 def _noise_only(fit: FitResult, site: SiteResult) -> bool:

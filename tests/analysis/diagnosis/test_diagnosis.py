@@ -140,3 +140,7 @@ def test_from_the_textbook_model_the_path_ends_at_the_truths_model(pool, mt, eff
     for name, value in truth.items():
         z = (result.final.values[name] - value) / result.final.stderr[name]
         assert abs(z) < 4, f"{name}: {result.final.values[name]:.6g} vs {value:.6g} ({z:.1f} sigma)"
+    # The swap is found at the noise floor, where only the idle effect's other forms are refitted.
+    swap = next(step for step in result.steps if step.chosen is not None and step.chosen.replaces is not None
+                and step.chosen.replaces.id == "lr3")
+    assert {c.effect.category for c in swap.candidates} == {"inductance"}
