@@ -303,6 +303,7 @@ def result_json(result: AnalysisResult) -> dict:
 
 
 def model_json(fit: FitResult) -> dict:
+    from analysis.fit.added_effects import stuck_effect_notes
     return {
         "effects": list(fit.model.effect_ids),
         "method": fit.method,
@@ -312,4 +313,6 @@ def model_json(fit: FitResult) -> dict:
         "n_data": fit.n_data,
         "n_parameters": fit.n_varying,
         "converged": fit.success,
+        # An added effect held on its bound far from the data: it may fit worse than none (one line each).
+        "notes": stuck_effect_notes(fit),
     }

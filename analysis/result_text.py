@@ -58,6 +58,8 @@ def format_result(result) -> str:
             lines.append(model_part_words(result.validity))
         if not fit.success:
             lines.append(f"warning: the fit did not converge: {fit.message}")
+        from analysis.fit.added_effects import stuck_effect_notes
+        lines += [f"warning: {note}" for note in stuck_effect_notes(fit)]
         report = fit.report()
     if notes:
         lines += ["", "not reported:"] + notes

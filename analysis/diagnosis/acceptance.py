@@ -13,7 +13,12 @@ these hold (docs/diagnosis.md says why each is needed):
 2. It pays at the misfit's own scale: with s^2 = max(1, reduced chi^2 of
    the current model), delta chi^2 / s^2 + delta k * ln n < -MIN_BIC_GAIN.
    At the noise floor this is the ordinary BIC rule; far from it, an effect
-   must remove a share of the misfit, not just many sigma of it.
+   must remove a share of the misfit, not just many sigma of it. A swap that
+   simplifies (fewer parameters, for an effect with a parameter undetermined
+   or on a bound) needs only to lower that BIC: the margin guards against
+   adding what the data do not ask for, and here the data have already said
+   the simpler effect is enough (LR-3 with R3 on its bound pays one
+   parameter's ln n, about 6, for nothing; swapping it for LR-2 saves only that).
 3. It explains its site's misfit: a smooth, flexible correction at the
    effect's own site (analysis.diagnosis.sites) shows how much of the misfit any
    effect there could remove. The candidate must remove most of that:
@@ -179,17 +184,27 @@ def site_gap(current: FitResult, candidate: FitResult, effect: Effect, site: "Si
     return candidate.chi2 - allowed
 
 
+def simplifies(current: FitResult, fit: FitResult | None, replaced: Effect | None) -> bool:
+    """A swap to fewer parameters, for an effect with a parameter undetermined or on a bound in `current`."""
+    if fit is None or replaced is None or fit.n_varying >= current.n_varying:
+        return False
+    idle = {f.parameter for f in parameter_flags(current, replaced.param_names, typical=False)
+            if f.code in (UNDETERMINED, AT_BOUND)}
+    return bool(idle)
+
+
 def assess(current: FitResult, fit: FitResult | None, effect: Effect, flags: tuple[Flag, ...],
-           site: "SiteResult | None" = None) -> Assessment:
+           site: "SiteResult | None" = None, simplifying: bool = False) -> Assessment:
     """The acceptance rule for one candidate. `site`: the smooth correction at its site, None when not
-    computed (then rule 3 is not applied: only candidates passing rules 1 and 2 need it)."""
+    computed (then rule 3 is not applied: only candidates passing rules 1 and 2 need it). `simplifying`:
+    the candidate `simplifies` the model, and rule 2 asks only that it lower the scaled BIC."""
     if fit is None:
         return Assessment(False, FAILED, math.inf, message="the refit failed")
     gain = scaled_delta_bic(current, fit)
     blocking = [f for f in flags if f.blocking]
     if blocking:
         return Assessment(False, FLAGGED, gain, message="flagged: " + "; ".join(f.message for f in blocking))
-    if gain >= -MIN_BIC_GAIN:
+    if gain >= (0.0 if simplifying else -MIN_BIC_GAIN):
         return Assessment(False, NO_GAIN, gain, message=(
             f"it does not pay at the misfit's scale (delta BIC {gain:+.1f} with chi^2 in units of the current "
             f"reduced chi^2 {misfit_scale(current):.3g})"))

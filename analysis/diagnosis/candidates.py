@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Callable
 
-from analysis.diagnosis import acceptance, jobs, noise_floor, pairs, residuals
+from analysis.diagnosis import acceptance, determined, jobs, noise_floor, pairs, residuals
 from analysis.diagnosis.acceptance import MIN_BIC_GAIN, Assessment, Flag
 from analysis.diagnosis.sites import SiteResult, first_among_tied, fit_site, localise, usable_sites
 from analysis.diagnosis.starts import best_starts, residual_context, same_compliance_at_fs, screen_calls
@@ -166,7 +166,8 @@ def _refit(data: FitData, model: Model, start: dict, cancel) -> FitResult:
 
 def rank_candidates(data: FitData, current: FitResult, executor: Executor | None = None,
                     cancel: threading.Event | None = None, costs: dict[str, float] | None = None,
-                    passing: Callable[[Site], None] | None = None) -> tuple[Candidate, ...]:
+                    passing: Callable[[Site], None] | None = None,
+                    effects: tuple[Effect, ...] | None = None) -> tuple[Candidate, ...]:
     """Every candidate refitted, warm-started from `current`, flagged and ranked by delta BIC (best first).
 
     Their assessment applies rules 1 and 2 of the acceptance rule; rule 3
@@ -174,8 +175,9 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     `costs`: what each effect's refit cost before (by effect id), to hand the costliest to the pool first.
     `passing`: told the site of each single candidate that passes rules 1 and 2 as soon as it does (on the
     pool, while other refits still run), so that rule 3's site fit can start behind them.
+    `effects`: what may be tried (default: candidate_models's).
     """
-    moves = candidate_models(current.model)
+    moves = candidate_models(current.model, effects)
     ctx = residual_context(data, current)
     screens, screen_owners = screen_calls(data, current, moves, ctx)
     screen_handles = jobs.submit(screens, executor, cancel)
@@ -219,7 +221,7 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
             outcomes[index] = (fit, error)
         calls_left[index] -= 1
         if calls_left[index] == 0:
-            judged[index] = _judged(current, moves[index], *outcomes[index])
+            judged[index] = _judged(data, current, moves[index], *outcomes[index])
             if passing is not None and judged[index].accepted:
                 passing(judged[index].effect.site)
     candidates = [judged[index] for index in range(len(moves))]
@@ -227,13 +229,16 @@ def rank_candidates(data: FitData, current: FitResult, executor: Executor | None
     return tuple(sorted(candidates, key=lambda c: c.delta_bic))
 
 
-def _judged(current: FitResult, move, fit: FitResult | None, error: str | None) -> Candidate:
-    """A single candidate, flagged and assessed by rules 1 and 2."""
+def _judged(data: FitData, current: FitResult, move, fit: FitResult | None, error: str | None) -> Candidate:
+    """A single candidate, flagged and assessed by rules 1 and 2 (its own parameters judged determined or not
+    with those of the others the data do not fix held: analysis.diagnosis.determined)."""
     action, effect, replaces, _ = move
+    fit = determined.with_undetermined_held(data, fit, effect.param_names)
     flags = acceptance.candidate_flags(current, fit, effect)
     return Candidate(action=action, effect=effect, replaces=replaces, fit=fit,
                      delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,
-                     flags=flags, assessment=acceptance.assess(current, fit, effect, flags))
+                     flags=flags, assessment=acceptance.assess(
+                         current, fit, effect, flags, simplifying=acceptance.simplifies(current, fit, replaces)))
 
 
 class _SiteFits:
@@ -274,7 +279,8 @@ def choose(current: FitResult, ranked: tuple[Candidate, ...], sites: _SiteFits
     for c in ranked:
         if c.accepted:
             site = sites.done[c.effect.site]
-            c = dataclasses.replace(c, assessment=acceptance.assess(current, c.fit, c.judged, c.flags, site))
+            c = dataclasses.replace(c, assessment=acceptance.assess(
+                current, c.fit, c.judged, c.flags, site, simplifying=acceptance.simplifies(current, c.fit, c.replaces)))
         judged.append(c)
     chosen = next((c for c in judged if c.accepted), None)
     return tuple(judged), chosen
@@ -313,20 +319,26 @@ def diagnose(data: FitData, start_model: Model, executor: Executor | None = None
     diagnosis then ends at the candidate the path would take (Diagnosis.final), nothing is
     adopted. locate=False skips the site localisation of the final model.
     """
-    current = start_fit or fit_model(data, start_model, cancel=cancel)
+    current = determined.with_undetermined_held(data, start_fit or fit_model(data, start_model, cancel=cancel))
     steps: list[Step] = []
     capped = False
     while True:
         sites = _SiteFits(data, current, executor)
+        tried = None        # every effect
         if noise_floor.channels_at_noise(current):
             sites.need(usable_sites(current.model))
-            if noise_floor.nothing_to_find(current, sites.done):
-                steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current), chosen=None,
-                                  flags=_model_flags(current), at_noise_floor=True))
-                break
+            if noise_floor.meets_noise(current, sites.done):
+                idle = {e.category for e in noise_floor.idle_effects(current)}
+                if not idle:
+                    steps.append(Step(fit=current, candidates=(), residual=residuals.describe(current),
+                                      chosen=None, flags=_model_flags(current), at_noise_floor=True))
+                    break
+                # At the noise floor only a simpler form of an idle effect is looked for (noise_floor rule 3).
+                tried = tuple(e for e in available_effects() if e.category in idle)
         if progress:
             progress(f"trying every effect on {current.model.describe()}")
-        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps), passing=sites.start)
+        ranked = rank_candidates(data, current, executor, cancel, costs=_refit_costs(steps), passing=sites.start,
+                                 effects=tried)
         ranked, best = choose(current, ranked, sites)
         if best is None:    # the candidates rule 3 refused, tried with what acts on the channel they left
             refused = pairs.rank_pairs(data, current, ranked, _refit, jobs.run, executor, cancel, Candidate,

@@ -32,7 +32,7 @@ import dataclasses
 from concurrent.futures import Executor
 import threading
 
-from analysis.diagnosis import acceptance
+from analysis.diagnosis import acceptance, determined
 from analysis.effects.base import Effect, Site
 from analysis.fit.least_squares import FitData, FitResult
 from analysis.model.composed import ModelError
@@ -137,6 +137,7 @@ def rank_pairs(data: FitData, current: FitResult, ranked, refit, run, executor: 
     pairs = []
     for (first, partner), (fit, error) in zip(kept, run(calls, executor, cancel)):
         both = PairedEffect(first.effect, partner.effect)
+        fit = determined.with_undetermined_held(data, fit, both.param_names)
         flags = acceptance.candidate_flags(current, fit, both)
         pairs.append(candidate_type(action=first.action, effect=first.effect, replaces=None, fit=fit,
                                     delta_bic=(fit.bic - current.bic) if fit else float("inf"), error=error,

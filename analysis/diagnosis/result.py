@@ -13,8 +13,8 @@ from typing import TYPE_CHECKING
 from analysis.derived import parameter_table
 from analysis.diagnosis import acceptance, noise_floor
 from analysis.diagnosis.candidates import Diagnosis, explain
-from analysis.diagnosis.words import (VERDICT_TITLES, chi2_words, residual_json, sites_json, tied_sites,
-                                      verdict_text)
+from analysis.diagnosis.words import (VERDICT_TITLES, chi2_words, residual_json, sites_json, stop_reason,
+                                      tied_sites, verdict_text)
 
 if TYPE_CHECKING:
     from analysis.diagnosis.candidates import Candidate, Step
@@ -51,6 +51,7 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
     return {
         "action": c.action,
         "effect": c.effect.id,
+        "with": c.partner.id if c.partner else None,
         "category": c.effect.category,
         "site": c.effect.site.key,
         "replaces": c.replaces.id if c.replaces else None,
@@ -64,8 +65,14 @@ def _candidate_json(current: FitResult, c: Candidate) -> dict:
 
 
 def _step_json(step: Step) -> dict:
-    return {**_fit_summary(step.fit), "chosen": step.chosen.effect.id if step.chosen else None,
-            "flags": acceptance.flags_json(step.flags), "at_noise_floor": step.at_noise_floor}
+    """A step of the path: its model, the move taken from it (`chosen`, `chosen_with` for a pair's second
+    effect) and every candidate ranked there."""
+    chosen = step.chosen
+    return {**_fit_summary(step.fit), "chosen": chosen.effect.id if chosen else None,
+            "chosen_with": chosen.partner.id if chosen and chosen.partner else None,
+            "chosen_action": chosen.action if chosen else None,
+            "flags": acceptance.flags_json(step.flags), "at_noise_floor": step.at_noise_floor,
+            "candidates": [_candidate_json(step.fit, c) for c in step.candidates]}
 
 
 def diagnosis_json(result: Diagnosis, sd_m2: float | None = None, drift: str | None = None) -> dict:
@@ -80,12 +87,27 @@ def diagnosis_json(result: Diagnosis, sd_m2: float | None = None, drift: str | N
         "residual": result.steps[0].residual,
         "candidates": [_candidate_json(result.start, c) for c in result.first_candidates],
         "steps": [_step_json(step) for step in result.steps],
+        "stopped": dict(zip(("reason", "text"), stop_reason(result))),
         "final": {**_fit_summary(final),
                   "parameters": {n: p.as_json() for n, p in parameter_table(final, sd_m2).items()},
                   "residual": residual_json(final),
                   "flags": acceptance.flags_json(result.final_flags)},
         "sites": sites_json(result.sites),
     }
+
+
+def _move(c: Candidate) -> str:
+    """'add lr3', 'replace lr2 (for lr3)', 'add breakup + breakup-spot'."""
+    return f"{c.action} {c.label}" + (f" (for {c.replaces.id})" if c.replaces else "")
+
+
+def _judgement(c: Candidate, chosen: Candidate | None) -> str:
+    """What the acceptance rule made of a candidate: taken (the one the path took), acceptable, or why not."""
+    if c is chosen:
+        return "taken"
+    if c.accepted:
+        return "acceptable"
+    return c.assessment.reason if c.assessment else ""
 
 
 def _flags_text(flags) -> str:
@@ -95,14 +117,18 @@ def _flags_text(flags) -> str:
 def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
     """The verdict in words, the first candidates ranked, the path taken and the sites."""
     lines = [f"verdict: {VERDICT_TITLES[result.verdict]}", "  " + verdict_text(result, drift), "",
-             f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", "",
-             f"{'rank':<5}{'move':<34}{'delta BIC':>12}  {'taken?':<12} reduced chi^2"]
-    for rank, c in enumerate(result.first_candidates, 1):
-        move = f"{c.action} {c.effect.id}" + (f" (for {c.replaces.id})" if c.replaces else "")
-        chi = chi2_words(c.fit.chi2_red_by_channel()) if c.fit else c.error
-        dbic = f"{c.delta_bic:+.1f}" if c.fit else "failed"
-        taken = "yes" if c.accepted else (c.assessment.reason if c.assessment else "")
-        lines.append(f"{rank:<5}{move:<34}{dbic:>12}  {taken:<12} {chi}")
+             f"start: {result.start.model.describe()}", f"  residual: {result.steps[0].residual}", ""]
+    first = result.steps[0]
+    rows = [(_move(c), f"{c.delta_bic:+.1f}" if c.fit else "failed", _judgement(c, first.chosen),
+             chi2_words(c.fit.chi2_red_by_channel()) if c.fit else c.error) for c in result.first_candidates]
+    # The columns as wide as their longest entry: a pair's or a user effect's move can be long.
+    move_w = max([34] + [len(r[0]) + 2 for r in rows])
+    bic_w = max([12] + [len(r[1]) + 1 for r in rows])
+    lines.append(f"{'rank':<5}{'move':<{move_w}}{'delta BIC':>{bic_w}}  {'judgement':<12} reduced chi^2")
+    for rank, (move, dbic, judgement, chi) in enumerate(rows, 1):
+        lines.append(f"{rank:<5}{move:<{move_w}}{dbic:>{bic_w}}  {judgement:<12} {chi}")
+    if rows:
+        lines.append("  (taken: the move the path took; acceptable: passes the acceptance rule but ranks below it)")
     if result.first_candidates:
         lines += ["", "why: " + explain(result.start, result.first_candidates[0])]
     elif result.steps[0].at_noise_floor:
@@ -118,7 +144,11 @@ def format_diagnosis(result: Diagnosis, drift: str | None = None) -> str:
             lines.append(f"     {move}" + (f", taken with flags: {_flags_text(c.flags)}" if c.flags else ""))
         if step.flags:
             lines.append(f"     flags of this model: {_flags_text(step.flags)}")
+        if step.candidates:
+            acceptable = sum(1 for c in step.candidates if c.accepted)
+            lines.append(f"     ranked {len(step.candidates)} candidates, {acceptable} acceptable")
         previous = step
+    lines.append(f"stopped: {stop_reason(result)[1]}")
     lines.append(f"final residual: {result.steps[-1].residual}")
     if result.sites:
         tied = {s.site for s in tied_sites(result.sites)}

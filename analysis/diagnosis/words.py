@@ -10,7 +10,8 @@ from typing import Iterable
 from analysis.diagnosis import acceptance, noise_floor, residuals
 from analysis.diagnosis.candidates import Diagnosis
 from analysis.diagnosis.sites import TIE_CHI2, SiteResult, tied_sites  # noqa: F401 (said from here too)
-from analysis.effects.base import Site
+from analysis.effects import catalogue, registry
+from analysis.effects.base import Effect, Site
 from analysis.validity.findings import DRIFT
 from analysis.fit.least_squares import FitResult
 
@@ -97,6 +98,41 @@ def first_site(result: Diagnosis) -> Site | None:
     return taken.effect.site if taken is not None else None
 
 
+def own_effects_taken(result: Diagnosis) -> list[str]:
+    """The ids of the user's own effects (not the catalogue's) that the path took."""
+    taken = [step.chosen for step in result.steps if step.chosen is not None]
+    effects: list[Effect] = [e for c in taken for e in (c.effect, c.partner) if e is not None]
+    return [e.id for e in effects if e.id not in catalogue.IDS]
+
+
+# Why the path stopped (stable codes: the JSON gives them).
+STOP_NOISE_FLOOR = "noise-floor"
+STOP_NONE_ACCEPTABLE = "none-acceptable"
+STOP_STEP_CAP = "step-cap"
+STOP_NOT_FOLLOWED = "not-followed"
+
+
+def stop_reason(result: Diagnosis) -> tuple[str, str]:
+    """Why the greedy path ended where it did: a code and a sentence."""
+    last = result.steps[-1]
+    if result.step_cap_reached:
+        return STOP_STEP_CAP, (f"it reached its cap of {len(result.steps) - 1} steps; the last model was not "
+                               "ranked further")
+    if last.at_noise_floor:
+        return STOP_NOISE_FLOOR, ("the model meets the noise on every channel, no site's smooth correction "
+                                  "removes more than noise would and every parameter is determined: nothing is "
+                                  "left to find")
+    if last.chosen is not None:
+        return STOP_NOT_FOLLOWED, f"the candidates were ranked, not followed (the best acceptable: {last.chosen.label})"
+    ranked = [c for c in last.candidates if c.fit is not None]
+    if not ranked:
+        return STOP_NONE_ACCEPTABLE, "no candidate could be refitted"
+    best = ranked[0]
+    why = best.assessment.message if best.assessment is not None else "not assessed"
+    return STOP_NONE_ACCEPTABLE, (f"none of the {len(last.candidates)} candidates passes the acceptance rule; the "
+                                  f"best by delta BIC, {best.action} {best.label}, was not taken: {why}")
+
+
 def verdict_headline(result: Diagnosis) -> str:
     """The verdict in one short sentence (verdict_text says it all)."""
     verdict = result.verdict
@@ -137,12 +173,16 @@ def verdict_text(result: Diagnosis, drift: str | None = None) -> str:
     elif verdict == acceptance.PARTLY_EXPLAINED:
         parts.append(f"Partly explained: {moves} helps (reduced χ² {chi2_words(start.chi2_red_by_channel())} → "
                      f"{chi2_words(final.chi2_red_by_channel())}), but misfit is left that no effect of the "
-                     "catalogue explains.")
+                     "catalogue" + (" or of your own" if registry.user_effects() else "") + " explains.")
     else:
         parts.append(f"Unexplained: no effect of the catalogue explains the misfit (reduced χ² "
                      f"{chi2_words(start.chi2_red_by_channel())}); none was added.")
+    own = own_effects_taken(result)
+    if own and verdict == acceptance.EXPLAINED:
+        parts.append(f"{' and '.join(own)} {'is an effect' if len(own) == 1 else 'are effects'} of your own: "
+                     "it explained what the catalogue's effects did not.")
     if result.steps[-1].at_noise_floor:
-        parts.append(noise_floor.SKIPPED_WORDS)
+        parts.append(noise_floor.SKIPPED_WORDS if not taken else noise_floor.ENDED_WORDS)
     if verdict in (acceptance.PARTLY_EXPLAINED, acceptance.UNEXPLAINED):
         parts.append(f"Where: {residuals.describe(final)}.")
         if result.sites:

@@ -123,3 +123,24 @@ def test_from_the_textbook_model_the_path_ends_at_the_noise_floor(pool, mt):
     assert chi2[0] > 1e4 and chi2[-1] < 2.0
     assert all(b <= a for a, b in zip(chi2, chi2[1:]))
     assert {e.category for e in result.final.model.effects} == {"inductance", "creep"}
+
+
+@pytest.mark.parametrize("effects, values", [(BASE, {}), (BASE + ",delay-x", {"tau_x": 300e-6})],
+                         ids=["nothing-else", "delay-x"])
+def test_from_the_textbook_model_the_path_ends_at_the_truths_model(pool, mt, effects, values):
+    # With seed 3 the path takes LR-3 first; creep-log then leaves its second stage idle (a singular
+    # covariance), which once blocked creep-log as "undetermined", and the noise floor ended the path before
+    # the swap of LR-3 for LR-2.
+    truth = _truth(effects, values)
+    rec = recording(truth, effects, noise=TYPICAL_NOISE, n_periods=8, seed=3, mt=mt)
+    result = diagnose(FitData.from_spectra(estimate_spectra(rec)), Model(()), executor=pool)
+    assert result.verdict == "explained"
+    assert set(result.final.model.effect_ids) == set(parse_effects_ids(effects)), \
+        [step.chosen.label for step in result.steps if step.chosen]
+    for name, value in truth.items():
+        z = (result.final.values[name] - value) / result.final.stderr[name]
+        assert abs(z) < 4, f"{name}: {result.final.values[name]:.6g} vs {value:.6g} ({z:.1f} sigma)"
+    # The swap is found at the noise floor, where only the idle effect's other forms are refitted.
+    swap = next(step for step in result.steps if step.chosen is not None and step.chosen.replaces is not None
+                and step.chosen.replaces.id == "lr3")
+    assert {c.effect.category for c in swap.candidates} == {"inductance"}

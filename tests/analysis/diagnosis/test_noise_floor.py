@@ -49,3 +49,12 @@ def test_a_site_whose_correction_removes_more_than_noise_leaves_something_to_fin
     structure = result.edf + 3.1 * math.sqrt(2.0 * result.edf)
     found = dataclasses.replace(result, chi2=fit.chi2 - structure)
     assert not noise_floor.nothing_to_find(fit, {**sites, site: found})
+
+
+def test_a_model_with_an_undetermined_parameter_is_not_the_end(clean):
+    # An effect whose parameter the data do not fix may be superfluous: the path ranks the candidates once
+    # more, so that the swap for a simpler effect of its category (LR-3 for LR-2) can be taken.
+    fit, sites = clean
+    idle = dataclasses.replace(fit, stderr={**fit.stderr, "L2": None})
+    assert noise_floor.superfluous_parameters(idle) == ["L2"]
+    assert not noise_floor.nothing_to_find(idle, sites)

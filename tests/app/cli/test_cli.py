@@ -149,6 +149,7 @@ def test_diagnose_json_says_what_it_cannot_explain_and_where(capsys, odd_mechani
     assert max(sites[0]["chi2_red"].values()) < 2 < min(doc["final"]["chi2_red"].values())
     flagged = [c for c in doc["candidates"] if c["flags"]]
     assert flagged and all(not c["accepted"] for c in doc["candidates"])
+    assert doc["stopped"]["reason"] == "none-acceptable" and doc["steps"][0]["candidates"] == doc["candidates"]
     assert {"code", "parameter", "channel", "message"} <= set(flagged[0]["flags"][0])
 
 
@@ -158,6 +159,7 @@ def test_diagnose_text_states_the_verdict_and_the_site(capsys, odd_mechanical_pa
     assert out.splitlines()[0] == "verdict: Unexplained"
     assert "mechanical site" in out and "effect of your own" in out
     assert "site" in out and "delta BIC" in out
+    assert "\nstopped: none of the " in out and " taken " not in out
 
 
 def test_the_effects_catalogue_is_listed(capsys):

@@ -64,6 +64,9 @@ def test_diagnose_ranks_the_users_effect_first_and_explains_the_recording(capsys
     assert doc["verdict"] == "explained"
     assert doc["final"]["effects"] == ["lr2", "creep-log", "rms-sqrt-f"]
     assert all(v <= 2 for v in doc["final"]["chi2_red"].values())
+    # The verdict credits the user's effect, not "no effect of the catalogue has anything to explain".
+    assert "rms-sqrt-f is an effect of your own" in doc["verdict_text"]
+    assert "of the catalogue" not in doc["verdict_text"]
 
 
 def test_without_the_file_the_effect_is_unknown_and_the_message_says_how(capsys, rms_recording):
@@ -123,3 +126,33 @@ def test_an_archived_result_keeps_the_effect_file_and_reports_without_it(capsys,
     assert code == 0, err
     html = (tmp_path / "r.html").read_text(encoding="utf-8")
     assert "rms-sqrt-f" in html and "r * (sqrt(w / ws) - 1)" in html and "mechanical" in html
+
+
+# An effect file whose term vanishes at r = 1 but that the fit runs to its bound (log turns complex below 0).
+STUCK = """id = "log-root"
+title = "a term that vanishes at r = 1"
+site = "electrical"
+formula = "0.001 * log(r) * sqrt(f)"
+physics = "none: a test of a fit worse than leaving the effect out"
+[parameters.r]
+unit = "-"
+start = 1.5
+min = -5
+max = 5
+"""
+
+
+def test_analyze_says_when_an_added_effect_is_stuck_on_its_bound_far_from_the_data(capsys, tmp_path):
+    from tests.builders import recording
+    write_recording(tmp_path / "paper", recording(noise=TYPICAL_NOISE, n_periods=8, seed=3))
+    (tmp_path / "log-root.toml").write_text(STUCK, encoding="utf-8")
+    args = ("analyze", tmp_path / "paper", "--effects-file", tmp_path / "log-root.toml", "--model",
+            "lr2,creep-log,log-root")
+    code, out, err = run(capsys, *args)
+    assert code == 0, err
+    said = [line for line in out.splitlines() if line.startswith("warning: the added effect log-root")]
+    assert len(said) == 1 and "r = -5" in said[0] and "--model lr2,creep-log" in said[0]
+    code, out, err = run(capsys, *args, "--json")
+    doc = json.loads(out)
+    assert max(doc["model"]["chi2_red"].values()) > 100
+    assert len(doc["model"]["notes"]) == 1 and "log-root" in doc["model"]["notes"][0]
