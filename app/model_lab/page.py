@@ -2,8 +2,9 @@
 reduced chi^2 fall towards the noise floor version after version.
 
 The lab starts from the model the Results page fitted and keeps its own
-history of versions. Every refit is warm-started from the current version's
-values; a diagnosis ranks every model one move away (analysis.diagnosis.candidates) and
+history of versions. Every refit starts from the current version's values and
+from the model's own start values, as `linpar analyze --model` does
+(analysis.diagnosis.refit); a diagnosis ranks every model one move away (analysis.diagnosis.candidates) and
 its candidates can be adopted without a refit, their fits being computed
 already. The current version is handed back to the Results page
 (model_adopted), so that both pages show the same model.
@@ -279,7 +280,7 @@ class ModelLab(QWidget):
 
     @Slot(tuple)
     def on_selection_changed(self, checked: tuple) -> None:
-        """A checkbox changed: refit the changed model, warm-started from the current version."""
+        """A checkbox changed: refit the changed model from the current version (analysis.diagnosis.refit)."""
         if self.current is None:
             return
         current = self.current.fitted.fit.model
@@ -292,7 +293,7 @@ class ModelLab(QWidget):
         self.jobs.drop()         # a newer choice replaces a refit or diagnosis still running
         if model.effect_ids == current.effect_ids:
             return
-        self._run(self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values),
+        self._run(self.worker.refit(self.base, self.data, model, self.current.fitted.fit),
                   f"Refitting: {move_text(current, model)}…", self.on_refit_finished)
 
     @Slot()
