@@ -1,16 +1,22 @@
-"""The Model lab's catalogue and reduced-chi^2 chart at the sizes they have on a 1280x720 screen: the effects'
-titles take the room left without a horizontal scroll bar (cut with "…", whole in the tooltip), and the channels'
-names never lie over the noise floor's label."""
+"""The Model lab's catalogue, reduced-chi^2 chart and candidates at the sizes they have on a 1280x720
+screen: the effects' titles take the room left without a horizontal scroll bar (cut with "…", whole in the
+tooltip), the channels' names never lie over the noise floor's label, and the candidates' ids are read whole."""
 from __future__ import annotations
 
 import pytest
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QApplication, QStyle
 
+from analysis.diagnosis.candidates import candidate_models
+from analysis.effects import get_effect, parse_effects
+from analysis.model import Model
+from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome
+from app.model_lab.candidates import EFFECT, CandidatesPanel
 from app.model_lab.catalogue import EffectCatalogue
 from app.model_lab.plots import CHANNEL_SHORT, ChartPoint, ChiSquareChart
 
 # What the lab gives them in a 1280x720 window (docs/screenshots/model-lab-*-1280x720.png).
-CATALOGUE_SIZE, CHART_SIZE = (270, 560), (365, 230)
+CATALOGUE_SIZE, CHART_SIZE, CANDIDATES_SIZE = (270, 560), (365, 230), (617, 250)
 
 
 def test_the_catalogues_titles_fit_beside_the_ids_without_a_scroll_bar(qtbot):
@@ -43,3 +49,32 @@ def test_the_chi2_charts_channel_names_never_cover_the_noise_floors_label(qtbot,
     assert legend is None or not legend.sceneBoundingRect().intersects(floor)
     title = chart.plot.titleLabel.text
     assert all(name in title for name in CHANNEL_SHORT.values())       # the colours are said in the title
+
+
+def _every_move_from(effect_ids: str) -> tuple[CandidateRow, ...]:
+    """A row for every move one step from `effect_ids` (as a diagnosis ranks them), and a pair of two effects."""
+    rows = [CandidateRow(str(action), effect, replaced, -100.0 - i, "", None)
+            for i, (action, effect, replaced, _) in enumerate(candidate_models(Model(parse_effects(effect_ids))))]
+    return (*rows, CandidateRow("add", get_effect("breakup"), None, -1.0, "", None, partner=get_effect("breakup-spot")))
+
+
+def test_the_candidates_ids_are_read_whole_and_no_two_rows_look_alike(qtbot):
+    """The effect's title alone, beside a Category column, was cut to a word: "Vented …" for two different boxes."""
+    panel = CandidatesPanel()
+    qtbot.addWidget(panel)
+    panel.resize(*CANDIDATES_SIZE)
+    panel.show()
+    rows = _every_move_from("lr2,creep-log")
+    panel.set_outcome(DiagnosisOutcome(None, rows, (), ""), 1, "lr2, creep-log")
+    QApplication.processEvents()
+    table = panel.table
+    room = table.columnWidth(EFFECT) - 2 * (table.style().pixelMetric(QStyle.PM_FocusFrameHMargin) + 1)   # as the cell draws
+    shown = [table.fontMetrics().elidedText(table.item(r, EFFECT).text(), Qt.ElideRight, room)
+             for r in range(table.rowCount())]
+    for row, text in zip(rows, shown):
+        ids = row.effect.id + (f" + {row.partner.id}" if row.partner else "") + \
+            (f" for {row.replaces.id}" if row.replaces else "")
+        assert text.startswith(ids), (text, ids)
+    assert len(set(shown)) == len(shown)
+    assert not table.horizontalScrollBar().isVisible()
+

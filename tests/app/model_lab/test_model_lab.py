@@ -27,7 +27,7 @@ from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app.widgets import style
-from app.model_lab.candidates import ACTION, CATEGORY, COLUMNS, DELTA_BIC, EFFECT, JUDGED, SIZED_COLUMNS
+from app.model_lab.candidates import ACTION, COLUMNS, DELTA_BIC, EFFECT, JUDGED, SIZED_COLUMNS
 from app.model_lab.catalogue import EFFECT_ROLE
 from app.model_lab.page import ModelLab
 from app.results.parameter_table import VALUE
@@ -139,9 +139,9 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
         assert table.columnWidth(column) >= table.sizeHintForColumn(column) > 0, COLUMNS[column]
     top = outcome.candidates[0]
     assert top.effect.category == "creep"
-    assert table.item(0, CATEGORY).text() == "Suspension creep"
-    assert table.item(0, ACTION).text() == "add" and table.item(0, EFFECT).text() == top.effect.title
-    assert top.effect.id in table.item(0, EFFECT).toolTip()                  # the id, for who needs it
+    assert table.item(0, ACTION).text() == "add"
+    assert table.item(0, EFFECT).text() == f"{top.effect.id} · {top.effect.title}"       # the id, then the title
+    assert "Suspension creep" in table.item(0, EFFECT).toolTip()                        # and its category
     assert top.delta_bic < -MIN_BIC_GAIN
     assert table.item(0, DELTA_BIC).text().endswith("fits far better")       # a word and a bar, no number
     assert table.item(0, DELTA_BIC).text().startswith("▰")
