@@ -24,9 +24,9 @@ from app.jobs.refit_process import RefitProcess
 
 
 def _refit(job: Job, refits: RefitProcess, ticket: int, base: AnalysisResult, data: FitData, model: Model,
-           start: dict[str, float]) -> LabFit:
+           current: FitResult) -> LabFit:
     job.say(f"fitting {model.describe()}")
-    fit = refits.fit(ticket, data, model, start, job.cancel_event)
+    fit = refits.fit(ticket, data, model, current, job.cancel_event)
     job.check()
     return lab_fit(base, fit)       # 2-5 ms here: sending the base (its spectra, 2.6 MB) to the worker costs more
 
@@ -65,9 +65,10 @@ class LabWorker(JobRunner):
         super().__init__(parent)
         self.refits = RefitProcess()
 
-    def refit(self, base: AnalysisResult, data: FitData, model: Model, start: dict[str, float]) -> Job:
-        start, ticket = dict(start), self.refits.ticket()      # in the GUI thread: app.jobs.refit_process
-        return self.run("refit", lambda job: _refit(job, self.refits, ticket, base, data, model, start),
+    def refit(self, base: AnalysisResult, data: FitData, model: Model, current: FitResult) -> Job:
+        """`model` refitted from `current`, the version it changes (analysis.diagnosis.refit)."""
+        ticket = self.refits.ticket()      # in the GUI thread: app.jobs.refit_process
+        return self.run("refit", lambda job: _refit(job, self.refits, ticket, base, data, model, current),
                         "the model lab's refit")
 
     def shutdown(self, wait_ms: int) -> bool:

@@ -22,7 +22,8 @@ import threading
 from concurrent.futures.process import BrokenProcessPool
 from multiprocessing.reduction import ForkingPickler
 
-from analysis.fit.least_squares import FitData, FitResult, fit_model
+from analysis.diagnosis.refit import refit
+from analysis.fit.least_squares import FitData, FitResult
 from analysis.model.composed import Model
 from analysis.parallel import WorkerPool, pool_context, run_in_the_background, worker_count
 from app.jobs.background_pool import CANCEL_POLL_S, PoolCancelled
@@ -48,24 +49,25 @@ class _CancelledFrom:
         return _cancelled_up_to.value >= self.number
 
 
-def _fit_in_worker(number: int, data: FitData, model: Model, start: dict[str, float]) -> FitResult:
-    return fit_model(data, model, start=start, cancel=_CancelledFrom(number))
+def _fit_in_worker(number: int, data: FitData, model: Model, current: FitResult) -> FitResult:
+    return refit(data, model, current, cancel=_CancelledFrom(number))
 
 
-def _travels(model: Model) -> bool:
-    """Whether `model` can be sent to the worker (pickled as the pool sends its calls). A package's effect may be an
-    object pickle cannot send (its class made inside the factory its entry point names, a lambda among its fields):
-    that refit fits in the caller's thread, as all did before the worker, instead of failing as an internal error.
-    0.05 ms for lr3,creep-log."""
+def _travels(*objects) -> bool:
+    """Whether `objects` (a model, the fit it is refitted from) can be sent to the worker (pickled as the pool sends
+    its calls). A package's effect may be an object pickle cannot send (its class made inside the factory its entry
+    point names, a lambda among its fields): that refit fits in the caller's thread, as all did before the worker,
+    instead of failing as an internal error. 0.05 ms for lr3,creep-log."""
     try:
-        ForkingPickler.dumps(model)
+        ForkingPickler.dumps(objects)
     except Exception:  # noqa: BLE001 - whatever stops the pickler (PicklingError, TypeError, AttributeError ...)
         return False
     return True
 
 
 class RefitProcess:
-    """fit_model on the lab's worker process, the wait cancellable; in the caller's thread on a one-core machine."""
+    """A lab's refit (analysis.diagnosis.refit) on the lab's worker process, the wait cancellable; in the caller's
+    thread on a one-core machine."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()       # the lab's refits run one at a time, but a shutdown may come from the GUI
@@ -93,21 +95,22 @@ class RefitProcess:
         """The next refit's number; taken where the refits are asked for, one after the other (the GUI thread)."""
         return next(self._numbers)
 
-    def fit(self, number: int, data: FitData, model: Model, start: dict[str, float],
+    def fit(self, number: int, data: FitData, model: Model, current: FitResult,
             cancel: threading.Event) -> FitResult:
-        """Refit `number` (a ticket) of `model`; PoolCancelled once `cancel` is set."""
+        """Refit `number` (a ticket): `model` refitted from `current`, the version it changes; PoolCancelled once
+        `cancel` is set."""
         if cancel.is_set():
             raise PoolCancelled("refit cancelled")
         pool = self._running()
-        if pool is None or not _travels(model):
-            return fit_model(data, model, start=start, cancel=cancel)
+        if pool is None or not _travels(model, current):
+            return refit(data, model, current, cancel=cancel)
         try:
             try:
-                future = pool.submit(_fit_in_worker, number, data, model, start)
+                future = pool.submit(_fit_in_worker, number, data, model, current)
             except RuntimeError:            # "cannot schedule new futures after shutdown": the lab closed meanwhile
                 if not self._closed:
                     raise
-                return fit_model(data, model, start=start, cancel=cancel)
+                return refit(data, model, current, cancel=cancel)
             while True:
                 try:
                     return future.result(timeout=CANCEL_POLL_S)
@@ -119,7 +122,7 @@ class RefitProcess:
             # The worker died (killed, out of memory): the next refit starts another; this one fits here.
             log.warning("the Model lab's refit process ended unexpectedly; refitting in the window's process")
             self._drop(pool)
-            return fit_model(data, model, start=start, cancel=cancel)
+            return refit(data, model, current, cancel=cancel)
 
     def shutdown(self) -> None:
         """Stop the worker: a refit still running is cancelled at its next check; the caller does not wait."""

@@ -17,10 +17,12 @@ from app.jobs.lab_outcome import CandidateRow, DiagnosisOutcome
 from app.model_lab.catalogue import category_title
 from app.widgets.column_widths import fit_to_contents, sized_when_filled
 
-# The reduced chi^2 per channel is in the Fit cell's tooltip: the columns must fit a 1280 px screen.
-COLUMNS = ("#", "Action", "Effect", "Category", "Fit", "Acceptable")
-RANK, ACTION, EFFECT, CATEGORY, DELTA_BIC, JUDGED = range(len(COLUMNS))
-SIZED_COLUMNS = (RANK, ACTION, CATEGORY, DELTA_BIC, JUDGED)      # as wide as their contents
+# The reduced chi^2 per channel is in the Fit cell's tooltip, the category in the Effect cell's: the columns must
+# fit a 1280 px screen, where a Category column took the width and cut the effects' titles to a word ("Vented …"
+# twice, for two different boxes).
+COLUMNS = ("#", "Action", "Effect", "Fit", "Acceptable")
+RANK, ACTION, EFFECT, DELTA_BIC, JUDGED = range(len(COLUMNS))
+SIZED_COLUMNS = (RANK, ACTION, DELTA_BIC, JUDGED)      # as wide as their contents
 # The word scale of a BIC change (Kass and Raftery's grades of evidence), the best grade first.
 FIT_WORDS = ((-10.0, "fits far better"), (-6.0, "fits better"), (-2.0, "slightly better"), (2.0, "no better"))
 WORSE = "fits worse"
@@ -66,6 +68,25 @@ def fit_bar(delta_bic: float, best_gain: float) -> str:
         return "▱" * BAR_CELLS
     filled = max(1, round(BAR_CELLS * math.log10(gain) / math.log10(best_gain)))
     return "▰" * filled + "▱" * (BAR_CELLS - filled)
+
+
+def effect_text(row: CandidateRow) -> str:
+    """The Effect cell: the move's ids first, which tell any two candidates apart and are short enough to be read
+    whole at 1280 px, then the titles, which the cell cuts where its width ends."""
+    if row.replaces is not None:
+        return f"{row.effect.id} for {row.replaces.id} · {row.effect.title} for {row.replaces.title}"
+    if row.partner is not None:
+        return f"{row.effect.id} + {row.partner.id} · {row.effect.title} with {row.partner.title}"
+    return f"{row.effect.id} · {row.effect.title}"
+
+
+def effect_tooltip(row: CandidateRow) -> str:
+    """The Effect cell's text whole, one effect a line, with its category."""
+    effects = [row.effect] + [e for e in (row.partner,) if e is not None]
+    lines = [f"{e.title} (id {e.id}): {category_title(e.category)}" for e in effects]
+    if row.replaces is not None:
+        lines.append(f"in place of {row.replaces.title} (id {row.replaces.id})")
+    return "\n".join(lines)
 
 
 def fit_tooltip(row: CandidateRow) -> str:
@@ -117,7 +138,7 @@ class CandidatesPanel(QWidget):
         self.table.setAlternatingRowColors(True)
         self.table.verticalHeader().setVisible(False)
         self.table.verticalHeader().setDefaultSectionSize(self.fontMetrics().height() + 6)
-        # The effect's title takes what is left, elided (whole in its tooltip); the category is read whole.
+        # The move's ids and titles take what is left, the titles cut at its end (whole in the tooltip).
         self.table.horizontalHeader().setSectionResizeMode(EFFECT, QHeaderView.Stretch)
         sized_when_filled(self.table, SIZED_COLUMNS)       # measured when filled, not at each show of the lab
         fit_to_contents(self.table, SIZED_COLUMNS)
@@ -158,11 +179,9 @@ class CandidatesPanel(QWidget):
         gains = [-row.delta_bic for row in self.rows if math.isfinite(row.delta_bic)]
         best_gain = max(gains, default=0.0)
         for r, row in enumerate(self.rows):
-            # Read across: "replace" + "<new title> for <old title>" is the move; the ids are in the tooltips.
+            # Read across: "replace" + "<new id> for <old id> · <titles>" is the move.
             action = "replace" if row.replaces is not None else "add"
-            effect = row.effect.title if row.replaces is None else f"{row.effect.title} for {row.replaces.title}"
-            cells = {RANK: str(r + 1), ACTION: action, EFFECT: effect,
-                     CATEGORY: category_title(row.effect.category),
+            cells = {RANK: str(r + 1), ACTION: action, EFFECT: effect_text(row),
                      DELTA_BIC: f"{fit_bar(row.delta_bic, best_gain)} {fit_words(row.delta_bic)}"}
             cells[JUDGED] = JUDGEMENT_WORDS.get(row.judgement, row.judgement)
             if row is chosen:
@@ -172,11 +191,9 @@ class CandidatesPanel(QWidget):
                 if column == RANK:
                     item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
                 if column == EFFECT:
-                    item.setToolTip(f"{row.effect.title} (id {row.effect.id}): {row.effect.category} effect")
+                    item.setToolTip(effect_tooltip(row))
                 if column == ACTION and row.replaces is not None:
                     item.setToolTip(f"replaces {row.replaces.title} (id {row.replaces.id})")
-                if column == CATEGORY:
-                    item.setToolTip(category_title(row.effect.category))
                 if column == DELTA_BIC:
                     item.setToolTip(fit_tooltip(row))
                 if column == JUDGED:

@@ -2,8 +2,9 @@
 reduced chi^2 fall towards the noise floor version after version.
 
 The lab starts from the model the Results page fitted and keeps its own
-history of versions. Every refit is warm-started from the current version's
-values; a diagnosis ranks every model one move away (analysis.diagnosis.candidates) and
+history of versions. Every refit starts from the current version's values and
+from the model's own start values, as `linpar analyze --model` does
+(analysis.diagnosis.refit); a diagnosis ranks every model one move away (analysis.diagnosis.candidates) and
 its candidates can be adopted without a refit, their fits being computed
 already. The current version is handed back to the Results page
 (model_adopted), so that both pages show the same model.
@@ -37,7 +38,7 @@ from app.results.parameter_table import titled_parameter_table
 from app.widgets.layout_room import LinesLabel
 from app.jobs.workers import AnalysisOutcome
 
-HEADER_LINES = 4        # the version (two lines with the how of a first version), its fit's headline (one or two)
+HEADER_LINES = 4        # the version and how it came (one or two lines), its fit's headline (one or two)
 EMPTY_TEXT = ("No model yet.\n\nOpen a recording (File ▸ Open recording…): the lab starts from the model the "
               "Results page fits, and from there you add, remove or swap effects.")
 
@@ -66,16 +67,21 @@ class ModelLab(QWidget):
         self.model_label = LinesLabel(HEADER_LINES, whole_in_tooltip=False)     # its tooltip: the fit's report
         self.model_label.setTextFormat(Qt.RichText)
         self.model_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        # What the last job did, with what to try (a refit's words run to five sentences): its first line at the top,
+        # a text too long cut at the bottom (whole in its tooltip).
         self.status_label = LinesLabel(HEADER_LINES)
-        self.status_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
         # The refit or diagnosis running: what it does, a busy indicator and Cancel.
         self.jobs = JobControls(self.worker, cancel_tip="Stop the refit or diagnosis; the current version stays",
                                 bar_width=120)
-        self.jobs.busy_changed.connect(lambda _busy: self._update_buttons())
+        self.jobs.busy_changed.connect(self._on_busy_changed)
+        # The two share one place: a job empties the status as it starts, and the job controls are empty between
+        # jobs. Side by side, each had half the room, and at 1280 px a refit's advice was cut.
+        self.status_stack = QStackedWidget()
+        self.status_stack.addWidget(self.status_label)
+        self.status_stack.addWidget(self.jobs)
         header = QHBoxLayout()
         header.addWidget(self.model_label, 3)
-        header.addWidget(self.status_label, 1)
-        header.addWidget(self.jobs, 1)
+        header.addWidget(self.status_stack, 2)
 
         self.catalogue = EffectCatalogue()
         self.residual_panel = ResidualPanel()
@@ -234,7 +240,10 @@ class ModelLab(QWidget):
         the paint it sets off 2-8 ms of the GUI thread's CPU (three steps held it 17-26 ms each)."""
         version = self.versions[-1]
         fit = version.fitted.fit
-        text = (f"<b>Version {version.number}</b>: {html.escape(version.effects)} "
+        # The effects by their ids, as the catalogue's checkboxes name them: by their titles, four effects took three
+        # of the header's lines at 1280 px and cut the fit's headline below them.
+        ids = ", ".join(fit.model.effect_ids) or "textbook"
+        text = (f"<b>Version {version.number}</b>: {html.escape(ids)} "
                 f"<span style='color:#555'>({html.escape(version.how)})</span><br>{html.escape(fit_headline(fit))}")
         self.model_label.setToolTip(f"<pre>{html.escape(fit.report())}</pre>")     # the numbers one look away
         if not fit.success:
@@ -255,6 +264,10 @@ class ModelLab(QWidget):
         result = self.versions[-1].fitted.result
         descriptions = {spec.name: spec.description for spec in result.fit.model.param_specs}
         self.parameter_table.set_parameters(result.parameters, descriptions, result.sd_m2)
+
+    def _on_busy_changed(self, busy: bool) -> None:
+        self.status_stack.setCurrentWidget(self.jobs if busy else self.status_label)
+        self._update_buttons()
 
     def _update_buttons(self) -> None:
         ready = self.current is not None and not self.busy
@@ -279,7 +292,7 @@ class ModelLab(QWidget):
 
     @Slot(tuple)
     def on_selection_changed(self, checked: tuple) -> None:
-        """A checkbox changed: refit the changed model, warm-started from the current version."""
+        """A checkbox changed: refit the changed model from the current version (analysis.diagnosis.refit)."""
         if self.current is None:
             return
         current = self.current.fitted.fit.model
@@ -292,7 +305,7 @@ class ModelLab(QWidget):
         self.jobs.drop()         # a newer choice replaces a refit or diagnosis still running
         if model.effect_ids == current.effect_ids:
             return
-        self._run(self.worker.refit(self.base, self.data, model, self.current.fitted.fit.values),
+        self._run(self.worker.refit(self.base, self.data, model, self.current.fitted.fit),
                   f"Refitting: {move_text(current, model)}…", self.on_refit_finished)
 
     @Slot()

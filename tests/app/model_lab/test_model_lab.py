@@ -27,7 +27,7 @@ from analysis.parallel import worker_count
 from analysis.pipeline import analyze_recording
 from analysis.recording.format import read_recording
 from app.widgets import style
-from app.model_lab.candidates import ACTION, CATEGORY, COLUMNS, DELTA_BIC, EFFECT, JUDGED, SIZED_COLUMNS
+from app.model_lab.candidates import ACTION, COLUMNS, DELTA_BIC, EFFECT, JUDGED, SIZED_COLUMNS
 from app.model_lab.catalogue import EFFECT_ROLE
 from app.model_lab.page import ModelLab
 from app.results.parameter_table import VALUE
@@ -139,9 +139,9 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
         assert table.columnWidth(column) >= table.sizeHintForColumn(column) > 0, COLUMNS[column]
     top = outcome.candidates[0]
     assert top.effect.category == "creep"
-    assert table.item(0, CATEGORY).text() == "Suspension creep"
-    assert table.item(0, ACTION).text() == "add" and table.item(0, EFFECT).text() == top.effect.title
-    assert top.effect.id in table.item(0, EFFECT).toolTip()                  # the id, for who needs it
+    assert table.item(0, ACTION).text() == "add"
+    assert table.item(0, EFFECT).text() == f"{top.effect.id} · {top.effect.title}"       # the id, then the title
+    assert "Suspension creep" in table.item(0, EFFECT).toolTip()                        # and its category
     assert top.delta_bic < -MIN_BIC_GAIN
     assert table.item(0, DELTA_BIC).text().endswith("fits far better")       # a word and a bar, no number
     assert table.item(0, DELTA_BIC).text().startswith("▰")
@@ -187,6 +187,25 @@ def test_unchecking_an_effect_refits_and_raises_chi2(qtbot, make_lab, full_resul
         assert list(versions) == [1, 2] and chi2[1] > chi2[0]
     with pytest.raises(KeyError):
         lab.parameter_table.parameter_model.row_of("lambda")     # the table follows the model
+
+
+# Physics the version lacks, with the seed of a recording on which a refit from the version's values alone went
+# astray: ticking bl-eddy ended at a reduced chi^2 of 1.5e5, ticking breakup at 1.7e5 (from 1.9e5), where
+# `linpar analyze --model lr2,creep-log,EFFECT` reaches 1.01 and 1.04.
+LACKED = {"bl-eddy": ({"dBl": 0.15, "f_Bl": 2000.0}, 3), "breakup": ({"f2": 1500.0, "Q2": 8.0, "mu2": 0.1}, 0)}
+
+
+@pytest.mark.parametrize("effect_id", sorted(LACKED))
+def test_checking_the_effect_the_recording_has_reaches_what_analyze_reaches(qtbot, make_lab, effect_id):
+    from tests.builders import TYPICAL_NOISE, recording
+    extra, seed = LACKED[effect_id]
+    truth = recording({**PAPER.parameters, **extra}, f"lr2,creep-log,{effect_id}", noise=TYPICAL_NOISE, seed=seed)
+    lab = make_lab(analyze_recording(truth, effects=(get_effect("lr2"), get_effect("creep-log"))))
+    analysed = analyze_recording(truth, effects=(get_effect("lr2"), get_effect("creep-log"), get_effect(effect_id)))
+    version = _toggle(qtbot, lab, effect_id, checked=True)
+    assert version.fitted.fit.model.effect_ids == ("lr2", "creep-log", effect_id)
+    assert version.fitted.fit.chi2 == pytest.approx((analysed.whole_band_fit or analysed.fit).chi2, rel=0.02)
+    assert max(_chi2(lab).values()) < 1.2 and "rose" not in lab.status_label.text()
 
 
 def test_checking_a_second_effect_of_a_category_swaps_it(qtbot, lab):
@@ -258,7 +277,7 @@ def test_the_gui_thread_never_fits(qtbot, lab, monkeypatch):
 def test_a_refit_fits_on_the_labs_process_not_in_the_window_s(qtbot, lab, monkeypatch):
     """A refit in a thread of the GUI process took the GIL from the paint (app.jobs.refit_process)."""
     here = []
-    monkeypatch.setattr(app.jobs.refit_process, "fit_model", lambda *a, **k: here.append(a))
+    monkeypatch.setattr(app.jobs.refit_process, "refit", lambda *a, **k: here.append(a))
     _toggle(qtbot, lab, "creep-log", checked=True)
     assert here == [] and lab.current.fitted.fit.model.effect_ids == ("lr2", "creep-log")
     assert lab.worker.refits._running() is not None
@@ -278,7 +297,7 @@ def test_a_diagnosis_and_what_the_lab_shows_of_it_are_built_on_the_pool(qtbot, l
 def test_cancel_stops_a_refit_and_keeps_the_model(qtbot, lab, monkeypatch):
     started = threading.Event()
 
-    def blocked(refits, ticket, data, model, start, cancel):
+    def blocked(refits, ticket, data, model, current, cancel):
         started.set()
         if not cancel.wait(240):           # only the Cancel button ends this "fit"
             raise AssertionError("never cancelled")
