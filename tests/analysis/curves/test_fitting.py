@@ -126,6 +126,7 @@ def test_the_json_has_the_shape_of_a_recording_analysis():
     values = PAPER.parameters
     doc = curve_json(fit_curves(curve(values, "impedance"), curve(values, "displacement"), "lr2,creep-log", 0.0133))
     assert set(doc) == {"parameters", "model", "validity"}
-    assert set(doc["model"]) == {"effects", "method", "chi2_red", "aic", "bic", "n_data", "n_parameters", "converged"}
+    assert set(doc["model"]) == {"effects", "method", "chi2_red", "aic", "bic", "n_data", "n_parameters", "converged",
+                                "notes"}
     assert doc["validity"]["overall"] == "unknown" and "no per-line noise" in doc["validity"]["note"]
     assert doc["parameters"]["Bl"]["unit"] == "T*m" and doc["parameters"]["Bl"]["std"] >= 0
