@@ -129,8 +129,8 @@ def render_html(content: ReportContent) -> str:
     for title, fig in residuals:
         parts.append(f"<figure><figcaption>{escape(title)}</figcaption>{svg_of(fig)}</figure>")
     parts.append("<h2>Measurement settings</h2>" + _pairs(c.settings))
-    parts.append("<h2>Calibration as recorded</h2>" + _pairs(c.calibration_detail or
-                                                           (("Calibration", "not recorded"),)))
+    if c.calibration_detail:           # nothing recorded: the first page says so already, in its own words
+        parts.append("<h2>Calibration as recorded</h2>" + _pairs(c.calibration_detail))
     parts.append("<p class='note'>Values in SI are in the results JSON; uncertainties are one standard "
                  "deviation from the fit, scaled by the Birge ratio when the model does not fit within the "
                  "noise.</p></body></html>\n")

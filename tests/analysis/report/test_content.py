@@ -38,3 +38,13 @@ def test_a_recordings_method_and_calibration_are_as_before(stored):
     assert dict(c.fit)["Method"] == "joint: Z and Hx fitted together, each line weighted by its noise"
     assert ("Inputs", "1.5 V at full scale") in c.calibration
     assert dict(build_report(stored, {}).calibration)["Calibration"] == "not recorded with this measurement"
+
+
+def test_the_html_appendix_has_no_calibration_section_when_none_was_recorded(impedance_only, stored):
+    """It said "Calibration as recorded: not recorded" of imported curves whose first page says who calibrated
+    them; the PDF leaves the section out, as the HTML now does."""
+    from analysis.report import render_html
+    html = render_html(impedance_only)
+    assert "Calibration as recorded" not in html and "calibrated by whoever measured them" in html
+    with_keys = build_report(stored, {}, None, {"volts_per_fs": 1.5})
+    assert "Calibration as recorded" in render_html(with_keys)
