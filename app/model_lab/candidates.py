@@ -240,12 +240,13 @@ class CandidatesPanel(QWidget):
 
     def mark_stale(self, version: int) -> None:
         """The model changed since the diagnosis: its candidates are one move from an older version."""
-        if not self.rows or self.stale:
+        if not self.rows:
             return
-        self.stale = True
         self.title.setText(f"{self._heading}: the model is now version {version}; Diagnose again to rank "
-                           f"from it")
-        self.selected_changed.emit()
+                           f"from it")        # the newest version, at each one added
+        if not self.stale:
+            self.stale = True
+            self.selected_changed.emit()
 
     def selected(self) -> CandidateRow | None:
         rows = self.table.selectionModel().selectedRows()

@@ -87,6 +87,7 @@ class SitePanel(QWidget):
         self.sites: tuple[SiteResult, ...] = ()
         self.heading = QLabel()
         self.heading.setTextFormat(Qt.RichText)
+        self._diagnosed_heading: str | None = None
         self.heading.setWordWrap(True)
         self.plot = CorrectionPlot()
         self.ranking = QLabel()
@@ -108,6 +109,7 @@ class SitePanel(QWidget):
         return bool(self.sites) and self.sites[0].delta_bic < -MIN_BIC_GAIN
 
     def set_sites(self, sites: tuple[SiteResult, ...]) -> None:
+        self._diagnosed_heading = None          # the heading of these sites, before mark_stale prefixes it
         self.sites = tuple(sites)
         self.ranking.setText("")
         if not self.sites:
@@ -137,7 +139,11 @@ class SitePanel(QWidget):
         self.ranking.setText("Then: " + " · ".join(rows))
 
     def mark_stale(self, version: int) -> None:
-        """The model changed since the diagnosis: the sites are those of an older version."""
-        if self.sites and "Diagnose again" not in self.heading.text():
-            self.heading.setText(f"<i>Version {version} is newer than this diagnosis: Diagnose again.</i> "
-                                 f"{self.heading.text()}")
+        """The model changed since the diagnosis: the sites are those of an older version (the newest named, at each
+        version added: it said "Version 2 is newer" with the lab at version 3)."""
+        if not self.sites:
+            return
+        if self._diagnosed_heading is None:
+            self._diagnosed_heading = self.heading.text()
+        self.heading.setText(f"<i>Version {version} is newer than this diagnosis: Diagnose again.</i> "
+                             f"{self._diagnosed_heading}")

@@ -171,6 +171,13 @@ def test_diagnose_finds_the_missing_creep_and_apply_lowers_chi2_tenfold(qtbot, l
     assert "noise floor" in lab.residual_panel.text.text()
     assert _parameter(lab, "lambda") == pytest.approx(PAPER.parameters["lambda"], rel=0.05)
     assert lab.candidates.stale and not lab.candidates.apply_button.isEnabled()
+    assert "version 2" in lab.candidates.title.text()
+    # A third version: the stale diagnosis names the newest (it kept saying "version 2").
+    _toggle(qtbot, lab, top.effect.id, checked=False)
+    assert lab.current.number == 3 and "version 3" in lab.candidates.title.text()
+    if lab.site_panel.sites:
+        heading = lab.site_panel.heading.text()
+        assert "Version 3 is newer" in heading and heading.count("Diagnose again") == 1
 
 
 def test_unchecking_an_effect_refits_and_raises_chi2(qtbot, make_lab, full_result):
