@@ -109,3 +109,9 @@ def test_in_a_1280x720_window_the_labs_header_says_its_words_whole(qtbot, window
     QApplication.processEvents()
     for label in (lab.model_label, lab.status_label):
         assert label.heightForWidth(label.width()) <= label.height(), label.text()
+    # Both problems at once: the misfit rose, and a parameter on its bound (they ran past four lines).
+    both = dataclasses.replace(on_bound, chi2=fitted.chi2 * 10)
+    lab.status_label.setText(refit_text(fitted, both))
+    assert "The misfit rose" in lab.status_label.text() and "Try widening that bound" in lab.status_label.text()
+    QApplication.processEvents()
+    assert lab.status_label.heightForWidth(lab.status_label.width()) <= lab.status_label.height()
