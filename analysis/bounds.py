@@ -162,7 +162,9 @@ class SizeLimits:
 
     wav: int = 2 * GiB              # a recording's samples: ~3 hours of 3 channels of float32 at 48 kHz
     sidecar: int = 10 * MiB         # a recording's NAME.json: a few kB, with the capture's counts
-    curve: int = 200 * MiB          # an imported curve export (text)
+    # An imported curve export (text): 20 times a 1 Hz-spaced U/I/V export to 10 kHz (1 MB). An 87 MB file of
+    # 3 million lines took 30 s and 2.9 GB of memory to read and fit; at the 200 MB allowed before, 6-7 GB.
+    curve: int = 20 * MiB
     archive: int = 50 * MiB         # an archive's JSON files (results.json holds every fitted line)
     laser_stream: int = 2 * GiB     # a raw laser stream kept with a measurement
     config: int = 10 * MiB          # limits, thresholds, driver and calibration files
