@@ -8,8 +8,8 @@ QA's (analysis.fit.error.FIT_ERROR_DEFAULTS): what QA does not judge, the result
 """
 from __future__ import annotations
 
+from analysis.curves.findings import with_curve_findings
 from analysis.fit.error import FIT_ERROR_DEFAULTS
-from analysis.validity.assessment import ChannelValidity
 from analysis.validity.findings import MODEL_MISFIT, Finding, Severity
 from analysis.validity.fit import CURVES_MISFIT_REMEDY
 from analysis.validity.result import ResultValidity
@@ -17,18 +17,12 @@ from analysis.validity.result import ResultValidity
 
 def judged_misfit(validity: ResultValidity) -> ResultValidity:
     """`validity` with a yellow model-misfit finding on each curve whose fit error exceeds its tolerance."""
-    channels = dict(validity.channels)
+    found = []
     for name, error in (validity.fit_error_percent or {}).items():
         tolerance = FIT_ERROR_DEFAULTS.get(name)
         if tolerance is None or error <= tolerance:
             continue
-        finding = Finding(name, MODEL_MISFIT, Severity.YELLOW,
-                          f"{name}: the model misses this curve by {error:.3g} % rms (tolerance {tolerance:g} %): "
-                          "its parameters are doubtful, and QA does not judge them", CURVES_MISFIT_REMEDY, error)
-        before = channels.get(name)
-        # The curve has findings but no light of its own: nothing else of it was checked.
-        channels[name] = ChannelValidity(name, None, (*(before.findings if before else ()), finding))
-    if channels == validity.channels:
-        return validity
-    overall = Severity.YELLOW if validity.overall not in (Severity.RED, Severity.YELLOW) else validity.overall
-    return validity.replace(overall=overall, channels=channels)
+        found.append(Finding(name, MODEL_MISFIT, Severity.YELLOW,
+                             f"{name}: the model misses this curve by {error:.3g} % rms (tolerance {tolerance:g} %): "
+                             "its parameters are doubtful, and QA does not judge them", CURVES_MISFIT_REMEDY, error))
+    return with_curve_findings(validity, found)

@@ -9,9 +9,8 @@ from __future__ import annotations
 
 from typing import Mapping
 
+from analysis.curves.findings import with_curve_findings
 from analysis.derived import ParameterValue
-from analysis.validity.assessment import ChannelValidity
-from analysis.validity.findings import Severity, worst
 from analysis.validity.plausibility import mechanical_findings
 from analysis.validity.result import ResultValidity
 
@@ -23,12 +22,4 @@ def judged_plausible(validity: ResultValidity, parameters: Mapping[str, Paramete
                      sd_m2: float | None) -> ResultValidity:
     """`validity` with the findings of numbers no driver has on the displacement (the channel the mass and the
     efficiency come from); its overall light the worst of them where there are any."""
-    found = mechanical_findings(parameters, sd_m2, None, x_scale=HX_SCALE)
-    if not found:
-        return validity
-    light = worst(f.severity for f in found)
-    if validity.overall in set(Severity) and Severity(validity.overall).rank > light.rank:
-        light = Severity(validity.overall)
-    # The channel has findings but no light of its own: nothing else of the curves was checked.
-    channels = {**validity.channels, "displacement": ChannelValidity("displacement", None, tuple(found))}
-    return validity.replace(overall=light, channels=channels)
+    return with_curve_findings(validity, mechanical_findings(parameters, sd_m2, None, x_scale=HX_SCALE))

@@ -184,13 +184,16 @@ def site_gap(current: FitResult, candidate: FitResult, effect: Effect, site: "Si
     return candidate.chi2 - allowed
 
 
+def idle_parameters(fit: FitResult, names: tuple[str, ...] | None = None) -> list[str]:
+    """The parameters (all, or `names`) undetermined or on a bound: their effect may have nothing left to do."""
+    return [f.parameter for f in parameter_flags(fit, names, typical=False) if f.code in (UNDETERMINED, AT_BOUND)]
+
+
 def simplifies(current: FitResult, fit: FitResult | None, replaced: Effect | None) -> bool:
     """A swap to fewer parameters, for an effect with a parameter undetermined or on a bound in `current`."""
     if fit is None or replaced is None or fit.n_varying >= current.n_varying:
         return False
-    idle = {f.parameter for f in parameter_flags(current, replaced.param_names, typical=False)
-            if f.code in (UNDETERMINED, AT_BOUND)}
-    return bool(idle)
+    return bool(idle_parameters(current, replaced.param_names))
 
 
 def assess(current: FitResult, fit: FitResult | None, effect: Effect, flags: tuple[Flag, ...],

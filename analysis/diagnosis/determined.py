@@ -30,7 +30,7 @@ from typing import Sequence
 
 import numpy as np
 
-from analysis.fit.covariance import MAX_CONDITION, jacobian
+from analysis.fit.covariance import MAX_CONDITION, jacobian, normal_inverse
 from analysis.fit.least_squares import FitData, FitResult, _residual_vector, channel_sigmas
 
 
@@ -52,12 +52,9 @@ def with_undetermined_held(data: FitData, fit: FitResult | None, last: Sequence[
     sigmas = channel_sigmas(data, use_x)
     J = jacobian(lambda p: _residual_vector(fit.model, p, data, use_x, sigmas), fit.values, names, specs)
     kept = _independent_columns(J)
-    if not kept:
+    covar = normal_inverse(J[:, kept]) if kept else None
+    if covar is None:
         return fit
-    columns = J[:, kept]
-    norms = np.linalg.norm(columns, axis=0)
-    scaled = columns / norms
-    covar = np.linalg.inv(scaled.T @ scaled) / np.outer(norms, norms)
     # Scaled as analysis.fit.least_squares.result_of scales the whole covariance.
     birge = max(1.0, fit.chi2_red) if fit.noise_known else fit.chi2_red
     stderr = {n: None for n in fit.values}

@@ -65,8 +65,7 @@ def meets_noise(fit: FitResult, sites: dict) -> bool:
 
 def superfluous_parameters(fit: FitResult) -> list[str]:
     """The parameters undetermined or on a bound (their effect may have nothing left to do)."""
-    return [f.parameter for f in acceptance.parameter_flags(fit, typical=False)
-            if f.code in (acceptance.UNDETERMINED, acceptance.AT_BOUND)]
+    return acceptance.idle_parameters(fit)
 
 
 def idle_effects(fit: FitResult) -> tuple[Effect, ...]:
